@@ -1,1 +1,6 @@
-fn main() {}
+//! `moreau`: the command-line tool of the workspace. See `moreau --help`.
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    driver::cli::main()
+}

@@ -1,1 +1,23 @@
-//! model
+//! The system of the paper, eq. (xy)-(yz): `x' = A x + B w + E z`, `y = C x`, `z in y + Theta`,
+//! with its input `w(t)`, initial state `(x0, z0)` and simulation defaults, and the TOML
+//! model-file format that describes it.
+//!
+//! - [`system`]: the validated [`System`] and its linearisation `F = A + E C` (eq. (F)).
+//! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, samples from a CSV).
+//! - [`model_file`]: reading and writing model files with errors that name key and value.
+//! - [`effects`]: optional physics extensions (friction, delay, ...) used by `discovery`;
+//!   all equal to the nominal model at zero.
+#![allow(non_snake_case)]
+
+pub mod effects;
+pub mod error;
+pub mod input;
+pub mod model_file;
+pub mod system;
+mod toml_access;
+
+pub use effects::Effects;
+pub use error::ModelError;
+pub use input::Input;
+pub use model_file::{load, parse_str, to_toml_string};
+pub use system::{SimDefaults, System};

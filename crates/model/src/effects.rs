@@ -1,0 +1,201 @@
+//! Optional physics extensions of the nominal model (`[[effects]]` in a model file), used by
+//! the `discovery` crate to express what a recording shows and the nominal model lacks.
+//! Each effect equals the nominal model when its parameters are zero (or it is absent), so a
+//! fitted model is an ordinary model file.
+use crate::toml_access::{check_keys, describe, f64_at, key, str_at, vec_at, vec_value};
+use crate::ModelError;
+use toml::{Table, Value};
+
+/// Where a backlash (play) effect sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlayLocation {
+    /// In the feedback loop, as in the paper (`z in y + [-w/2, w/2]`).
+    Loop,
+    /// Between the input and the plant (`w` passes through a play operator).
+    Input,
+}
+
+/// One physical effect. Parameters are in the units of the model's states and input.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    /// A play of total width `width` where the nominal model has none.
+    Backlash { width: f64, location: PlayLocation },
+    /// Theta scaled by `1 + relative_change`.
+    GapWidth { relative_change: f64 },
+    /// Coulomb friction of level `level` on the derivative of velocity state `state`,
+    /// with stick-slip (the state sticks at zero while the other forces stay below `level`).
+    CoulombFriction { state: usize, level: f64 },
+    /// Constant bias `force` added to the derivative of state `state`.
+    ConstantForce { state: usize, force: f64 },
+    /// The backlash output has mass `mass` and damping `damping`: after `y` reverses, `z`
+    /// coasts instead of stopping at once.
+    BacklashInertia { mass: f64, damping: f64 },
+    /// The plant sees `w(t - delay)`.
+    InputDelay { delay: f64 },
+    /// The plant sees `clamp(w, -limit, limit)`.
+    InputSaturation { limit: f64 },
+    /// The sensor reads `y + offset`.
+    SensorOffset { offset: Vec<f64> },
+}
+
+impl Effect {
+    /// The name used in model files and reports.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Effect::Backlash { .. } => "backlash",
+            Effect::GapWidth { .. } => "gap_width",
+            Effect::CoulombFriction { .. } => "coulomb_friction",
+            Effect::ConstantForce { .. } => "constant_force",
+            Effect::BacklashInertia { .. } => "backlash_inertia",
+            Effect::InputDelay { .. } => "input_delay",
+            Effect::InputSaturation { .. } => "input_saturation",
+            Effect::SensorOffset { .. } => "sensor_offset",
+        }
+    }
+}
+
+/// The list of effects of a model (empty for the nominal model).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Effects {
+    pub list: Vec<Effect>,
+}
+
+fn nonneg(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
+    let v = f64_at(t, prefix, k)?;
+    if v < 0.0 {
+        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be non-negative" });
+    }
+    Ok(v)
+}
+
+fn state_index(t: &Table, prefix: &str, n: usize) -> Result<usize, ModelError> {
+    let v = f64_at(t, prefix, "state")?;
+    if v < 0.0 || v.fract() != 0.0 || v as usize >= n {
+        return Err(ModelError::OutOfRange { key: key(prefix, "state"), value: v, reason: "must be a state index 0..n-1" });
+    }
+    Ok(v as usize)
+}
+
+impl Effects {
+    /// Parses `[[effects]]` entries; `n` and `p` are the model's state and output dimensions.
+    pub(crate) fn parse(v: Option<&Value>, n: usize, p: usize) -> Result<Self, ModelError> {
+        let Some(v) = v else { return Ok(Self::default()) };
+        let Value::Array(items) = v else {
+            return Err(ModelError::WrongType { key: "effects".into(), expected: "an array of tables ([[effects]])", found: describe(v) });
+        };
+        let mut list = Vec::new();
+        for (i, it) in items.iter().enumerate() {
+            let prefix = format!("effects[{i}]");
+            let Value::Table(t) = it else {
+                return Err(ModelError::WrongType { key: prefix, expected: "a table", found: describe(it) });
+            };
+            let kind = str_at(t, &prefix, "kind")?;
+            let e = match kind {
+                "backlash" => {
+                    check_keys(t, &prefix, "kind, width, location")?;
+                    let location = match t.get("location").map(|l| l.as_str()) {
+                        None | Some(Some("loop")) => PlayLocation::Loop,
+                        Some(Some("input")) => PlayLocation::Input,
+                        Some(_) => return Err(ModelError::WrongType { key: key(&prefix, "location"), expected: "\"loop\" or \"input\"", found: describe(&t["location"]) }),
+                    };
+                    Effect::Backlash { width: nonneg(t, &prefix, "width")?, location }
+                }
+                "gap_width" => {
+                    check_keys(t, &prefix, "kind, relative_change")?;
+                    let r = f64_at(t, &prefix, "relative_change")?;
+                    if r <= -1.0 {
+                        return Err(ModelError::OutOfRange { key: key(&prefix, "relative_change"), value: r, reason: "must exceed -1" });
+                    }
+                    Effect::GapWidth { relative_change: r }
+                }
+                "coulomb_friction" => {
+                    check_keys(t, &prefix, "kind, state, level")?;
+                    Effect::CoulombFriction { state: state_index(t, &prefix, n)?, level: nonneg(t, &prefix, "level")? }
+                }
+                "constant_force" => {
+                    check_keys(t, &prefix, "kind, state, force")?;
+                    Effect::ConstantForce { state: state_index(t, &prefix, n)?, force: f64_at(t, &prefix, "force")? }
+                }
+                "backlash_inertia" => {
+                    check_keys(t, &prefix, "kind, mass, damping")?;
+                    Effect::BacklashInertia { mass: nonneg(t, &prefix, "mass")?, damping: nonneg(t, &prefix, "damping")? }
+                }
+                "input_delay" => {
+                    check_keys(t, &prefix, "kind, delay")?;
+                    Effect::InputDelay { delay: nonneg(t, &prefix, "delay")? }
+                }
+                "input_saturation" => {
+                    check_keys(t, &prefix, "kind, limit")?;
+                    let l = f64_at(t, &prefix, "limit")?;
+                    if l <= 0.0 {
+                        return Err(ModelError::OutOfRange { key: key(&prefix, "limit"), value: l, reason: "must be positive" });
+                    }
+                    Effect::InputSaturation { limit: l }
+                }
+                "sensor_offset" => {
+                    check_keys(t, &prefix, "kind, offset")?;
+                    let o = vec_at(t, &prefix, "offset")?;
+                    if o.len() != p {
+                        return Err(ModelError::Dimension { key: key(&prefix, "offset"), expected: format!("length p = {p}"), got: format!("length {}", o.len()) });
+                    }
+                    Effect::SensorOffset { offset: o }
+                }
+                other => {
+                    return Err(ModelError::WrongType {
+                        key: key(&prefix, "kind"),
+                        expected: "one of backlash, gap_width, coulomb_friction, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
+                        found: format!("{other:?}"),
+                    })
+                }
+            };
+            list.push(e);
+        }
+        Ok(Self { list })
+    }
+
+    pub(crate) fn to_value(&self) -> Option<Value> {
+        if self.list.is_empty() {
+            return None;
+        }
+        let items = self
+            .list
+            .iter()
+            .map(|e| {
+                let mut t = Table::new();
+                t.insert("kind".into(), Value::String(e.kind().into()));
+                match e {
+                    Effect::Backlash { width, location } => {
+                        t.insert("width".into(), Value::Float(*width));
+                        t.insert("location".into(), Value::String(if *location == PlayLocation::Loop { "loop" } else { "input" }.into()));
+                    }
+                    Effect::GapWidth { relative_change } => {
+                        t.insert("relative_change".into(), Value::Float(*relative_change));
+                    }
+                    Effect::CoulombFriction { state, level } => {
+                        t.insert("state".into(), Value::Integer(*state as i64));
+                        t.insert("level".into(), Value::Float(*level));
+                    }
+                    Effect::ConstantForce { state, force } => {
+                        t.insert("state".into(), Value::Integer(*state as i64));
+                        t.insert("force".into(), Value::Float(*force));
+                    }
+                    Effect::BacklashInertia { mass, damping } => {
+                        t.insert("mass".into(), Value::Float(*mass));
+                        t.insert("damping".into(), Value::Float(*damping));
+                    }
+                    Effect::InputDelay { delay } => {
+                        t.insert("delay".into(), Value::Float(*delay));
+                    }
+                    Effect::InputSaturation { limit } => {
+                        t.insert("limit".into(), Value::Float(*limit));
+                    }
+                    Effect::SensorOffset { offset } => {
+                        t.insert("offset".into(), vec_value(offset));
+                    }
+                }
+                Value::Table(t)
+            })
+            .collect();
+        Some(Value::Array(items))
+    }
+}

@@ -1,0 +1,40 @@
+//! Errors of model files: each names the offending key and value.
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum ModelError {
+    #[error("cannot read {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: TOML syntax error: {message}")]
+    Syntax { path: String, message: String },
+    #[error("missing key `{key}`")]
+    Missing { key: String },
+    #[error("key `{key}`: expected {expected}, found {found}")]
+    WrongType { key: String, expected: &'static str, found: String },
+    #[error("key `{key}`: value {value} is not finite")]
+    NotFinite { key: String, value: f64 },
+    #[error("key `{key}`: {reason} (value {value})")]
+    OutOfRange { key: String, value: f64, reason: &'static str },
+    #[error("key `{key}`: expected {expected}, got {got}")]
+    Dimension { key: String, expected: String, got: String },
+    #[error("key `{key}`: rows have different lengths (row 0 has {first}, row {row} has {len})")]
+    Ragged { key: String, first: usize, row: usize, len: usize },
+    #[error("key `theta.shape`: unknown shape {value:?} (known: interval, ball, ellipsoid, ball_intersection, polytope, box, point)")]
+    UnknownShape { value: String },
+    #[error("key `input.kind`: unknown input {value:?} (known: sine, square, csv, zero)")]
+    UnknownInput { value: String },
+    #[error("key `{key}`: {source}")]
+    Geometry { key: String, source: geometry::GeometryError },
+    #[error("Theta does not contain 0 (distance {distance:e} from 0 to Theta = {theta})")]
+    ThetaMissesOrigin { distance: f64, theta: String },
+    #[error("initial condition violates z0 - C x0 in Theta: q0 = {q0:?} is at distance {distance:e} from Theta")]
+    InitialOutsideTheta { q0: Vec<f64>, distance: f64 },
+    #[error("input CSV {path}: {reason}")]
+    Csv { path: String, reason: String },
+    #[error("input CSV {path}: time stamps must increase strictly: row {row} has t = {t} after t = {prev}")]
+    UnsortedTimes { path: String, row: usize, t: f64, prev: f64 },
+    #[error("input CSV {path}: row {row}, column `{column}`: value {value:?} is not a finite number")]
+    CsvValue { path: String, row: usize, column: String, value: String },
+    #[error("key `{key}`: unknown key (known here: {known})")]
+    UnknownKey { key: String, known: &'static str },
+}

@@ -1,0 +1,153 @@
+//! The external input `w(t)` of eq. (xy).
+use crate::ModelError;
+use std::f64::consts::TAU;
+use std::path::Path;
+
+/// Input signal `w : R -> R^m`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Input {
+    /// `w = 0` in R^m.
+    Zero { m: usize },
+    /// `w_i(t) = a_i sin(omega t + phase)`; period `2 pi / omega`.
+    Sine { amplitudes: Vec<f64>, omega: f64, phase: f64 },
+    /// `w_i(t) = a_i sign(sin(omega t + phase))` (value `+a_i` at the jumps); period `2 pi / omega`.
+    Square { amplitudes: Vec<f64>, omega: f64, phase: f64 },
+    /// Samples `(t_k, w_k)` from a CSV file, linearly interpolated, held constant outside the
+    /// sampled range. Periodic only if a `period` is stated.
+    Samples { path: String, t: Vec<f64>, w: Vec<Vec<f64>>, period: Option<f64> },
+}
+
+impl Input {
+    /// Dimension `m` of `w`.
+    pub fn m(&self) -> usize {
+        match self {
+            Input::Zero { m } => *m,
+            Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } => amplitudes.len(),
+            Input::Samples { w, .. } => w[0].len(),
+        }
+    }
+
+    /// The period `T` if the input is periodic.
+    pub fn period(&self) -> Option<f64> {
+        match self {
+            Input::Zero { .. } => None,
+            Input::Sine { omega, .. } | Input::Square { omega, .. } => Some(TAU / omega),
+            Input::Samples { period, .. } => *period,
+        }
+    }
+
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Input::Zero { .. } => "zero",
+            Input::Sine { .. } => "sine",
+            Input::Square { .. } => "square",
+            Input::Samples { .. } => "csv",
+        }
+    }
+
+    /// Writes `w(t)` into `out` (length `m`).
+    pub fn eval(&self, t: f64, out: &mut [f64]) {
+        match self {
+            Input::Zero { .. } => out.iter_mut().for_each(|o| *o = 0.0),
+            Input::Sine { amplitudes, omega, phase } => {
+                let s = (omega * t + phase).sin();
+                out.iter_mut().zip(amplitudes).for_each(|(o, a)| *o = a * s);
+            }
+            Input::Square { amplitudes, omega, phase } => {
+                let s = if (omega * t + phase).rem_euclid(TAU) < std::f64::consts::PI { 1.0 } else { -1.0 };
+                out.iter_mut().zip(amplitudes).for_each(|(o, a)| *o = a * s);
+            }
+            Input::Samples { t: ts, w, period, .. } => {
+                let mut tt = t;
+                if let Some(per) = period {
+                    tt = ts[0] + (t - ts[0]).rem_euclid(*per);
+                }
+                let k = ts.partition_point(|&s| s <= tt);
+                if k == 0 {
+                    out.copy_from_slice(&w[0]);
+                } else if k >= ts.len() {
+                    out.copy_from_slice(&w[ts.len() - 1]);
+                } else {
+                    let (t0, t1) = (ts[k - 1], ts[k]);
+                    let a = (tt - t0) / (t1 - t0);
+                    for (i, o) in out.iter_mut().enumerate() {
+                        *o = (1.0 - a) * w[k - 1][i] + a * w[k][i];
+                    }
+                }
+            }
+        }
+    }
+
+    /// `w(t)` as a new vector.
+    pub fn at(&self, t: f64) -> Vec<f64> {
+        let mut out = vec![0.0; self.m()];
+        self.eval(t, &mut out);
+        out
+    }
+
+    /// Reads samples from a CSV file with header `t,w` or `t,w1,...,wm`. Rejects missing or
+    /// non-numeric cells, NaN/inf, and time stamps that do not increase strictly.
+    pub fn from_csv(path: &Path, period: Option<f64>) -> Result<Self, ModelError> {
+        let ps = path.display().to_string();
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_path(path)
+            .map_err(|e| ModelError::Csv { path: ps.clone(), reason: e.to_string() })?;
+        let headers = rdr.headers().map_err(|e| ModelError::Csv { path: ps.clone(), reason: e.to_string() })?.clone();
+        let names: Vec<String> = headers.iter().map(|h| h.to_string()).collect();
+        if names.len() < 2 || names[0] != "t" || !names[1..].iter().all(|h| h.starts_with('w')) {
+            return Err(ModelError::Csv { path: ps, reason: format!("header must be `t,w` or `t,w1,...,wm`, found `{}`", names.join(",")) });
+        }
+        let mut t = Vec::new();
+        let mut w = Vec::new();
+        for (i, rec) in rdr.records().enumerate() {
+            let row = i + 2; // 1-based, after the header
+            let rec = rec.map_err(|e| ModelError::Csv { path: ps.clone(), reason: format!("row {row}: {e}") })?;
+            if rec.len() != names.len() {
+                return Err(ModelError::Csv { path: ps, reason: format!("row {row} has {} fields, header has {}", rec.len(), names.len()) });
+            }
+            let mut vals = Vec::with_capacity(names.len());
+            for (j, cell) in rec.iter().enumerate() {
+                match cell.parse::<f64>() {
+                    Ok(x) if x.is_finite() => vals.push(x),
+                    _ => return Err(ModelError::CsvValue { path: ps, row, column: names[j].clone(), value: cell.to_string() }),
+                }
+            }
+            if let Some(&prev) = t.last() {
+                if vals[0] <= prev {
+                    return Err(ModelError::UnsortedTimes { path: ps, row, t: vals[0], prev });
+                }
+            }
+            t.push(vals[0]);
+            w.push(vals[1..].to_vec());
+        }
+        if t.len() < 2 {
+            return Err(ModelError::Csv { path: ps, reason: format!("needs at least 2 samples, found {}", t.len()) });
+        }
+        Ok(Input::Samples { path: path.display().to_string(), t, w, period })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sine_and_square_have_the_stated_period_and_values() {
+        let s = Input::Sine { amplitudes: vec![2.0], omega: 2.0, phase: 0.0 };
+        assert!((s.period().unwrap() - std::f64::consts::PI).abs() < 1e-15);
+        assert!((s.at(std::f64::consts::PI / 4.0)[0] - 2.0).abs() < 1e-15);
+        let q = Input::Square { amplitudes: vec![1.0, -3.0], omega: 1.0, phase: 0.0 };
+        assert_eq!(q.at(1.0), vec![1.0, -3.0]);
+        assert_eq!(q.at(4.0), vec![-1.0, 3.0]);
+    }
+
+    #[test]
+    fn samples_interpolate_linearly_and_hold_outside() {
+        let s = Input::Samples { path: String::new(), t: vec![0.0, 1.0, 3.0], w: vec![vec![0.0], vec![2.0], vec![0.0]], period: None };
+        assert_eq!(s.at(0.5), vec![1.0]);
+        assert_eq!(s.at(2.0), vec![1.0]);
+        assert_eq!(s.at(-1.0), vec![0.0]);
+        assert_eq!(s.at(9.0), vec![0.0]);
+    }
+}

@@ -1,0 +1,293 @@
+//! The TOML model file. Example (the worked example of NOTES.md):
+//!
+//! ```toml
+//! name = "worked example"
+//! [plant]
+//! A = [[0.0, 1.0], [-2.0, -0.6]]
+//! B = [[0.0], [1.0]]          # or the flat column [0.0, 1.0]
+//! C = [[1.0, 0.0]]
+//! E = [[0.0], [1.0]]
+//! [theta]                     # absent: Theta = {0}
+//! shape = "interval"          # interval | ball | ellipsoid | ball_intersection | polytope | box | point
+//! half_width = 0.1            # or lo/hi
+//! [input]
+//! kind = "sine"               # sine | square | csv | zero
+//! amplitudes = [1.0]
+//! omega = 1.0
+//! [initial]
+//! x0 = [0.0, 0.0]
+//! z0 = [0.0]
+//! [simulation]
+//! dt = 1e-3
+//! periods = 20
+//! ```
+//!
+//! Shapes: `interval` (`half_width` or `lo`, `hi`); `ball` (`centre` (default 0), `radius`);
+//! `ellipsoid` (`centre` (default 0) and `matrix` (SPD shape matrix `M`, the set is
+//! `(x-c)^T M^{-1} (x-c) <= 1`) or `semi_axes`); `ball_intersection` (`centres`, `radii`);
+//! `polytope` (`normals`, `offsets`: `normals[i] . x <= offsets[i]`); `box` (`lower`,
+//! `upper`); `point` (`{0}`). Input `csv`: `file` (relative to the model file) with header
+//! `t,w` or `t,w1,...,wm`, optional `period`.
+use crate::toml_access::*;
+use crate::{Effects, Input, ModelError, SimDefaults, System};
+use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, GeometryError, Interval, Polytope, Shape};
+use nalgebra::DVector;
+use std::path::Path;
+use toml::{Table, Value};
+
+/// Reads and validates a model file.
+pub fn load(path: &Path) -> Result<System, ModelError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io { path: path.display().to_string(), source })?;
+    parse_str_with(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
+}
+
+/// Parses a model file from a string (`csv` inputs are resolved relative to the current
+/// directory).
+pub fn parse_str(text: &str) -> Result<System, ModelError> {
+    parse_str_with(text, "<string>", Path::new("."))
+}
+
+fn geo(key: &str) -> impl FnOnce(GeometryError) -> ModelError + '_ {
+    move |source| ModelError::Geometry { key: key.into(), source }
+}
+
+fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
+    let Some(t) = t else { return Ok(Shape::origin(p)) };
+    let pre = "theta";
+    let shape = str_at(t, pre, "shape")?;
+    let centre = |t: &Table| -> Result<Vec<f64>, ModelError> { if t.contains_key("centre") { vec_at(t, pre, "centre") } else { Ok(vec![0.0; p]) } };
+    Ok(match shape {
+        "interval" => {
+            check_keys(t, pre, "shape, half_width, lo, hi")?;
+            if let Some(d) = opt_f64(t, pre, "half_width")? {
+                if d < 0.0 {
+                    return Err(ModelError::OutOfRange { key: "theta.half_width".into(), value: d, reason: "must be non-negative" });
+                }
+                Shape::Interval(Interval::symmetric(d).map_err(geo("theta.half_width"))?)
+            } else {
+                Shape::Interval(Interval::new(f64_at(t, pre, "lo")?, f64_at(t, pre, "hi")?).map_err(geo("theta.lo/hi"))?)
+            }
+        }
+        "ball" => {
+            check_keys(t, pre, "shape, centre, radius")?;
+            let r = f64_at(t, pre, "radius")?;
+            if r < 0.0 {
+                return Err(ModelError::OutOfRange { key: "theta.radius".into(), value: r, reason: "must be non-negative" });
+            }
+            Shape::Ball(Ball::new(centre(t)?, r).map_err(geo("theta.radius"))?)
+        }
+        "point" => {
+            check_keys(t, pre, "shape")?;
+            Shape::origin(p)
+        }
+        "ellipsoid" => {
+            check_keys(t, pre, "shape, centre, matrix, semi_axes")?;
+            let c = centre(t)?;
+            if t.contains_key("semi_axes") {
+                let a = vec_at(t, pre, "semi_axes")?;
+                if let Some(&bad) = a.iter().find(|&&x| x <= 0.0) {
+                    return Err(ModelError::OutOfRange { key: "theta.semi_axes".into(), value: bad, reason: "semi-axes must be positive" });
+                }
+                if a.len() != c.len() {
+                    return Err(ModelError::Dimension { key: "theta.semi_axes".into(), expected: format!("length {}", c.len()), got: format!("length {}", a.len()) });
+                }
+                Shape::Ellipsoid(Ellipsoid::axis_aligned(c, &a).map_err(geo("theta.semi_axes"))?)
+            } else {
+                let m = matrix_at(t, pre, "matrix", false)?;
+                Shape::Ellipsoid(Ellipsoid::new(c, &m).map_err(geo("theta.matrix"))?)
+            }
+        }
+        "ball_intersection" => {
+            check_keys(t, pre, "shape, centres, radii")?;
+            let centres = rows_at(t, pre, "centres")?;
+            let radii = vec_at(t, pre, "radii")?;
+            Shape::BallIntersection(BallIntersection::new(centres, radii).map_err(geo("theta"))?)
+        }
+        "polytope" => {
+            check_keys(t, pre, "shape, normals, offsets")?;
+            let normals = rows_at(t, pre, "normals")?;
+            let offsets = vec_at(t, pre, "offsets")?;
+            Shape::Polytope(Polytope::new(normals, offsets).map_err(geo("theta"))?)
+        }
+        "box" => {
+            check_keys(t, pre, "shape, lower, upper")?;
+            Shape::Polytope(Polytope::from_box(&vec_at(t, pre, "lower")?, &vec_at(t, pre, "upper")?).map_err(geo("theta"))?)
+        }
+        other => return Err(ModelError::UnknownShape { value: other.to_string() }),
+    })
+}
+
+fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelError> {
+    let Some(t) = t else { return Ok(Input::Zero { m }) };
+    let pre = "input";
+    let kind = str_at(t, pre, "kind")?;
+    let omega_phase = |t: &Table| -> Result<(f64, f64), ModelError> {
+        let omega = f64_at(t, pre, "omega")?;
+        if omega <= 0.0 {
+            return Err(ModelError::OutOfRange { key: "input.omega".into(), value: omega, reason: "angular frequency must be positive" });
+        }
+        Ok((omega, opt_f64(t, pre, "phase")?.unwrap_or(0.0)))
+    };
+    Ok(match kind {
+        "zero" => {
+            check_keys(t, pre, "kind")?;
+            Input::Zero { m }
+        }
+        "sine" | "square" => {
+            check_keys(t, pre, "kind, amplitudes, omega, phase")?;
+            let amplitudes = vec_at(t, pre, "amplitudes")?;
+            let (omega, phase) = omega_phase(t)?;
+            if kind == "sine" { Input::Sine { amplitudes, omega, phase } } else { Input::Square { amplitudes, omega, phase } }
+        }
+        "csv" => {
+            check_keys(t, pre, "kind, file, period")?;
+            let file = str_at(t, pre, "file")?;
+            let period = opt_f64(t, pre, "period")?;
+            if let Some(per) = period {
+                if per <= 0.0 {
+                    return Err(ModelError::OutOfRange { key: "input.period".into(), value: per, reason: "must be positive" });
+                }
+            }
+            Input::from_csv(&dir.join(file), period)?
+        }
+        other => return Err(ModelError::UnknownInput { value: other.to_string() }),
+    })
+}
+
+fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
+    let root: Table = text.parse::<Table>().map_err(|e| ModelError::Syntax { path: origin.to_string(), message: e.to_string().lines().next().unwrap_or("").to_string() })?;
+    check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects")?;
+    let name = match root.get("name") {
+        Some(Value::String(s)) => s.clone(),
+        Some(other) => return Err(ModelError::WrongType { key: "name".into(), expected: "a string", found: describe(other) }),
+        None => origin.to_string(),
+    };
+    let plant = table_at(&root, "", "plant")?;
+    check_keys(plant, "plant", "A, B, C, E")?;
+    let A = matrix_at(plant, "plant", "A", false)?;
+    let B = matrix_at(plant, "plant", "B", true)?;
+    let C = matrix_at(plant, "plant", "C", false)?;
+    let E = matrix_at(plant, "plant", "E", true)?;
+    let n = A.nrows();
+    let p = C.nrows();
+    let sub = |k: &str| -> Result<Option<&Table>, ModelError> {
+        match root.get(k) {
+            None => Ok(None),
+            Some(Value::Table(t)) => Ok(Some(t)),
+            Some(other) => Err(ModelError::WrongType { key: k.into(), expected: "a table", found: describe(other) }),
+        }
+    };
+    let theta = parse_theta(sub("theta")?, p)?;
+    let input = parse_input(sub("input")?, B.ncols(), dir)?;
+    let (x0, z0) = match sub("initial")? {
+        None => (DVector::zeros(n), DVector::zeros(p)),
+        Some(t) => {
+            check_keys(t, "initial", "x0, z0")?;
+            let x0 = if t.contains_key("x0") { DVector::from_vec(vec_at(t, "initial", "x0")?) } else { DVector::zeros(n) };
+            let z0 = if t.contains_key("z0") {
+                DVector::from_vec(vec_at(t, "initial", "z0")?)
+            } else if C.ncols() == x0.len() {
+                &C * &x0 // q0 = 0
+            } else {
+                DVector::zeros(p)
+            };
+            (x0, z0)
+        }
+    };
+    let mut sim = SimDefaults::default();
+    if let Some(t) = sub("simulation")? {
+        check_keys(t, "simulation", "dt, periods, t_end")?;
+        if let Some(dt) = opt_f64(t, "simulation", "dt")? {
+            sim.dt = dt;
+        }
+        if let Some(per) = opt_f64(t, "simulation", "periods")? {
+            if per < 1.0 || per.fract() != 0.0 {
+                return Err(ModelError::OutOfRange { key: "simulation.periods".into(), value: per, reason: "must be a positive integer" });
+            }
+            sim.periods = per as usize;
+        }
+        sim.t_end = opt_f64(t, "simulation", "t_end")?;
+    }
+    let effects = Effects::parse(root.get("effects"), n, p)?;
+    System::new(name, A, B, C, E, theta, input, x0, z0, sim, effects)
+}
+
+fn shape_table(s: &Shape) -> Option<Table> {
+    let mut t = Table::new();
+    t.insert("shape".into(), Value::String(s.kind().into()));
+    match s {
+        Shape::Ball(b) if b.radius == 0.0 && b.centre.iter().all(|&c| c == 0.0) => return None,
+        Shape::Interval(i) => {
+            t.insert("lo".into(), Value::Float(i.lo));
+            t.insert("hi".into(), Value::Float(i.hi));
+        }
+        Shape::Ball(b) => {
+            t.insert("shape".into(), Value::String("ball".into()));
+            t.insert("centre".into(), vec_value(&b.centre));
+            t.insert("radius".into(), Value::Float(b.radius));
+        }
+        Shape::Ellipsoid(e) => {
+            let p = e.dim();
+            t.insert("centre".into(), vec_value(e.centre()));
+            let m = nalgebra::DMatrix::from_row_slice(p, p, e.matrix());
+            t.insert("matrix".into(), matrix_value(&m));
+        }
+        Shape::BallIntersection(b) => {
+            t.insert("centres".into(), Value::Array(b.centres().iter().map(|c| vec_value(c)).collect()));
+            t.insert("radii".into(), vec_value(b.radii()));
+        }
+        Shape::Polytope(pl) => {
+            t.insert("normals".into(), Value::Array(pl.normals().iter().map(|c| vec_value(c)).collect()));
+            t.insert("offsets".into(), vec_value(pl.offsets()));
+        }
+    }
+    Some(t)
+}
+
+/// Writes a system as a model file (round-trips through [`parse_str`]; a `csv` input keeps
+/// its file path as given).
+pub fn to_toml_string(s: &System) -> String {
+    let mut root = Table::new();
+    root.insert("name".into(), Value::String(s.name.clone()));
+    let mut plant = Table::new();
+    plant.insert("A".into(), matrix_value(&s.A));
+    plant.insert("B".into(), matrix_value(&s.B));
+    plant.insert("C".into(), matrix_value(&s.C));
+    plant.insert("E".into(), matrix_value(&s.E));
+    root.insert("plant".into(), Value::Table(plant));
+    if let Some(t) = shape_table(&s.theta) {
+        root.insert("theta".into(), Value::Table(t));
+    }
+    let mut inp = Table::new();
+    inp.insert("kind".into(), Value::String(s.input.kind().into()));
+    match &s.input {
+        Input::Zero { .. } => {}
+        Input::Sine { amplitudes, omega, phase } | Input::Square { amplitudes, omega, phase } => {
+            inp.insert("amplitudes".into(), vec_value(amplitudes));
+            inp.insert("omega".into(), Value::Float(*omega));
+            inp.insert("phase".into(), Value::Float(*phase));
+        }
+        Input::Samples { path, period, .. } => {
+            inp.insert("file".into(), Value::String(path.clone()));
+            if let Some(per) = period {
+                inp.insert("period".into(), Value::Float(*per));
+            }
+        }
+    }
+    root.insert("input".into(), Value::Table(inp));
+    let mut init = Table::new();
+    init.insert("x0".into(), vec_value(s.x0.as_slice()));
+    init.insert("z0".into(), vec_value(s.z0.as_slice()));
+    root.insert("initial".into(), Value::Table(init));
+    let mut sim = Table::new();
+    sim.insert("dt".into(), Value::Float(s.sim.dt));
+    sim.insert("periods".into(), Value::Integer(s.sim.periods as i64));
+    if let Some(te) = s.sim.t_end {
+        sim.insert("t_end".into(), Value::Float(te));
+    }
+    root.insert("simulation".into(), Value::Table(sim));
+    if let Some(e) = s.effects.to_value() {
+        root.insert("effects".into(), e);
+    }
+    toml::to_string(&root).expect("a TOML table always serialises")
+}

@@ -1,0 +1,150 @@
+//! The validated closed-loop system of eqs. (xy), (yz).
+use crate::{Effects, Input, ModelError};
+use geometry::{ConvexSet, Shape};
+use nalgebra::{Complex, DMatrix, DVector};
+
+/// Simulation defaults stored in a model file (`[simulation]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimDefaults {
+    /// Time step `h` of the catching-up scheme. Default `1e-3`.
+    pub dt: f64,
+    /// Number of input periods to simulate (periodic inputs). Default `20`.
+    pub periods: usize,
+    /// Final time for non-periodic inputs. Default: the last sample time, or `100`.
+    pub t_end: Option<f64>,
+}
+
+impl Default for SimDefaults {
+    fn default() -> Self {
+        Self { dt: 1e-3, periods: 20, t_end: None }
+    }
+}
+
+/// `x' = A x + B w + E z`, `y = C x`, `z in y + Theta` (eqs. (xy), (yz)) with input, initial
+/// state and simulation defaults. Construct through [`System::new`] (or a model file), which
+/// validates everything.
+#[derive(Debug, Clone)]
+pub struct System {
+    pub name: String,
+    pub A: DMatrix<f64>,
+    pub B: DMatrix<f64>,
+    pub C: DMatrix<f64>,
+    pub E: DMatrix<f64>,
+    /// Backlash set `Theta` (the singleton `{0}` when absent: the linearised system).
+    pub theta: Shape,
+    pub input: Input,
+    pub x0: DVector<f64>,
+    pub z0: DVector<f64>,
+    pub sim: SimDefaults,
+    pub effects: Effects,
+}
+
+fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
+    ModelError::Dimension { key: key.into(), expected, got: format!("{}x{}", got.nrows(), got.ncols()) }
+}
+
+impl System {
+    /// Builds and validates: dimensions of `A (n x n), B (n x m), C (p x n), E (n x p)`,
+    /// `Theta` in R^p containing 0, `x0 in R^n`, `z0 - C x0 in Theta` (to `1e-9` relative),
+    /// finiteness, `m` of the input equal to the columns of `B`.
+    pub fn new(
+        name: impl Into<String>,
+        A: DMatrix<f64>,
+        B: DMatrix<f64>,
+        C: DMatrix<f64>,
+        E: DMatrix<f64>,
+        theta: Shape,
+        input: Input,
+        x0: DVector<f64>,
+        z0: DVector<f64>,
+        sim: SimDefaults,
+        effects: Effects,
+    ) -> Result<Self, ModelError> {
+        let n = A.nrows();
+        if A.ncols() != n || n == 0 {
+            return Err(dim_err("plant.A", "a square n x n matrix".into(), &A));
+        }
+        if B.nrows() != n {
+            return Err(dim_err("plant.B", format!("{n} rows (n)"), &B));
+        }
+        if C.ncols() != n {
+            return Err(dim_err("plant.C", format!("{n} columns (n)"), &C));
+        }
+        let p = C.nrows();
+        if E.nrows() != n || E.ncols() != p {
+            return Err(dim_err("plant.E", format!("{n}x{p} (n x p)"), &E));
+        }
+        for (k, m) in [("plant.A", &A), ("plant.B", &B), ("plant.C", &C), ("plant.E", &E)] {
+            if let Some(&value) = m.iter().find(|x| !x.is_finite()) {
+                return Err(ModelError::NotFinite { key: k.into(), value });
+            }
+        }
+        if theta.dim() != p {
+            return Err(ModelError::Dimension { key: "theta".into(), expected: format!("a set in R^{p} (p = rows of C)"), got: format!("a set in R^{}", theta.dim()) });
+        }
+        if input.m() != B.ncols() {
+            return Err(ModelError::Dimension { key: "input".into(), expected: format!("m = {} components (columns of B)", B.ncols()), got: format!("{}", input.m()) });
+        }
+        if x0.len() != n {
+            return Err(ModelError::Dimension { key: "initial.x0".into(), expected: format!("length n = {n}"), got: format!("length {}", x0.len()) });
+        }
+        if z0.len() != p {
+            return Err(ModelError::Dimension { key: "initial.z0".into(), expected: format!("length p = {p}"), got: format!("length {}", z0.len()) });
+        }
+        let scale = 1.0 + theta.deviation_from_origin().upper;
+        let zero = vec![0.0; p];
+        if !theta.contains(&zero, 1e-12 * scale) {
+            let proj = geometry::convex_set::project_vec(&theta, &zero);
+            return Err(ModelError::ThetaMissesOrigin { distance: geometry::linalg::norm(&proj), theta: theta.describe() });
+        }
+        let q0: Vec<f64> = (&z0 - &C * &x0).iter().copied().collect();
+        let tol = 1e-9 * (scale + geometry::linalg::norm(&q0));
+        if !theta.contains(&q0, tol) {
+            let proj = geometry::convex_set::project_vec(&theta, &q0);
+            return Err(ModelError::InitialOutsideTheta { distance: geometry::linalg::dist(&q0, &proj), q0 });
+        }
+        if !(sim.dt > 0.0 && sim.dt.is_finite()) {
+            return Err(ModelError::OutOfRange { key: "simulation.dt".into(), value: sim.dt, reason: "must be positive and finite" });
+        }
+        if sim.periods == 0 {
+            return Err(ModelError::OutOfRange { key: "simulation.periods".into(), value: 0.0, reason: "must be at least 1" });
+        }
+        Ok(Self { name: name.into(), A, B, C, E, theta, input, x0, z0, sim, effects })
+    }
+
+    /// State dimension `n`.
+    pub fn n(&self) -> usize {
+        self.A.nrows()
+    }
+    /// Input dimension `m`.
+    pub fn m(&self) -> usize {
+        self.B.ncols()
+    }
+    /// Output / backlash dimension `p`.
+    pub fn p(&self) -> usize {
+        self.C.nrows()
+    }
+    /// `F = A + E C`, the matrix of the linearised system, eq. (F).
+    pub fn F(&self) -> DMatrix<f64> {
+        &self.A + &self.E * &self.C
+    }
+    /// Eigenvalues of `F`, sorted by real part (descending).
+    pub fn eig_F(&self) -> Vec<Complex<f64>> {
+        let mut ev: Vec<Complex<f64>> = self.F().complex_eigenvalues().iter().copied().collect();
+        ev.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
+        ev
+    }
+    /// Spectral abscissa `mu = max Re eig(F)`, eq. (stab) (floating-point estimate; the `lmi`
+    /// crate certifies Hurwitz stability).
+    pub fn mu(&self) -> f64 {
+        self.eig_F().iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max)
+    }
+    /// The period of the input, if periodic.
+    pub fn period(&self) -> Option<f64> {
+        self.input.period()
+    }
+    /// Copy with another input (e.g. a different amplitude in a sweep).
+    pub fn with_input(&self, input: Input) -> Self {
+        Self { input, ..self.clone() }
+    }
+}
