@@ -1,0 +1,399 @@
+//! Minimal `beta` of eq. (bet) for a given `lambda` as one SDP with Clarabel PSD cones.
+//!
+//! For `0 < lambda < |mu|` (eq. (lammu)) solve
+//!
+//! ```text
+//! minimise b  over Pi = Pi^T, b
+//! s.t.  Pi - pi_min I >= 0,   pi_max I - Pi >= 0,                       (normalisation)
+//!       -(S(Pi F) + lambda_s Pi) >= 0,                                   eq. (ALI)
+//!       [[Pi, H(Pi)], [H(Pi)^T, b I_p]] >= 0,  H(Pi) = (Pi E - F^T C^T)/2  eq. (G_H), (bet)
+//! ```
+//!
+//! By the Schur complement the last LMI is `b >= lambda_max(H^T Pi^{-1} H) = beta` when
+//! `Pi > 0`, so the optimum is the smallest `beta` over all `Pi` satisfying (ALI), and
+//! `psi` of eq. (phipsi) (increasing in `beta` for fixed `alpha, lambda, gamma`) is then
+//! as small as this `lambda` allows.
+//!
+//! # Normalisation
+//! `beta` is **not** homogeneous in `Pi`: `H` is affine in `Pi` (the term `F^T C^T` comes
+//! from `|Q|^2`, which has weight 1 in `V = |X|_Pi^2 + |Q|^2`, eq. (V_Gamma)). For
+//! `Pi = s Pi_0`,
+//! `beta = lambda_max(s E^T Pi_0 E - E^T G - G^T E + G^T Pi_0^{-1} G / s) / 4`, `G = F^T C^T`,
+//! which blows up as `s -> 0` (if `C != 0`) and as `s -> inf` (if `E != 0`). So the scale
+//! of `Pi` is *determined* by the problem and must not be fixed by a trace or `Pi >= I`
+//! normalisation (that would change the optimum). The objective is bounded below by 0,
+//! so the SDP is never unbounded; what can fail is *attainment*: with `C = 0` the
+//! infimum is approached as `Pi -> 0`, with `E = 0` as `Pi -> inf`, and in general `Pi`
+//! may degenerate along some directions. The two bounds
+//! `pi_min I <= Pi <= pi_max I`, taken relative to the natural scale
+//! `s_* = ||F^T C^T||_F / ||E||_F` (the minimiser of `beta(s I)` is of this order), make
+//! the feasible set compact and keep `Pi` strictly positive definite and invertible, as
+//! `Pi^{-1}` in eq. (bet) requires, and as the rigorous verification of `Pi > 0` needs.
+//! With the defaults (`1e-6 s_*`, `1e6 s_*`) they are inactive on non-degenerate
+//! problems; when one is active the solution reports it (`pi_min_active`,
+//! `pi_max_active`): `beta` is then the minimum over the box, still a valid bound.
+//! `lambda_s = lambda` unless `tol_lambda_margin` asks for a small safety margin.
+
+use crate::error::{LmiError, Result};
+use crate::psd_triangle::{symmetric_basis, sym_from_entries, triangular_number};
+use crate::sdp::{LmiBuilder, SdpSettings, SdpStatus};
+use crate::spectral_abscissa::{check_lambda, check_system, hurwitz_mu};
+use crate::verify::{certify, Certificate, VerifySettings};
+use nalgebra::DMatrix;
+
+/// Settings of the beta SDP.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BetaSdpSettings {
+    /// Interior-point settings. Default [`SdpSettings::default`].
+    pub sdp: SdpSettings,
+    /// Verification settings. Default [`VerifySettings::default`].
+    pub verify: VerifySettings,
+    /// Lower bound `Pi >= min_pi_rel * s_* I` with `s_* =` [`pi_scale`]. Default `1e-6`.
+    pub min_pi_rel: f64,
+    /// Upper bound `Pi <= max_pi_rel * s_* I`. Default `1e6`.
+    pub max_pi_rel: f64,
+    /// The SDP imposes (ALI) at `lambda_s = lambda + tol_lambda_margin (|mu| - lambda)` so
+    /// that the rounded `Pi` verifies at `lambda` without backing off. Default `1e-7`.
+    pub tol_lambda_margin: f64,
+}
+
+impl Default for BetaSdpSettings {
+    fn default() -> Self {
+        Self {
+            sdp: SdpSettings::default(),
+            verify: VerifySettings::default(),
+            min_pi_rel: 1e-6,
+            max_pi_rel: 1e6,
+            tol_lambda_margin: 1e-7,
+        }
+    }
+}
+
+impl BetaSdpSettings {
+    /// `0 < min_pi_rel < max_pi_rel < inf`, `0 <= tol_lambda_margin < 1`, nested settings valid.
+    pub fn validate(&self) -> Result<()> {
+        self.sdp.validate()?;
+        self.verify.validate()?;
+        if !(self.min_pi_rel.is_finite() && self.min_pi_rel > 0.0) {
+            return Err(LmiError::InvalidSetting { name: "min_pi_rel", value: self.min_pi_rel });
+        }
+        if !(self.max_pi_rel.is_finite() && self.max_pi_rel > self.min_pi_rel) {
+            return Err(LmiError::InvalidSetting { name: "max_pi_rel", value: self.max_pi_rel });
+        }
+        if !(self.tol_lambda_margin >= 0.0 && self.tol_lambda_margin < 1.0) {
+            return Err(LmiError::InvalidSetting { name: "tol_lambda_margin", value: self.tol_lambda_margin });
+        }
+        Ok(())
+    }
+}
+
+/// Natural scale `s_* = ||F^T C^T||_F / ||E||_F` of `Pi` (1 when either norm is zero).
+pub fn pi_scale(F: &DMatrix<f64>, E: &DMatrix<f64>, C: &DMatrix<f64>) -> f64 {
+    let g = (C * F).norm();
+    let e = E.norm();
+    if g > 0.0 && e > 0.0 && (g / e).is_finite() {
+        g / e
+    } else {
+        1.0
+    }
+}
+
+/// Optimal point of the beta SDP (floating point, not yet verified).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BetaSdpSolution {
+    /// Requested `lambda`.
+    pub lambda: f64,
+    /// `lambda_s` at which (ALI) was imposed (`>= lambda`, see `tol_lambda_margin`).
+    pub lambda_solved: f64,
+    /// `Pi` (symmetric).
+    pub Pi: DMatrix<f64>,
+    /// Optimal value `b` = minimal `beta` of eq. (bet) (to solver accuracy).
+    pub beta: f64,
+    /// `mu` of eq. (stab).
+    pub mu: f64,
+    /// Normalisation bounds actually used.
+    pub pi_min: f64,
+    /// Normalisation bounds actually used.
+    pub pi_max: f64,
+    /// `lambda_min(Pi)` is within 0.1 % of `pi_min`.
+    pub pi_min_active: bool,
+    /// `lambda_max(Pi)` is within 0.1 % of `pi_max`.
+    pub pi_max_active: bool,
+    /// Solver status (`Solved` or `AlmostSolved`).
+    pub status: SdpStatus,
+    /// Interior-point iterations.
+    pub iterations: u32,
+}
+
+/// Solver solution together with its rigorous [`Certificate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CertifiedBeta {
+    /// SDP solution.
+    pub solution: BetaSdpSolution,
+    /// Verified `(lambda, b_hat)` for `solution.Pi`.
+    pub certificate: Certificate,
+}
+
+/// Solve the beta SDP (module docs) at `lambda`.
+///
+/// Errors: input validation ([`LmiError::DimensionMismatch`], [`LmiError::NonFinite`],
+/// [`LmiError::Empty`]), [`LmiError::NotHurwitz`], [`LmiError::LambdaOutOfRange`],
+/// solver outcomes ([`LmiError::Infeasible`], [`LmiError::Unbounded`],
+/// [`LmiError::IterationLimit`], [`LmiError::SolverFailed`]).
+pub fn solve_beta_sdp(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    lambda: f64,
+    settings: &BetaSdpSettings,
+) -> Result<BetaSdpSolution> {
+    settings.validate()?;
+    check_system(F, E, C)?;
+    let mu = hurwitz_mu(F)?;
+    check_lambda(lambda, mu)?;
+    solve_checked(F, E, C, lambda, mu, settings)
+}
+
+/// [`solve_beta_sdp`] followed by [`certify`]; [`LmiError::NotVerified`] when no proof
+/// could be obtained.
+pub fn certified_beta(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    lambda: f64,
+    settings: &BetaSdpSettings,
+) -> Result<CertifiedBeta> {
+    settings.validate()?;
+    check_system(F, E, C)?;
+    let mu = hurwitz_mu(F)?;
+    check_lambda(lambda, mu)?;
+    certified_checked(F, E, C, lambda, mu, settings)
+}
+
+pub(crate) fn certified_checked(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    lambda: f64,
+    mu: f64,
+    settings: &BetaSdpSettings,
+) -> Result<CertifiedBeta> {
+    let solution = solve_checked(F, E, C, lambda, mu, settings)?;
+    let certificate = certify(F, E, C, &solution.Pi, lambda, solution.beta.max(0.0), &settings.verify)?;
+    if !certificate.verified {
+        return Err(LmiError::NotVerified { lambda, b_hat: certificate.b_hat });
+    }
+    Ok(CertifiedBeta { solution, certificate })
+}
+
+pub(crate) fn solve_checked(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    lambda: f64,
+    mu: f64,
+    settings: &BetaSdpSettings,
+) -> Result<BetaSdpSolution> {
+    let n = F.nrows();
+    let p = E.ncols();
+    let m = triangular_number(n);
+    let scale = pi_scale(F, E, C);
+    let pi_min = settings.min_pi_rel * scale;
+    let pi_max = settings.max_pi_rel * scale;
+    let lambda_s = lambda + settings.tol_lambda_margin * (-mu - lambda);
+    let basis = symmetric_basis(n);
+    let nvar = m + 1; // [entries of Pi, b]
+    let I_n = DMatrix::<f64>::identity(n, n);
+    let mut bld = LmiBuilder::new(nvar);
+
+    // Pi - pi_min I >= 0
+    let mut Mk: Vec<Option<DMatrix<f64>>> = basis.iter().cloned().map(Some).collect();
+    Mk.push(None);
+    bld.add_psd(&(&I_n * -pi_min), &Mk);
+    // pi_max I - Pi >= 0
+    let Mk: Vec<Option<DMatrix<f64>>> =
+        basis.iter().map(|B| Some(-B)).chain(std::iter::once(None)).collect();
+    bld.add_psd(&(&I_n * pi_max), &Mk);
+    // -(S(Pi F) + lambda_s Pi) >= 0, eq. (ALI)
+    let Mk: Vec<Option<DMatrix<f64>>> = basis
+        .iter()
+        .map(|B| {
+            let BF = B * F;
+            Some(-((&BF + BF.transpose()) * 0.5 + B * lambda_s))
+        })
+        .chain(std::iter::once(None))
+        .collect();
+    bld.add_psd(&DMatrix::zeros(n, n), &Mk);
+    // [[Pi, H], [H^T, b I]] >= 0 with H = (Pi E - F^T C^T)/2, eq. (bet)
+    let G = F.transpose() * C.transpose();
+    let mut K0 = DMatrix::<f64>::zeros(n + p, n + p);
+    K0.view_mut((0, n), (n, p)).copy_from(&(&G * -0.5));
+    K0.view_mut((n, 0), (p, n)).copy_from(&(G.transpose() * -0.5));
+    let mut Mk: Vec<Option<DMatrix<f64>>> = basis
+        .iter()
+        .map(|B| {
+            let mut K = DMatrix::<f64>::zeros(n + p, n + p);
+            K.view_mut((0, 0), (n, n)).copy_from(B);
+            let BE = B * E * 0.5;
+            K.view_mut((0, n), (n, p)).copy_from(&BE);
+            K.view_mut((n, 0), (p, n)).copy_from(&BE.transpose());
+            Some(K)
+        })
+        .collect();
+    let mut Kb = DMatrix::<f64>::zeros(n + p, n + p);
+    for j in 0..p {
+        Kb[(n + j, n + j)] = 1.0;
+    }
+    Mk.push(Some(Kb));
+    bld.add_psd(&K0, &Mk);
+
+    let mut q = vec![0.0; nvar];
+    q[m] = 1.0;
+    let sol = bld.solve(&q, &settings.sdp, lambda)?;
+    let Pi = sym_from_entries(&sol.x[..m], n);
+    let eig = Pi.clone().symmetric_eigen().eigenvalues;
+    let lmin = eig.iter().copied().fold(f64::INFINITY, f64::min);
+    let lmax = eig.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Ok(BetaSdpSolution {
+        lambda,
+        lambda_solved: lambda_s,
+        Pi,
+        beta: sol.x[m],
+        mu,
+        pi_min,
+        pi_max,
+        pi_min_active: lmin <= pi_min * 1.001,
+        pi_max_active: lmax >= pi_max * 0.999,
+        status: sol.status,
+        iterations: sol.iterations,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::{paper_example, random_hurwitz_system};
+    use crate::verify::{beta_estimate, check_certificate, lambda_of_pi};
+    use approx::assert_relative_eq;
+
+    /// Scalar case n = p = 1, F = -f, E = e, C = c: (ALI) is lambda <= f, and
+    /// beta(pi) = (pi e + f c)^2 / (4 pi) is minimised at pi = f|c|/|e| (if e c > 0 the
+    /// minimum over pi > 0 of (pi e + f c)^2/(4 pi) is e f c, at pi = f c / e).
+    #[test]
+    fn scalar_case_closed_form() {
+        let (f, e, c) = (2.0, 0.5, 3.0);
+        let F = DMatrix::from_element(1, 1, -f);
+        let E = DMatrix::from_element(1, 1, e);
+        let C = DMatrix::from_element(1, 1, c);
+        let sol = solve_beta_sdp(&F, &E, &C, 1.0, &BetaSdpSettings::default()).unwrap();
+        // H = (pi e + f c)/2 since F^T C^T = -f c.
+        assert_relative_eq!(sol.Pi[(0, 0)], f * c / e, max_relative = 1e-5);
+        assert_relative_eq!(sol.beta, e * f * c, max_relative = 1e-7);
+        assert!(!sol.pi_min_active && !sol.pi_max_active);
+    }
+
+    #[test]
+    fn paper_example_certifies_and_matches_beta_of_pi() {
+        let (F, E, C) = paper_example();
+        let cb = certified_beta(&F, &E, &C, 0.15, &BetaSdpSettings::default()).unwrap();
+        let cert = &cb.certificate;
+        assert!(cert.verified);
+        assert_eq!(cert.lambda, 0.15, "no back-off expected with the default margin");
+        assert_relative_eq!(cert.b_hat, cb.solution.beta, max_relative = 1e-6);
+        assert_relative_eq!(beta_estimate(&F, &E, &C, &cb.solution.Pi), cb.solution.beta, max_relative = 1e-6);
+        assert!(lambda_of_pi(&F, &cb.solution.Pi) >= 0.15 * (1.0 - 1e-9));
+    }
+
+    /// The SDP optimum is not beaten by Lyapunov-equation solutions Pi_t = t P,
+    /// (F + lambda I)^T P + P (F + lambda I) = -I, which are feasible for every t > 0.
+    #[test]
+    fn optimum_beats_scaled_lyapunov_solutions() {
+        for seed in 0..4u64 {
+            let (F, E, C) = random_hurwitz_system(seed, 3 + (seed as usize % 2), 1 + (seed as usize % 2));
+            let mu = hurwitz_mu(&F).unwrap();
+            let lambda = 0.5 * -mu;
+            let cb = certified_beta(&F, &E, &C, lambda, &BetaSdpSettings::default()).unwrap();
+            let n = F.nrows();
+            let Fl = &F + DMatrix::<f64>::identity(n, n) * lambda;
+            // Kronecker solve of the Lyapunov equation.
+            let I = DMatrix::<f64>::identity(n, n);
+            let K = Fl.transpose().kronecker(&I) + I.kronecker(&Fl.transpose());
+            let rhs = -DMatrix::<f64>::identity(n, n);
+            let vecP = K.lu().solve(&nalgebra::DVector::from_column_slice(rhs.as_slice())).unwrap();
+            let P = DMatrix::from_column_slice(n, n, vecP.as_slice());
+            let P = (&P + P.transpose()) * 0.5;
+            for t in [0.01, 0.1, 1.0, 10.0, 100.0] {
+                let b = beta_estimate(&F, &E, &C, &(&P * t));
+                assert!(cb.certificate.b_hat <= b * (1.0 + 1e-6), "seed {seed} t {t}: {} > {b}", cb.certificate.b_hat);
+            }
+        }
+    }
+
+    #[test]
+    fn negative_controls_perturbed_pi_and_underestimated_b() {
+        let (F, E, C) = random_hurwitz_system(11, 4, 2);
+        let mu = hurwitz_mu(&F).unwrap();
+        // lambda close to |mu| so that (ALI) is tight.
+        let lambda = 0.9 * -mu;
+        let cb = certified_beta(&F, &E, &C, lambda, &BetaSdpSettings::default()).unwrap();
+        assert!(cb.certificate.verified);
+        let Pi = &cb.certificate.Pi;
+        // Perturb Pi along the eigenvector of the tight (ALI) direction: rejected.
+        let PF = Pi * &F;
+        let N = -((&PF + PF.transpose()) * 0.5 + Pi * lambda);
+        let eig = N.symmetric_eigen();
+        let k = eig.eigenvalues.imin();
+        let v = eig.eigenvectors.column(k).into_owned();
+        let mut worst: Option<bool> = None;
+        for sgn in [1.0, -1.0] {
+            let Pp = Pi + (&v * v.transpose()) * (sgn * 1e-3 * Pi.norm());
+            let c = check_certificate(&F, &E, &C, &Pp, lambda, cb.certificate.b_hat * 10.0).unwrap();
+            worst = Some(worst.unwrap_or(true) && c.lyapunov.verified);
+        }
+        assert_eq!(worst, Some(false), "a perturbation of the tight Pi must break (ALI)");
+        // Underestimated b_hat is rejected.
+        let c = check_certificate(&F, &E, &C, Pi, cb.certificate.lambda, cb.solution.beta * (1.0 - 1e-4)).unwrap();
+        assert!(!c.schur.verified && !c.verified);
+        // And the certified one passes the plain check.
+        let c = check_certificate(&F, &E, &C, Pi, cb.certificate.lambda, cb.certificate.b_hat).unwrap();
+        assert!(c.verified);
+    }
+
+    #[test]
+    fn bad_input_is_an_error_value() {
+        let (F, E, C) = paper_example();
+        let s = BetaSdpSettings::default();
+        assert!(matches!(
+            solve_beta_sdp(&F, &E, &C, 0.3, &s),
+            Err(LmiError::LambdaOutOfRange { lambda, mu }) if lambda == 0.3 && (mu + 0.3).abs() < 1e-12
+        ));
+        assert!(matches!(solve_beta_sdp(&F, &E, &C, -0.1, &s), Err(LmiError::LambdaOutOfRange { .. })));
+        assert!(matches!(solve_beta_sdp(&F, &E, &C, f64::NAN, &s), Err(LmiError::NonFinite { what: "lambda", .. })));
+        let Fu = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, 0.6]);
+        assert!(matches!(solve_beta_sdp(&Fu, &E, &C, 0.1, &s), Err(LmiError::NotHurwitz { mu }) if (mu - 0.3).abs() < 1e-12));
+        let Cbad = DMatrix::zeros(2, 2);
+        assert!(matches!(
+            solve_beta_sdp(&F, &E, &Cbad, 0.1, &s),
+            Err(LmiError::DimensionMismatch { what: "C", expected: (1, 2), found: (2, 2) })
+        ));
+        let mut En = E.clone();
+        En[(1, 0)] = f64::INFINITY;
+        assert!(matches!(solve_beta_sdp(&F, &En, &C, 0.1, &s), Err(LmiError::NonFinite { what: "E", row: 1, col: 0, .. })));
+        let it = BetaSdpSettings { sdp: SdpSettings { max_iter: 2, ..Default::default() }, ..Default::default() };
+        assert!(matches!(solve_beta_sdp(&F, &E, &C, 0.1, &it), Err(LmiError::IterationLimit { max_iter: 2, .. })));
+        let bad = BetaSdpSettings { max_pi_rel: 1e-9, ..Default::default() };
+        assert!(matches!(solve_beta_sdp(&F, &E, &C, 0.1, &bad), Err(LmiError::InvalidSetting { name: "max_pi_rel", .. })));
+    }
+
+    /// Degenerate coupling E = 0: the infimum is approached as Pi -> inf; the upper
+    /// normalisation bound becomes active and is reported, and the certificate is valid.
+    #[test]
+    fn degenerate_e_zero_reports_active_bound() {
+        let (F, _, C) = paper_example();
+        let E = DMatrix::zeros(2, 1);
+        let cb = certified_beta(&F, &E, &C, 0.1, &BetaSdpSettings::default()).unwrap();
+        assert!(cb.solution.pi_max_active);
+        assert!(cb.certificate.verified);
+        assert!(cb.certificate.b_hat < 1e-4);
+    }
+}

@@ -1,0 +1,221 @@
+//! Thin layer over Clarabel's PSD cones: linear matrix inequalities
+//! `M_0 + sum_k x_k M_k >= 0` written directly as rows of `A x + s = b`,
+//! `s in PSDTriangleCone` (no modelling layer).
+//!
+//! Clarabel's form is `min q^T x  s.t.  A x + s = b, s in K`. With
+//! `s = svec(M_0 + sum_k x_k M_k)` ([`crate::psd_triangle::svec`]) this gives
+//! `b = svec(M_0)` and column `k` of `A` equal to `-svec(M_k)`.
+
+use crate::error::{LmiError, Result};
+use crate::psd_triangle::{svec, triangular_number};
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use nalgebra::DMatrix;
+
+/// Interior-point settings passed to Clarabel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SdpSettings {
+    /// Absolute duality-gap tolerance. Default `1e-9`.
+    pub tol_gap_abs: f64,
+    /// Relative duality-gap tolerance. Default `1e-9`.
+    pub tol_gap_rel: f64,
+    /// Primal/dual feasibility tolerance. Default `1e-9`.
+    pub tol_feas: f64,
+    /// Iteration limit; hitting it gives [`LmiError::IterationLimit`]. Default `200`.
+    pub max_iter: u32,
+    /// Print Clarabel's iteration log. Default `false`.
+    pub verbose: bool,
+}
+
+impl Default for SdpSettings {
+    fn default() -> Self {
+        Self { tol_gap_abs: 1e-9, tol_gap_rel: 1e-9, tol_feas: 1e-9, max_iter: 200, verbose: false }
+    }
+}
+
+impl SdpSettings {
+    /// Check that tolerances are positive and finite and `max_iter >= 1`.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("tol_gap_abs", self.tol_gap_abs),
+            ("tol_gap_rel", self.tol_gap_rel),
+            ("tol_feas", self.tol_feas),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(LmiError::InvalidSetting { name, value: v });
+            }
+        }
+        if self.max_iter == 0 {
+            return Err(LmiError::InvalidSetting { name: "max_iter", value: 0.0 });
+        }
+        Ok(())
+    }
+
+    fn to_clarabel(&self) -> DefaultSettings<f64> {
+        DefaultSettings {
+            tol_gap_abs: self.tol_gap_abs,
+            tol_gap_rel: self.tol_gap_rel,
+            tol_feas: self.tol_feas,
+            max_iter: self.max_iter,
+            verbose: self.verbose,
+            ..DefaultSettings::default()
+        }
+    }
+}
+
+/// Solver status, mirrored from Clarabel so that its types do not leak into the API.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum SdpStatus {
+    /// Converged to the requested tolerances.
+    Solved,
+    /// Converged to the reduced tolerances.
+    AlmostSolved,
+    /// Primal infeasibility certificate (possibly reduced accuracy).
+    PrimalInfeasible,
+    /// Dual infeasibility certificate, i.e. unbounded (possibly reduced accuracy).
+    DualInfeasible,
+    /// Iteration limit reached.
+    MaxIterations,
+    /// Time limit reached.
+    MaxTime,
+    /// Numerical error in the factorisation.
+    NumericalError,
+    /// Lack of progress.
+    InsufficientProgress,
+    /// Not solved / terminated by callback.
+    Unsolved,
+}
+
+impl From<SolverStatus> for SdpStatus {
+    fn from(s: SolverStatus) -> Self {
+        match s {
+            SolverStatus::Solved => SdpStatus::Solved,
+            SolverStatus::AlmostSolved => SdpStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                SdpStatus::PrimalInfeasible
+            }
+            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => SdpStatus::DualInfeasible,
+            SolverStatus::MaxIterations => SdpStatus::MaxIterations,
+            SolverStatus::MaxTime => SdpStatus::MaxTime,
+            SolverStatus::NumericalError => SdpStatus::NumericalError,
+            SolverStatus::InsufficientProgress => SdpStatus::InsufficientProgress,
+            SolverStatus::Unsolved | SolverStatus::CallbackTerminated => SdpStatus::Unsolved,
+        }
+    }
+}
+
+/// Primal solution of a solved SDP.
+#[derive(Debug, Clone)]
+pub(crate) struct SdpSolution {
+    pub x: Vec<f64>,
+    pub obj: f64,
+    pub status: SdpStatus,
+    pub iterations: u32,
+}
+
+/// Accumulates PSD constraints `M_0 + sum_k x_k M_k >= 0`.
+pub(crate) struct LmiBuilder {
+    nvar: usize,
+    /// Column-wise nonzeros (row, value) of `A`.
+    cols: Vec<Vec<(usize, f64)>>,
+    b: Vec<f64>,
+    cones: Vec<SupportedConeT<f64>>,
+}
+
+impl LmiBuilder {
+    pub fn new(nvar: usize) -> Self {
+        Self { nvar, cols: vec![Vec::new(); nvar], b: Vec::new(), cones: Vec::new() }
+    }
+
+    /// Add `M0 + sum_k x_k Mk[k] >= 0`; `Mk[k] = None` means variable `k` does not enter.
+    pub fn add_psd(&mut self, M0: &DMatrix<f64>, Mk: &[Option<DMatrix<f64>>]) {
+        debug_assert_eq!(Mk.len(), self.nvar);
+        let d = M0.nrows();
+        let row0 = self.b.len();
+        self.b.extend(svec(M0));
+        for (k, M) in Mk.iter().enumerate() {
+            if let Some(M) = M {
+                for (r, v) in svec(M).into_iter().enumerate() {
+                    if v != 0.0 {
+                        self.cols[k].push((row0 + r, -v));
+                    }
+                }
+            }
+        }
+        debug_assert_eq!(self.b.len(), row0 + triangular_number(d));
+        self.cones.push(SupportedConeT::PSDTriangleConeT(d));
+    }
+
+    /// `min q^T x` subject to the accumulated constraints.
+    pub fn solve(self, q: &[f64], settings: &SdpSettings, lambda: f64) -> Result<SdpSolution> {
+        let m = self.b.len();
+        let n = self.nvar;
+        let mut colptr = Vec::with_capacity(n + 1);
+        let mut rowval = Vec::new();
+        let mut nzval = Vec::new();
+        colptr.push(0);
+        for col in &self.cols {
+            for &(r, v) in col {
+                rowval.push(r);
+                nzval.push(v);
+            }
+            colptr.push(rowval.len());
+        }
+        let A = CscMatrix::new(m, n, colptr, rowval, nzval);
+        let P = CscMatrix::zeros((n, n));
+        let mut solver = DefaultSolver::new(&P, q, &A, &self.b, &self.cones, settings.to_clarabel())
+            .map_err(|_| LmiError::SetupRejected { rows: m, cols: n })?;
+        solver.solve();
+        let sol = &solver.solution;
+        let status = SdpStatus::from(sol.status);
+        match status {
+            SdpStatus::Solved | SdpStatus::AlmostSolved => Ok(SdpSolution {
+                x: sol.x.clone(),
+                obj: sol.obj_val,
+                status,
+                iterations: sol.iterations,
+            }),
+            SdpStatus::PrimalInfeasible => Err(LmiError::Infeasible { lambda, status }),
+            SdpStatus::DualInfeasible => Err(LmiError::Unbounded { lambda, status }),
+            SdpStatus::MaxIterations => Err(LmiError::IterationLimit { lambda, max_iter: settings.max_iter }),
+            _ => Err(LmiError::SolverFailed { lambda, status }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// End-to-end check of the svec convention through Clarabel itself:
+    /// `min <Cm, X>` s.t. `trace X = 1`, `X >= 0` has value `lambda_min(Cm)`, and the
+    /// minimiser is the corresponding eigenprojector. A wrong off-diagonal scaling
+    /// gives a different value.
+    #[test]
+    fn clarabel_psd_cone_convention_end_to_end() {
+        let Cm = DMatrix::from_row_slice(3, 3, &[2.0, 1.0, 0.5, 1.0, 3.0, -1.0, 0.5, -1.0, 1.5]);
+        let basis = crate::psd_triangle::symmetric_basis(3);
+        let nvar = basis.len();
+        let mut bld = LmiBuilder::new(nvar);
+        // X >= 0
+        bld.add_psd(&DMatrix::zeros(3, 3), &basis.iter().cloned().map(Some).collect::<Vec<_>>());
+        // trace X = 1 as two 1x1 PSD cones: trace X - 1 >= 0 and 1 - trace X >= 0.
+        let tr = |B: &DMatrix<f64>| DMatrix::from_element(1, 1, B.trace());
+        bld.add_psd(&DMatrix::from_element(1, 1, -1.0), &basis.iter().map(|B| Some(tr(B))).collect::<Vec<_>>());
+        bld.add_psd(&DMatrix::from_element(1, 1, 1.0), &basis.iter().map(|B| Some(-tr(B))).collect::<Vec<_>>());
+        let q: Vec<f64> = basis.iter().map(|B| (B * &Cm).trace()).collect();
+        let sol = bld.solve(&q, &SdpSettings::default(), 0.0).expect("solvable");
+        let lmin = Cm.clone().symmetric_eigen().eigenvalues.min();
+        assert_relative_eq!(sol.obj, lmin, epsilon = 1e-7);
+    }
+
+    #[test]
+    fn settings_validate_rejects_bad_values() {
+        assert!(SdpSettings::default().validate().is_ok());
+        let s = SdpSettings { tol_feas: f64::NAN, ..Default::default() };
+        assert!(matches!(s.validate(), Err(LmiError::InvalidSetting { name: "tol_feas", .. })));
+        let s = SdpSettings { max_iter: 0, ..Default::default() };
+        assert!(matches!(s.validate(), Err(LmiError::InvalidSetting { name: "max_iter", .. })));
+    }
+}
