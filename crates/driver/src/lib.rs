@@ -3,3 +3,4 @@
 #![allow(non_snake_case)]
 
 pub mod cli;
+pub mod output;
