@@ -115,9 +115,9 @@ pub struct BetaSdpSolution {
     pub pi_min: f64,
     /// Normalisation bounds actually used.
     pub pi_max: f64,
-    /// `lambda_min(Pi)` is within 0.1 % of `pi_min`.
+    /// `lambda_min(Pi)` is within 1 % of `pi_min` (the lower normalisation bound is active).
     pub pi_min_active: bool,
-    /// `lambda_max(Pi)` is within 0.1 % of `pi_max`.
+    /// `lambda_max(Pi)` is within 1 % of `pi_max` (the upper normalisation bound is active).
     pub pi_max_active: bool,
     /// Solver status (`Solved` or `AlmostSolved`).
     pub status: SdpStatus,
@@ -262,8 +262,8 @@ pub(crate) fn solve_checked(
         mu,
         pi_min,
         pi_max,
-        pi_min_active: lmin <= pi_min * 1.001,
-        pi_max_active: lmax >= pi_max * 0.999,
+        pi_min_active: lmin <= pi_min * 1.01,
+        pi_max_active: lmax >= pi_max * 0.99,
         status: sol.status,
         iterations: sol.iterations,
     })

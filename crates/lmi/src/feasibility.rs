@@ -5,8 +5,9 @@
 //! (ALI) is homogeneous in `Pi`, so here (unlike in [`crate::beta_sdp`]) the scale of
 //! `Pi` is free and is fixed by `I <= Pi <= max_cond_pi I`; the bound on the condition
 //! number makes the SDP compact. For each `lambda` the SDP
-//! `max tau  s.t.  -(S(Pi F) + lambda Pi) >= tau I,  I <= Pi <= max_cond_pi I`
-//! is always feasible and bounded; `lambda` counts as feasible when the returned `Pi`
+//! `max tau  s.t.  -(S(Pi F) + lambda Pi) >= tau I,  I <= Pi <= max_cond_pi I,  tau <= 1`
+//! is always feasible and bounded (the cap on `tau` keeps `Pi` away from its upper bound
+//! when there is room); `lambda` counts as feasible when the returned `Pi`
 //! passes the **rigorous** check of (ALI) ([`crate::verify`]), so the reported supremum is
 //! a verified lower bound of the true one (up to the condition-number bound).
 
@@ -22,7 +23,8 @@ use nalgebra::DMatrix;
 pub struct FeasibilitySettings {
     /// Interior-point settings. Default [`SdpSettings::default`].
     pub sdp: SdpSettings,
-    /// Bound on the condition number of `Pi` (`I <= Pi <= max_cond_pi I`). Default `1e8`.
+    /// Bound on the condition number of `Pi` (`I <= Pi <= max_cond_pi I`). Default `1e6` (at `1e8` Clarabel loses
+    /// progress on some infeasible `lambda`s of the paper example).
     pub max_cond_pi: f64,
     /// Bisection stops when the bracket is shorter than `tol_bisection_rel |mu|`. Default `1e-8`.
     pub tol_bisection_rel: f64,
@@ -32,7 +34,7 @@ pub struct FeasibilitySettings {
 
 impl Default for FeasibilitySettings {
     fn default() -> Self {
-        Self { sdp: SdpSettings::default(), max_cond_pi: 1e8, tol_bisection_rel: 1e-8, max_bisection_iter: 60 }
+        Self { sdp: SdpSettings::default(), max_cond_pi: 1e6, tol_bisection_rel: 1e-8, max_bisection_iter: 60 }
     }
 }
 
@@ -99,6 +101,10 @@ fn feasibility_checked(F: &DMatrix<f64>, lambda: f64, settings: &FeasibilitySett
         .chain(std::iter::once(Some(-&I_n)))
         .collect();
     bld.add_psd(&DMatrix::zeros(n, n), &Mk);
+    // tau <= 1: otherwise tau, homogeneous in Pi, drives Pi onto max_cond_pi I.
+    let mut Mk: Vec<Option<DMatrix<f64>>> = vec![None; m];
+    Mk.push(Some(DMatrix::from_element(1, 1, -1.0)));
+    bld.add_psd(&DMatrix::from_element(1, 1, 1.0), &Mk);
     let mut q = vec![0.0; nvar];
     q[m] = -1.0;
     let sol = bld.solve(&q, &settings.sdp, lambda)?;

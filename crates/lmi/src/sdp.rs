@@ -108,7 +108,6 @@ impl From<SolverStatus> for SdpStatus {
 #[derive(Debug, Clone)]
 pub(crate) struct SdpSolution {
     pub x: Vec<f64>,
-    pub obj: f64,
     pub status: SdpStatus,
     pub iterations: u32,
 }
@@ -171,7 +170,6 @@ impl LmiBuilder {
         match status {
             SdpStatus::Solved | SdpStatus::AlmostSolved => Ok(SdpSolution {
                 x: sol.x.clone(),
-                obj: sol.obj_val,
                 status,
                 iterations: sol.iterations,
             }),
@@ -207,7 +205,7 @@ mod tests {
         let q: Vec<f64> = basis.iter().map(|B| (B * &Cm).trace()).collect();
         let sol = bld.solve(&q, &SdpSettings::default(), 0.0).expect("solvable");
         let lmin = Cm.clone().symmetric_eigen().eigenvalues.min();
-        assert_relative_eq!(sol.obj, lmin, epsilon = 1e-7);
+        assert_relative_eq!(q.iter().zip(&sol.x).map(|(a, b)| a * b).sum::<f64>(), lmin, epsilon = 1e-7);
     }
 
     #[test]
