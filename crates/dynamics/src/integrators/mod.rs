@@ -1,0 +1,5 @@
+//! Time integrators of the closed loop (xy), (yz), (zdot).
+//! - [`catching_up`]: Moreau's catching-up scheme with the exact linear step (any `Theta`).
+//! - [`event_driven`]: the reference integrator for accuracy studies (interval, ball, ellipsoid).
+pub mod catching_up;
+pub mod event_driven;

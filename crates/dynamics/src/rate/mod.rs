@@ -1,0 +1,6 @@
+//! Measured convergence: the exponent of pairs of trajectories and the backlash motion.
+//! - [`lyapunov_exponent`]: `(1/2) limsup (1/t) ln V(t)`, `V` of eq. (V_Gamma), by regression
+//!   over periods with Benettin renormalisation.
+//! - [`path_length`]: path length of `z` per period and the running maximum of `|z'|`.
+pub mod lyapunov_exponent;
+pub mod path_length;
