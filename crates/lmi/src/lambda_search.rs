@@ -4,9 +4,9 @@
 //!
 //! For each `lambda` the minimal `beta` is computed by the SDP of [`crate::beta_sdp`] and
 //! **verified** ([`crate::verify`]); `theta` is then evaluated at the verified pair
-//! `(lambda_v, b_hat)` (with `lambda_v <= lambda`, `b_hat >= beta`), so every point of
-//! the curve is a valid bound, provided `theta` is nonincreasing in `lambda` ... no:
-//! `theta` is evaluated exactly at the certified pair, so no monotonicity is assumed.
+//! `(lambda_v, b_hat)` (with `lambda_v <= lambda`, `b_hat >= beta`): `theta` is evaluated
+//! exactly at a certified pair, so every point of the curve is a valid bound without any
+//! monotonicity assumption on `theta`.
 //!
 //! Search: a uniform grid `lambda_i = |mu| i / (N + 1)`, `i = 1..N`, then golden-section
 //! refinement on the bracket around the best grid point. SDP or verification failures
