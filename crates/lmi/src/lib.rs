@@ -10,6 +10,8 @@
 //! - [`lambda_search`]: `lambda in (0, |mu|)` minimising a user `theta(lambda, beta)`, eq. (theta);
 //! - [`fixtures`]: seeded test systems; [`error`]: the error enum.
 #![allow(non_snake_case)]
+// `!(x > 0.0)` is deliberate: it is also true for NaN, which must never pass a check.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 // Link OpenBLAS (LAPACK for Clarabel's PSD cones).
 extern crate openblas_src;
