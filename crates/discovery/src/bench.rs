@@ -1,0 +1,1 @@
+//! Benchmark runner (joins the generator and the diagnosis).

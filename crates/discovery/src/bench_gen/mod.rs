@@ -1,0 +1,1 @@
+//! Generator of recordings with concealed effects.

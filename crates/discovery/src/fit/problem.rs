@@ -1,0 +1,65 @@
+//! The simulation-error least-squares problem of one (composite) hypothesis.
+//!
+//! Unknowns: effect parameters `theta` in a box and the initial state `x0`. Residual on the
+//! estimation segment `k < k_est`: `r_{k,i} = (yhat_{k,i}(theta, x0) - y_{k,i}) / sigma_i`
+//! with `sigma_i` the standard deviation of output `i`, so outputs weigh alike.
+use crate::hypothesis::{Hypothesis, Scales};
+use crate::simulate::{ExtendedModel, SimOutput, StepMaps};
+use model::effects::Effect;
+use model::System;
+
+/// Data and structure shared by every evaluation.
+pub struct Problem<'a> {
+    pub sys: &'a System,
+    /// Effects fixed at given values (none in the single-effect round).
+    pub fixed: Vec<Effect>,
+    pub parts: Vec<Hypothesis>,
+    pub scales: &'a Scales,
+    /// Input, flat `k * m + j`, whole record.
+    pub w: &'a [f64],
+    /// Output, flat `k * p + i`, whole record.
+    pub y: &'a [f64],
+    pub m: usize,
+    pub p: usize,
+    pub dt: f64,
+    pub k_est: usize,
+    pub weights: Vec<f64>,
+    pub maps: StepMaps,
+    pub substeps: usize,
+}
+
+impl<'a> Problem<'a> {
+    /// Number of effect parameters.
+    pub fn k(&self) -> usize {
+        self.parts.iter().map(|h| h.k()).sum()
+    }
+    /// Effects for parameter vector `theta` (physical units, parts concatenated).
+    pub fn effects(&self, theta: &[f64]) -> Vec<Effect> {
+        let mut out = self.fixed.clone();
+        let mut off = 0;
+        for h in &self.parts {
+            out.push(h.effect(&theta[off..off + h.k()], self.scales));
+            off += h.k();
+        }
+        out
+    }
+    pub fn lower(&self) -> Vec<f64> {
+        self.parts.iter().flat_map(|h| h.lower.clone()).collect()
+    }
+    pub fn upper(&self) -> Vec<f64> {
+        self.parts.iter().flat_map(|h| h.upper.clone()).collect()
+    }
+    /// Simulates with `theta`, `x0` over the first `len` samples (`None`: the whole record).
+    pub fn simulate(&self, theta: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
+        let ext = ExtendedModel::from_maps(self.sys, &self.effects(theta), self.maps.clone(), self.substeps).ok()?;
+        let len = len.unwrap_or(self.w.len() / self.m);
+        let out = ext.simulate(&self.w[..len * self.m], self.dt, x0);
+        out.finite.then_some(out)
+    }
+    /// Weighted residual on the estimation segment (None if the simulation blew up).
+    pub fn residual(&self, theta: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
+        let out = self.simulate(theta, x0, Some(self.k_est))?;
+        let p = self.p;
+        Some((0..self.k_est * p).map(|idx| (out.y[idx] - self.y[idx]) * self.weights[idx % p]).collect())
+    }
+}

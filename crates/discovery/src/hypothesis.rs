@@ -1,0 +1,184 @@
+//! Hypotheses: one or more effects of the physics library with free parameters, their
+//! bounds and starting points, derived from the model's structure and the recording's scales
+//! (never from how a benchmark was generated).
+//!
+//! Bounds (all scale-free, from the data and the model):
+//! - play widths `[0, range(y)/2]` (loop) or `[0, range(w)/2]` (input);
+//! - `gap_width` relative change `[-0.9, 4]`;
+//! - force levels (friction, constant force) up to the force whose static deflection of `y`
+//!   equals `range(y)`: `range(y) / |C F^{-1} e_j|` (friction `[0, that]`, force `+-` half of it);
+//! - `backlash_inertia` time constant `mass/damping` in `[0, 2 tau_slow]` (damping fixed to 1:
+//!   only the ratio is identifiable from `y`, since `z` enters the plant only through `E z`);
+//! - `input_delay` in `[0, min(tau_slow, T/20)]` (at least 5 samples);
+//! - `input_saturation` limit in `[0.2, 1] max|w|` (1 = no clipping);
+//! - `sensor_offset` in `+- range(y)/2` per output.
+use model::effects::{Effect, PlayLocation};
+use model::System;
+use serde::Serialize;
+
+/// A structural choice of effect (parameters apart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Kind {
+    Backlash { at_input: bool },
+    GapWidth,
+    CoulombFriction { state: usize },
+    ConstantForce { state: usize },
+    BacklashInertia,
+    InputDelay,
+    InputSaturation,
+    SensorOffset,
+}
+
+impl Kind {
+    /// The model-file name of the effect.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Kind::Backlash { .. } => "backlash",
+            Kind::GapWidth => "gap_width",
+            Kind::CoulombFriction { .. } => "coulomb_friction",
+            Kind::ConstantForce { .. } => "constant_force",
+            Kind::BacklashInertia => "backlash_inertia",
+            Kind::InputDelay => "input_delay",
+            Kind::InputSaturation => "input_saturation",
+            Kind::SensorOffset => "sensor_offset",
+        }
+    }
+    /// Name with its structural choice, e.g. `coulomb_friction(x2)`.
+    pub fn label(&self) -> String {
+        match self {
+            Kind::Backlash { at_input: true } => "backlash(input)".into(),
+            Kind::Backlash { at_input: false } => "backlash(loop)".into(),
+            Kind::CoulombFriction { state } => format!("coulomb_friction(x{})", state + 1),
+            Kind::ConstantForce { state } => format!("constant_force(x{})", state + 1),
+            k => k.name().into(),
+        }
+    }
+    /// One-sentence physical description used in reports.
+    pub fn description(&self) -> String {
+        match self {
+            Kind::Backlash { at_input: false } => "Play in the feedback path: the backlash output z stays put until y has crossed the gap, as in loose gears or a slack coupling.".into(),
+            Kind::Backlash { at_input: true } => "Play between the command and the plant: the actuator only follows the input after the input has reversed by the width of the play.".into(),
+            Kind::GapWidth => "The real play is wider (or narrower) than the model's Theta, e.g. from gear wear or a wrong catalogue value.".into(),
+            Kind::CoulombFriction { state } => format!("Dry (Coulomb) friction opposes the motion of velocity state x{}: the motion sticks at rest until the driving force exceeds the friction level.", state + 1),
+            Kind::ConstantForce { state } => format!("A constant force (gravity, a spring preload, an amplifier bias) acts on the derivative of state x{}.", state + 1),
+            Kind::BacklashInertia => "The backlash output has mass and damping: after y reverses, z coasts on instead of stopping at once.".into(),
+            Kind::InputDelay => "The plant sees the input late (transport, communication or computation delay).".into(),
+            Kind::InputSaturation => "The actuator cannot deliver commands beyond a limit (voltage or current saturation).".into(),
+            Kind::SensorOffset => "The sensor reads a constant offset from the true output (calibration or zero error).".into(),
+        }
+    }
+}
+
+/// Scales of the problem used for bounds.
+#[derive(Debug, Clone)]
+pub struct Scales {
+    pub y_range: Vec<f64>,
+    pub w_range: Vec<f64>,
+    pub w_absmax: f64,
+    /// Slowest time constant `1 / |mu|` of the nominal `F`.
+    pub tau_slow: f64,
+    pub dt: f64,
+    pub duration: f64,
+}
+
+/// One effect hypothesis: effect parameters in the box `[lower, upper]`.
+#[derive(Debug, Clone)]
+pub struct Hypothesis {
+    pub kind: Kind,
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+    /// Starting points in normalised coordinates `(theta - lower) / (upper - lower)`.
+    pub starts: Vec<Vec<f64>>,
+    /// Parameter names (as in the model file, in the order of the parameter vector).
+    pub names: Vec<&'static str>,
+}
+
+impl Hypothesis {
+    /// The effect for parameters `theta` (physical units).
+    pub fn effect(&self, theta: &[f64], s: &Scales) -> Effect {
+        let _ = s;
+        match self.kind {
+            Kind::Backlash { at_input } => Effect::Backlash { width: theta[0].max(0.0), location: if at_input { PlayLocation::Input } else { PlayLocation::Loop } },
+            Kind::GapWidth => Effect::GapWidth { relative_change: theta[0] },
+            Kind::CoulombFriction { state } => Effect::CoulombFriction { state, level: theta[0].max(0.0) },
+            Kind::ConstantForce { state } => Effect::ConstantForce { state, force: theta[0] },
+            Kind::BacklashInertia => Effect::BacklashInertia { mass: theta[0].max(0.0), damping: 1.0 },
+            Kind::InputDelay => Effect::InputDelay { delay: theta[0].max(0.0) },
+            Kind::InputSaturation => Effect::InputSaturation { limit: theta[0].max(1e-12) },
+            Kind::SensorOffset => Effect::SensorOffset { offset: theta.to_vec() },
+        }
+    }
+    pub fn k(&self) -> usize {
+        self.lower.len()
+    }
+}
+
+/// Velocity-like states: `x_j` such that some other state's derivative is a multiple of
+/// `x_j` alone (`A` row `i` has its only non-zero at `j`, `B`, `E` rows `i` zero). When the
+/// model has none, every state is a candidate.
+pub fn velocity_states(sys: &System) -> Vec<usize> {
+    let n = sys.n();
+    let mut out = Vec::new();
+    for i in 0..n {
+        let nz: Vec<usize> = (0..n).filter(|&j| sys.A[(i, j)] != 0.0).collect();
+        let b0 = (0..sys.m()).all(|j| sys.B[(i, j)] == 0.0) && (0..sys.p()).all(|j| sys.E[(i, j)] == 0.0);
+        if nz.len() == 1 && nz[0] != i && b0 && !out.contains(&nz[0]) {
+            out.push(nz[0]);
+        }
+    }
+    if out.is_empty() {
+        out = (0..n).collect();
+    }
+    out.sort();
+    out
+}
+
+/// Static gain `|C F^{-1} e_j|` from a force on state `j` to `y` (None if `F` is singular or
+/// the gain vanishes).
+fn static_gain(sys: &System, j: usize) -> Option<f64> {
+    let Finv = sys.F().try_inverse()?;
+    let g = (&sys.C * Finv.column(j)).norm();
+    (g > 1e-12).then_some(g)
+}
+
+/// All single-effect hypotheses applicable to `sys`.
+pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
+    let point = crate::simulate::extended::theta_is_point(sys);
+    let e_nonzero = sys.E.iter().any(|v| *v != 0.0);
+    let yr = s.y_range.iter().copied().fold(0.0, f64::max).max(1e-12);
+    let wr = s.w_range.iter().copied().fold(0.0, f64::max).max(1e-12);
+    let one = |kind, lo: f64, hi: f64, name| Hypothesis { kind, lower: vec![lo], upper: vec![hi], starts: vec![vec![0.1], vec![0.4], vec![0.8]], names: vec![name] };
+    let mut out = Vec::new();
+    if point && e_nonzero {
+        out.push(one(Kind::Backlash { at_input: false }, 0.0, 0.5 * yr, "width"));
+    }
+    out.push(one(Kind::Backlash { at_input: true }, 0.0, 0.5 * wr, "width"));
+    if !point {
+        let mut h = one(Kind::GapWidth, -0.9, 4.0, "relative_change");
+        h.starts = vec![vec![0.1], vec![0.184], vec![0.3], vec![0.6]];
+        out.push(h);
+        out.push(one(Kind::BacklashInertia, 0.0, 2.0 * s.tau_slow, "mass"));
+    }
+    for j in velocity_states(sys) {
+        let fs = static_gain(sys, j).map(|g| yr / g).unwrap_or_else(|| s.w_absmax * sys.B.row(j).amax()).max(1e-12);
+        out.push(one(Kind::CoulombFriction { state: j }, 0.0, fs, "level"));
+        let mut h = one(Kind::ConstantForce { state: j }, -0.5 * fs, 0.5 * fs, "force");
+        h.starts = vec![vec![0.3], vec![0.5], vec![0.7]];
+        out.push(h);
+    }
+    let dmax = s.tau_slow.min(s.duration / 20.0).max(5.0 * s.dt);
+    out.push(one(Kind::InputDelay, 0.0, dmax, "delay"));
+    let mut h = one(Kind::InputSaturation, 0.2 * s.w_absmax, s.w_absmax, "limit");
+    h.starts = vec![vec![0.4], vec![0.7], vec![0.95]];
+    out.push(h);
+    let p = s.y_range.len();
+    out.push(Hypothesis {
+        kind: Kind::SensorOffset,
+        lower: s.y_range.iter().map(|r| -0.5 * r).collect(),
+        upper: s.y_range.iter().map(|r| 0.5 * r).collect(),
+        starts: vec![vec![0.5; p], vec![0.3; p], vec![0.7; p]],
+        names: vec!["offset"; p],
+    });
+    out
+}

@@ -1,0 +1,226 @@
+//! A recording of the real machine: CSV with header `t,w,y` or `t,w1..wm,y1..yp`, optional
+//! `z` (or `z1..zp`). Checked on reading (missing columns, non-finite values, non-increasing
+//! time, constant inputs) and put on a uniform time grid: irregular time stamps are resampled
+//! by linear interpolation at the median sampling interval.
+use crate::DiscoveryError;
+use std::path::Path;
+
+/// A recording on a uniform grid `t_k = t0 + k dt`.
+#[derive(Debug, Clone)]
+pub struct Recording {
+    /// Where it came from (for messages).
+    pub source: String,
+    pub t0: f64,
+    pub dt: f64,
+    /// `w[k]` in R^m.
+    pub w: Vec<Vec<f64>>,
+    /// `y[k]` in R^p.
+    pub y: Vec<Vec<f64>>,
+    /// Measured backlash output, if recorded.
+    pub z: Option<Vec<Vec<f64>>>,
+    /// Whether the original time stamps were irregular (relative spread of the sampling
+    /// interval above 1 %) and so were resampled.
+    pub resampled: bool,
+    /// Number of rows in the file.
+    pub rows_in_file: usize,
+}
+
+/// Minimum number of samples of a recording.
+pub const MIN_SAMPLES: usize = 50;
+
+fn col_names(prefix: &str, header: &[String]) -> Vec<usize> {
+    if let Some(i) = header.iter().position(|h| h == prefix) {
+        return vec![i];
+    }
+    let mut out = Vec::new();
+    for k in 1.. {
+        match header.iter().position(|h| *h == format!("{prefix}{k}")) {
+            Some(i) => out.push(i),
+            None => break,
+        }
+    }
+    out
+}
+
+impl Recording {
+    pub fn m(&self) -> usize {
+        self.w[0].len()
+    }
+    pub fn p(&self) -> usize {
+        self.y[0].len()
+    }
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty()
+    }
+    pub fn duration(&self) -> f64 {
+        self.dt * (self.len().saturating_sub(1)) as f64
+    }
+    pub fn time(&self, k: usize) -> f64 {
+        self.t0 + self.dt * k as f64
+    }
+
+    /// Reads a CSV file.
+    pub fn load(path: &Path) -> Result<Self, DiscoveryError> {
+        let text = std::fs::read_to_string(path).map_err(|e| DiscoveryError::Io { path: path.display().to_string(), reason: e.to_string() })?;
+        Self::parse_str(&text, &path.display().to_string())
+    }
+
+    /// Parses CSV text; `source` names it in errors.
+    pub fn parse_str(text: &str, source: &str) -> Result<Self, DiscoveryError> {
+        let path = source.to_string();
+        let mut rdr = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).flexible(true).from_reader(text.as_bytes());
+        let header: Vec<String> = rdr.headers().map_err(|e| DiscoveryError::Io { path: path.clone(), reason: e.to_string() })?.iter().map(|s| s.to_string()).collect();
+        let missing = |c: &str| DiscoveryError::MissingColumn { path: path.clone(), column: c.into(), header: header.clone() };
+        let it = header.iter().position(|h| h == "t").ok_or_else(|| missing("t"))?;
+        let iw = col_names("w", &header);
+        if iw.is_empty() {
+            return Err(missing("w"));
+        }
+        let iy = col_names("y", &header);
+        if iy.is_empty() {
+            return Err(missing("y"));
+        }
+        let iz = col_names("z", &header);
+        let mut t = Vec::new();
+        let mut w = Vec::new();
+        let mut y = Vec::new();
+        let mut z = Vec::new();
+        for (r, rec) in rdr.records().enumerate() {
+            let row = r + 2; // 1-based, header is row 1
+            let rec = rec.map_err(|e| DiscoveryError::Io { path: path.clone(), reason: e.to_string() })?;
+            if rec.len() != header.len() {
+                return Err(DiscoveryError::RowLength { path: path.clone(), row, got: rec.len(), expected: header.len() });
+            }
+            let get = |i: usize| -> Result<f64, DiscoveryError> {
+                let s = &rec[i];
+                match s.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    _ => Err(DiscoveryError::NotFinite { path: path.clone(), row, column: header[i].clone(), value: s.to_string() }),
+                }
+            };
+            let tk = get(it)?;
+            if let Some(&prev) = t.last() {
+                if tk <= prev {
+                    return Err(DiscoveryError::NonIncreasingTime { path: path.clone(), row, t: tk, prev });
+                }
+            }
+            t.push(tk);
+            w.push(iw.iter().map(|&i| get(i)).collect::<Result<Vec<_>, _>>()?);
+            y.push(iy.iter().map(|&i| get(i)).collect::<Result<Vec<_>, _>>()?);
+            if !iz.is_empty() {
+                z.push(iz.iter().map(|&i| get(i)).collect::<Result<Vec<_>, _>>()?);
+            }
+        }
+        if t.len() < MIN_SAMPLES {
+            return Err(DiscoveryError::TooFewSamples { path, rows: t.len(), min: MIN_SAMPLES });
+        }
+        for (j, &i) in iw.iter().enumerate() {
+            let v0 = w[0][j];
+            let scale = w.iter().map(|r| r[j].abs()).fold(0.0, f64::max).max(1e-300);
+            if w.iter().all(|r| (r[j] - v0).abs() <= 1e-12 * scale) {
+                return Err(DiscoveryError::ConstantInput { path, column: header[i].clone(), value: v0 });
+            }
+        }
+        let z = if iz.is_empty() { None } else { Some(z) };
+        Ok(Self::from_samples(source, &t, w, y, z))
+    }
+
+    /// Builds a recording from (possibly irregular) samples; times must increase strictly.
+    pub fn from_samples(source: &str, t: &[f64], w: Vec<Vec<f64>>, y: Vec<Vec<f64>>, z: Option<Vec<Vec<f64>>>) -> Self {
+        let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+        d.sort_by(f64::total_cmp);
+        let dt = d[d.len() / 2];
+        let (lo, hi) = (d[0], d[d.len() - 1]);
+        let irregular = (hi - lo) > 0.01 * dt;
+        let rows_in_file = t.len();
+        if !irregular {
+            return Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: false, rows_in_file };
+        }
+        let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
+        let interp = |s: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
+            let mut out = Vec::with_capacity(n);
+            let mut j = 0;
+            for k in 0..n {
+                let tk = t[0] + dt * k as f64;
+                while j + 2 < t.len() && t[j + 1] < tk {
+                    j += 1;
+                }
+                let a = ((tk - t[j]) / (t[j + 1] - t[j])).clamp(0.0, 1.0);
+                out.push(s[j].iter().zip(&s[j + 1]).map(|(u, v)| u + a * (v - u)).collect());
+            }
+            out
+        };
+        let (w, y, z) = (interp(&w), interp(&y), z.as_ref().map(interp));
+        Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: true, rows_in_file }
+    }
+
+    /// Writes the recording as CSV text (`t,w..,y..`).
+    pub fn to_csv_string(&self) -> String {
+        let mut s = String::from("t");
+        let (m, p) = (self.m(), self.p());
+        for j in 1..=m {
+            s += &if m == 1 { ",w".to_string() } else { format!(",w{j}") };
+        }
+        for j in 1..=p {
+            s += &if p == 1 { ",y".to_string() } else { format!(",y{j}") };
+        }
+        s.push('\n');
+        for k in 0..self.len() {
+            s += &format!("{}", self.time(k));
+            for v in self.w[k].iter().chain(&self.y[k]) {
+                s += &format!(",{v}");
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn csv(rows: usize, f: impl Fn(usize) -> String) -> String {
+        let mut s = "t,w,y\n".to_string();
+        for k in 0..rows {
+            s += &f(k);
+            s.push('\n');
+        }
+        s
+    }
+
+    #[test]
+    fn reads_regular_and_resamples_irregular() {
+        let r = Recording::parse_str(&csv(100, |k| format!("{},{},{}", k as f64 * 0.01, (k as f64).sin(), k)), "a").unwrap();
+        assert!(!r.resampled);
+        assert_eq!(r.len(), 100);
+        assert!((r.dt - 0.01).abs() < 1e-12);
+        let irr = csv(100, |k| {
+            let t = k as f64 * 0.01 + if k % 2 == 1 { 0.003 } else { 0.0 };
+            format!("{t},{},{}", (k as f64).sin(), 2.0 * t)
+        });
+        let r = Recording::parse_str(&irr, "b").unwrap();
+        assert!(r.resampled);
+        // y = 2 t is linear: interpolation must reproduce it exactly.
+        for k in 0..r.len() {
+            assert!((r.y[k][0] - 2.0 * r.time(k)).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_named() {
+        let e = Recording::parse_str("t,w\n0,1\n", "x").unwrap_err().to_string();
+        assert!(e.contains("lacks column `y`"), "{e}");
+        let e = Recording::parse_str(&csv(60, |k| if k == 7 { "0.07,NaN,1".into() } else { format!("{},{},1", k as f64 * 0.01, k) }), "x").unwrap_err().to_string();
+        assert!(e.contains("row 9") && e.contains("NaN"), "{e}");
+        let e = Recording::parse_str(&csv(60, |k| format!("{},{},1", if k == 5 { 0.0 } else { k as f64 }, k)), "x").unwrap_err().to_string();
+        assert!(e.contains("increase strictly"), "{e}");
+        let e = Recording::parse_str(&csv(60, |k| format!("{},3,{}", k, k)), "x").unwrap_err().to_string();
+        assert!(e.contains("constant"), "{e}");
+        let e = Recording::parse_str(&csv(10, |k| format!("{},{},{}", k, k, k)), "x").unwrap_err().to_string();
+        assert!(e.contains("only 10 samples"), "{e}");
+    }
+}
