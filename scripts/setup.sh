@@ -15,6 +15,6 @@ if [ "${#need_pkgs[@]}" -gt 0 ]; then
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then
-    echo "setup: cargo not found; this workspace needs the machine's Rust toolchain (>= 1.85)" >&2
+    echo "setup: cargo not found; this workspace needs the machine's Rust toolchain (>= 1.89)" >&2
     exit 1
 fi
