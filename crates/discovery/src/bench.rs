@@ -1,1 +1,169 @@
-//! Benchmark runner (joins the generator and the diagnosis).
+//! The concealed-effect benchmark: generates cases with [`crate::bench_gen`], diagnoses each
+//! with [`crate::diagnose`] (which knows nothing of the generator) and scores the names and
+//! parameters.
+use crate::bench_gen::{self, CLASSES};
+use crate::diagnose::{diagnose, DiagnoseSettings};
+use model::effects::Effect;
+use serde::Serialize;
+
+/// Outcome of one case.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseResult {
+    pub class: String,
+    pub index: usize,
+    pub description: String,
+    pub nominal_fit: f64,
+    /// Name of the first selected effect (`none` when nothing was added).
+    pub predicted: String,
+    /// Every selected effect.
+    pub selected: String,
+    /// Hypotheses reported as indistinguishable from the selected one.
+    pub ties: Vec<String>,
+    pub correct: bool,
+    /// The truth is the selected effect or one reported as tied with it.
+    pub correct_or_tied: bool,
+    /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right.
+    pub param_error: Option<f64>,
+    pub true_param: Option<f64>,
+    pub est_param: Option<f64>,
+    pub fit_before: f64,
+    pub fit_after: f64,
+    pub seconds: f64,
+    /// A diagnosis error (should not happen).
+    pub error: Option<String>,
+}
+
+/// The benchmark's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchResult {
+    pub classes: Vec<String>,
+    /// `confusion[true][predicted]`; the last column counts predictions outside the classes.
+    pub confusion: Vec<Vec<usize>>,
+    pub cases: Vec<CaseResult>,
+}
+
+/// Main parameter of an effect (the one the generator sets).
+pub fn main_param(e: &Effect) -> f64 {
+    match e {
+        Effect::Backlash { width, .. } => *width,
+        Effect::GapWidth { relative_change } => *relative_change,
+        Effect::CoulombFriction { level, .. } => *level,
+        Effect::ConstantForce { force, .. } => *force,
+        Effect::BacklashInertia { mass, damping } => mass / damping,
+        Effect::InputDelay { delay } => *delay,
+        Effect::InputSaturation { limit } => *limit,
+        Effect::SensorOffset { offset } => offset[0],
+    }
+}
+
+/// Runs one case.
+pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettings) -> CaseResult {
+    let case = bench_gen::generate(class, seed, index);
+    let start = std::time::Instant::now();
+    let r = diagnose(&case.nominal, &case.recording, s);
+    let seconds = start.elapsed().as_secs_f64();
+    let mut out = CaseResult {
+        class: class.into(),
+        index,
+        description: case.description.clone(),
+        nominal_fit: case.nominal_fit,
+        predicted: "error".into(),
+        selected: "error".into(),
+        ties: vec![],
+        correct: false,
+        correct_or_tied: false,
+        param_error: None,
+        true_param: case.truth.as_ref().map(main_param),
+        est_param: None,
+        fit_before: f64::NAN,
+        fit_after: f64::NAN,
+        seconds,
+        error: None,
+    };
+    match r {
+        Err(e) => out.error = Some(e.to_string()),
+        Ok(rep) => {
+            let fitted = rep.fitted_model.as_ref().map(|m| m.effects.list.clone()).unwrap_or_default();
+            out.predicted = rep.effects.first().map(|e| e.kind.clone()).unwrap_or_else(|| "none".into());
+            out.selected = rep.selected();
+            out.ties = rep.ties.clone();
+            out.correct = out.predicted == class;
+            out.correct_or_tied = out.correct || rep.ties.iter().any(|t| t.split('(').next() == Some(class));
+            out.fit_before = rep.fit_before.fit_percent[0];
+            out.fit_after = rep.fit_after.fit_percent[0];
+            if out.correct {
+                if let (Some(t), Some(e)) = (case.truth.as_ref(), fitted.iter().find(|e| e.kind() == class)) {
+                    let (tv, ev) = (main_param(t), main_param(e));
+                    out.est_param = Some(ev);
+                    out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs `cases` cases of every class.
+pub fn run(cases: usize, seed: u64, s: &DiagnoseSettings, mut progress: impl FnMut(&CaseResult)) -> BenchResult {
+    let mut results = Vec::new();
+    for i in 0..cases {
+        for &c in CLASSES.iter() {
+            let r = run_case(c, seed, i, s);
+            progress(&r);
+            results.push(r);
+        }
+    }
+    let k = CLASSES.len();
+    let mut confusion = vec![vec![0; k + 1]; k];
+    for r in &results {
+        let ti = CLASSES.iter().position(|c| *c == r.class).expect("known class");
+        let pi = CLASSES.iter().position(|c| *c == r.predicted).unwrap_or(k);
+        confusion[ti][pi] += 1;
+    }
+    BenchResult { classes: CLASSES.iter().map(|s| s.to_string()).collect(), confusion, cases: results }
+}
+
+impl BenchResult {
+    /// Confusion matrix and summary as text.
+    pub fn to_text(&self) -> String {
+        let k = self.classes.len();
+        let short = |s: &str| s.chars().take(9).collect::<String>();
+        let mut s = format!("{:>18}", "true \\ predicted");
+        for c in &self.classes {
+            s += &format!(" {:>9}", short(c));
+        }
+        s += &format!(" {:>9}\n", "other");
+        for (i, row) in self.confusion.iter().enumerate() {
+            s += &format!("{:>18}", self.classes[i]);
+            for v in row {
+                s += &format!(" {v:>9}");
+            }
+            s.push('\n');
+        }
+        let total = self.cases.len();
+        let correct = self.cases.iter().filter(|c| c.correct).count();
+        let tied = self.cases.iter().filter(|c| c.correct_or_tied).count();
+        let non_none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class != "none").collect();
+        let none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class == "none").collect();
+        let false_alarms = none.iter().filter(|c| c.predicted != "none").count();
+        s += &format!("\ncorrect names: {correct}/{total} ({:.1} %); counting reported ties: {tied}/{total} ({:.1} %)\n", 100.0 * correct as f64 / total.max(1) as f64, 100.0 * tied as f64 / total.max(1) as f64);
+        s += &format!("false alarms on none: {false_alarms}/{} ({:.1} %)\n", none.len(), 100.0 * false_alarms as f64 / none.len().max(1) as f64);
+        s += &format!("missed effects (predicted none): {}/{}\n", non_none.iter().filter(|c| c.predicted == "none").count(), non_none.len());
+        s += "\nparameter error of the main parameter (correctly named cases):\n";
+        for c in self.classes.iter().skip(1) {
+            let errs: Vec<f64> = self.cases.iter().filter(|r| &r.class == c).filter_map(|r| r.param_error).collect();
+            if errs.is_empty() {
+                s += &format!("  {c:>18}: no correctly named case\n");
+                continue;
+            }
+            let mut e = errs.clone();
+            e.sort_by(f64::total_cmp);
+            let within = e.iter().filter(|x| **x <= 0.15).count();
+            s += &format!("  {c:>18}: median {:.1} %, max {:.1} %, within 15 %: {within}/{}\n", 100.0 * e[e.len() / 2], 100.0 * e[e.len() - 1], e.len());
+        }
+        let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
+        s += &format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / total.max(1) as f64);
+        let _ = k;
+        s
+    }
+}
