@@ -1,1 +1,20 @@
-//! theorems
+//! `theorems`: a property campaign for every result of the paper
+//! (`../shared/paper/strongly-convex-backlash.tex`), shared by `cargo test -p theorems` and
+//! `moreau check`.
+//!
+//! - [`strategies`]: seeded proptest strategies for random strongly convex sets, points with
+//!   inward normals, Hurwitz systems with controlled `mu`, periodic inputs;
+//! - [`properties`]: one module per result, named after it (`lemma_a2.rs` checks eq.
+//!   (lem1:2)), each with a negative control that must fail;
+//! - [`campaign`]: the deterministic runner (cases, minimum normalised slack, violations,
+//!   shrunk counterexample).
+//!
+//! Where each result is computed, tested and what the campaign found: `proofs-notes/`.
+#![allow(non_snake_case)]
+
+pub mod campaign;
+pub mod properties;
+pub mod strategies;
+
+pub use campaign::{registry, run, run_property, CampaignError, CampaignSettings, PropertyReport};
+pub use properties::{CaseOutcome, Counterexample, Eval, Property, PropertyInfo, Variant};
