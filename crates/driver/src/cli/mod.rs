@@ -2,6 +2,12 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod check;
+pub mod convergence;
+pub mod diagnose;
+pub mod discover_bench;
+pub mod periodic;
+pub mod simulate;
 pub mod validate;
 
 /// Convergence to periodic regimes with a strongly convex backlash: simulate, certify, check.
@@ -16,6 +22,21 @@ pub struct Cli {
 pub enum Command {
     /// Parse and validate model files; print n, m, p, Theta and its R, eig(F) and mu.
     Validate(validate::Args),
+    /// Property campaign: every inequality of the paper on random cases (table of cases,
+    /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
+    Check(check::Args),
+    /// Simulate the closed loop; write trajectory.csv (t, w, x, y, z, q) and a plot (SVG, PNG).
+    Simulate(simulate::Args),
+    /// Periodic regime (Poincare fixed point, residual, (loc) check), measured convergence
+    /// exponent with its 95% interval, path length of z per period.
+    Periodic(periodic::Args),
+    /// Error of the catching-up scheme against the event-driven reference for a ladder of steps.
+    Convergence(convergence::Args),
+    /// Compare a model with a recording: locate the mismatch, name the missing physics, refit,
+    /// validate; writes report.md, report.json, fitted.toml and figures.
+    Diagnose(diagnose::Args),
+    /// Concealed-effect benchmark of `diagnose`: confusion matrix and parameter errors.
+    DiscoverBench(discover_bench::Args),
 }
 
 /// Runs the CLI: prints errors on one line (`error: ...`) and returns a non-zero exit code.
@@ -23,6 +44,12 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Validate(a) => validate::run(&a),
+        Command::Check(a) => check::run(&a),
+        Command::Simulate(a) => simulate::run(&a),
+        Command::Periodic(a) => periodic::run(&a),
+        Command::Convergence(a) => convergence::run(&a),
+        Command::Diagnose(a) => diagnose::run(&a),
+        Command::DiscoverBench(a) => discover_bench::run(&a),
     };
     match result {
         Ok(code) => code,
