@@ -13,7 +13,7 @@ fn cases() -> u32 {
 fn config() -> Config {
     Config {
         cases: cases(),
-        failure_persistence: Some(Box::new(FileFailurePersistence::SourceParallel("proptest-regressions"))),
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct("proptest-regressions/geometric.txt"))),
         source_file: Some(file!()),
         ..Config::default()
     }
@@ -26,7 +26,7 @@ fn holds(e: Eval) -> Result<(), TestCaseError> {
 
 /// Runs `eval` under the negative control and requires proptest to find (and shrink) a
 /// counterexample. Failing seeds are persisted to `proptest-regressions/geometric.txt`,
-/// which the claim tests replay first.
+/// which the claim tests replay first (path relative to the crate, where `cargo test` runs).
 fn negative_control<C: std::fmt::Debug + Clone>(strategy: BoxedStrategy<C>, eval: fn(&C, Variant) -> Eval) -> C {
     let mut runner = TestRunner::new(Config { cases: cases(), ..config() });
     match runner.run(&strategy, |c| holds(eval(&c, Variant::NegativeControl))) {

@@ -8,6 +8,7 @@ pub mod diagnose;
 pub mod discover_bench;
 pub mod periodic;
 pub mod simulate;
+pub mod check;
 pub mod validate;
 
 /// Convergence to periodic regimes with a strongly convex backlash: simulate, certify, check.
@@ -22,6 +23,9 @@ pub struct Cli {
 pub enum Command {
     /// Parse and validate model files; print n, m, p, Theta and its R, eig(F) and mu.
     Validate(validate::Args),
+    /// Property campaign: every inequality of the paper on random cases (table of cases,
+    /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
+    Check(check::Args),
     /// Property campaign: every inequality of the paper on random cases (table of cases,
     /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
     Check(check::Args),
@@ -44,6 +48,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Validate(a) => validate::run(&a),
+        Command::Check(a) => check::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Periodic(a) => periodic::run(&a),

@@ -288,7 +288,7 @@ pub fn system_counterexample(sys: &model::System, e: &Eval, property: &str, extr
 
 /// Common imports of the property modules.
 pub(crate) mod sets_prelude {
-    pub use super::{fp_tol, geometric_counterexample, system_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant};
+    pub use super::{fp_tol, geometric_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant};
     pub use crate::strategies::sets::*;
     pub use geometry::linalg::{dist, dot, norm};
     pub use geometry::ConvexSet;
