@@ -3,5 +3,13 @@
 #![allow(non_snake_case)]
 
 pub mod cli;
+pub mod error;
+pub mod orbit;
 pub mod output;
+pub mod report;
+pub mod stationary;
+pub mod theta;
+pub mod tube;
+
+pub use error::DriverError;
 pub mod plot;

@@ -8,7 +8,7 @@ pub mod diagnose;
 pub mod discover_bench;
 pub mod periodic;
 pub mod simulate;
-pub mod check;
+pub mod theta;
 pub mod validate;
 
 /// Convergence to periodic regimes with a strongly convex backlash: simulate, certify, check.
@@ -21,11 +21,11 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// The paper's bound theta (eq. (theta)) with every quantity labelled by its equation,
+    /// verified flags, and the measured rate, path length and limsup |z'| next to it.
+    Theta(theta::Args),
     /// Parse and validate model files; print n, m, p, Theta and its R, eig(F) and mu.
     Validate(validate::Args),
-    /// Property campaign: every inequality of the paper on random cases (table of cases,
-    /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
-    Check(check::Args),
     /// Property campaign: every inequality of the paper on random cases (table of cases,
     /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
     Check(check::Args),
@@ -47,8 +47,8 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Theta(a) => theta::run(&a),
         Command::Validate(a) => validate::run(&a),
-        Command::Check(a) => check::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Periodic(a) => periodic::run(&a),

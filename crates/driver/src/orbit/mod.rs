@@ -1,0 +1,11 @@
+//! The periodic orbit `eta_T = C xi_T` of the linearised system (eqs. (xiT), (etaT)) and the
+//! quantities of Theorem 2 computed from it:
+//! - [`eta_orbit`]: samples of `eta_T`, `eta_T'`; `osc = diam eta_T([0, T])` (eq. (mho)) from
+//!   below and `||eta_T'||_inf` (eq. (zinf)) from above (closed form for sine inputs);
+//! - [`path_bounds`]: the path-length bounds (path), (path1) (dynamic programming over a time
+//!   grid) and (path2) (greedy packing).
+pub mod eta_orbit;
+pub mod path_bounds;
+
+pub use eta_orbit::{EtaOrbit, OrbitSettings};
+pub use path_bounds::{packing_bound, partition_bound, path_bound, PackingBound};

@@ -1,0 +1,6 @@
+//! Tubular localisation of Section 4 (Lemma 2): `x(t) in xi(t) + Xi(t)`, eq. (xX), with the
+//! support functions of `Xi(t)` and `Xi_inf` (eqs. (Xsupp), (Xinfsupp)) and the tail bound
+//! (DXX). See [`xi_support`].
+pub mod xi_support;
+
+pub use xi_support::{Horizon, TubeKernel, TubeSettings};

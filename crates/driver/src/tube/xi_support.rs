@@ -1,0 +1,305 @@
+//! Support functions of the tube cross-sections `L Xi(t)` and `L Xi_inf` (Lemma 2):
+//!
+//! ```text
+//! sigma_{L Xi(t)}(v)   = int_0^t   sigma_Theta(K(s)^T v) ds,   K(s) = L e^{sF} E      (Xsupp)
+//! sigma_{L Xi_inf}(v)  = int_0^inf sigma_Theta(K(s)^T v) ds                           (Xinfsupp)
+//! ```
+//! (`L = I_n` gives `Xi` itself, `L = C` the output tube `C Xi_inf` of eq. (d), `L = C F` the
+//! set `C F Xi_inf` of eq. (zinf)), enclosed rigorously up to floating-point rounding.
+//!
+//! **Quadrature.** On a cell `[m - r, m + r]` write `c(s) = K(s)^T v`. Taylor:
+//! `c(m + tau) = c(m) + tau c'(m) + rho(tau)`, `|rho| <= tau^2/2 M2`, with
+//! `M2 = ||L F^2 e^{mF}||_F e^{r ||F||_F} ||E||_F |v|` bounding `|c''|` on the cell. As
+//! `sigma_Theta` is convex and `D_Theta`-Lipschitz (`D_Theta = D(Theta, {0})`, eq. (DTheta0)):
+//! - upper: `int <= r (sigma(c(m) - r c'(m)) + sigma(c(m) + r c'(m))) + D_Theta M2 r^3 / 3`
+//!   (the trapezoid rule over-estimates the integral of a convex function);
+//! - lower: `int >= 2 r sigma(c(m)) - D_Theta M2 r^3 / 3` (Jensen).
+//!
+//! The cell width is chosen (and halved, adaptively) until the summed remainders are below
+//! `tol_abs / 2`.
+//!
+//! **Tail, eq. (DXX).** `int_S^inf sigma_Theta(K(s)^T v) ds <= D_Theta |v| ||L e^{SF}||_F ||E||_F
+//! int_0^inf ||e^{rF}|| dr`, and `int_0^inf ||e^{rF}|| dr <= tau M / (1 - q)` with
+//! `q = ||e^{tau F}||_F < 1` and `M >= max_{[0, tau]} ||e^{rF}||` (grid maximum times
+//! `e^{delta ||F||_F}`). `S` is increased until the tail is below `tol_abs / 2`.
+use crate::error::DriverError;
+use dynamics::linear::expm::expm;
+use geometry::{ConvexSet, Shape};
+use nalgebra::DMatrix;
+
+/// Settings of the tube quadrature.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TubeSettings {
+    /// Target absolute width (per unit `|v|`) of the enclosure of a support value, half for the
+    /// quadrature remainder and half for the tail. Default `1e-6`.
+    pub tol_abs: f64,
+    /// Maximum number of quadrature cells. Default `400_000`.
+    pub max_cells: usize,
+}
+
+impl Default for TubeSettings {
+    fn default() -> Self {
+        Self { tol_abs: 1e-6, max_cells: 400_000 }
+    }
+}
+
+impl TubeSettings {
+    pub fn validate(&self) -> Result<(), DriverError> {
+        if !(self.tol_abs > 0.0 && self.tol_abs.is_finite()) {
+            return Err(DriverError::BadSetting { name: "tube.tol_abs", value: self.tol_abs, reason: "must be positive and finite" });
+        }
+        if self.max_cells < 16 {
+            return Err(DriverError::BadSetting { name: "tube.max_cells", value: self.max_cells as f64, reason: "must be at least 16" });
+        }
+        Ok(())
+    }
+}
+
+/// The integration horizon: `Xi(t)` (eq. (Xsupp)) or `Xi_inf` (eq. (Xinfsupp)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Horizon {
+    Finite(f64),
+    Infinite,
+}
+
+fn frob(M: &DMatrix<f64>) -> f64 {
+    M.iter().map(|x| x * x).sum::<f64>().sqrt() * (1.0 + 1e-14)
+}
+
+/// Precomputed quadrature of `sigma_{L Xi}(v)` for any direction `v in R^r` (`r` = rows of `L`).
+/// Thread-safe (immutable after construction), cheap to evaluate for many directions.
+#[derive(Debug, Clone)]
+pub struct TubeKernel {
+    r: usize,
+    p: usize,
+    theta: Shape,
+    /// Per cell: `(K(m) - r K'(m))^T`, `K(m)^T`, `(K(m) + r K'(m))^T`, each `p x r`, row-major.
+    minus: Vec<f64>,
+    mid: Vec<f64>,
+    plus: Vec<f64>,
+    /// Half-width of each cell.
+    half: Vec<f64>,
+    /// Sum of the Taylor remainders per unit `|v|`.
+    remainder: f64,
+    /// Tail bound per unit `|v|` (0 for a finite horizon).
+    tail: f64,
+    /// Upper bound of `int ||K(s)|| ds` (for Lipschitz constants).
+    k_l1: f64,
+    d_theta: f64,
+    zero_in_theta: bool,
+    /// Truncation point `S` of the infinite integral (or the finite horizon).
+    pub s_max: f64,
+    /// Cell width used.
+    pub h: f64,
+}
+
+/// Bound `int_0^inf ||e^{rF}|| dr <= tau M / (1 - q)` (see the module docs).
+pub fn exp_norm_integral(F: &DMatrix<f64>) -> Result<f64, DriverError> {
+    let nF = frob(F);
+    let mu = lmi::spectral_abscissa(F).map_err(DriverError::Lmi)?;
+    if mu >= 0.0 {
+        return Err(DriverError::NotHurwitz { mu });
+    }
+    let mut tau = 1.0 / -mu;
+    for _ in 0..40 {
+        let q = frob(&expm(&(F * tau)));
+        if q < 0.5 {
+            // M = max over a grid of [0, tau] of ||e^{rF}||_F, times e^{delta ||F||}.
+            let k = 256usize;
+            let delta = tau / k as f64;
+            let step = expm(&(F * delta));
+            let mut P = DMatrix::<f64>::identity(F.nrows(), F.nrows());
+            let mut M = frob(&P);
+            for _ in 0..k {
+                P = &P * &step;
+                M = M.max(frob(&P));
+            }
+            M *= (delta * nF).exp() * (1.0 + 1e-10);
+            return Ok(tau * M / (1.0 - q));
+        }
+        tau *= 2.0;
+    }
+    Err(DriverError::NoTailBound { tau_max: tau })
+}
+
+impl TubeKernel {
+    /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
+    pub fn new(L: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, horizon: Horizon, settings: &TubeSettings) -> Result<Self, DriverError> {
+        settings.validate()?;
+        let p = E.ncols();
+        let r = L.nrows();
+        let d_theta = theta.deviation_from_origin().upper;
+        let zero_in_theta = theta.contains(&vec![0.0; p], 0.0);
+        let nF = frob(F);
+        let nE = frob(E);
+        let LF = L * F;
+        let LF2 = &LF * F;
+        let tol = settings.tol_abs;
+        // Truncation point.
+        let (s_max, tail_unit) = match horizon {
+            Horizon::Finite(t) => {
+                if !(t >= 0.0 && t.is_finite()) {
+                    return Err(DriverError::BadSetting { name: "horizon", value: t, reason: "must be finite and >= 0" });
+                }
+                (t, 0.0)
+            }
+            Horizon::Infinite => {
+                let i_inf = exp_norm_integral(F)?;
+                let mu = lmi::spectral_abscissa(F).map_err(DriverError::Lmi)?;
+                let mut S = 8.0 / -mu;
+                let mut tail;
+                loop {
+                    tail = d_theta * frob(&(L * expm(&(F * S)))) * nE * i_inf;
+                    if tail <= 0.5 * tol || S > 1e6 / -mu {
+                        break;
+                    }
+                    S *= 1.25;
+                }
+                (S, tail)
+            }
+        };
+        // Cell width: start from a guess and shrink (remainder ~ h^2) until the summed
+        // remainders are below tol / 2.
+        let mut h = (0.05_f64).min(0.5 / nF.max(1e-300));
+        loop {
+            let cells = if s_max == 0.0 { 0 } else { ((s_max / h).ceil() as usize).max(1) };
+            if cells > settings.max_cells {
+                return Err(DriverError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: cells });
+            }
+            let k = Self::build(L, &LF, &LF2, F, E, theta, s_max, cells, d_theta, nF, nE, r, p);
+            if k.remainder <= 0.5 * tol || cells == 0 {
+                return Ok(Self { tail: tail_unit, zero_in_theta, s_max, ..k });
+            }
+            let factor = (k.remainder / (0.4 * tol)).sqrt().max(1.5);
+            let next = (cells as f64 * factor).ceil();
+            if next > settings.max_cells as f64 && cells < settings.max_cells {
+                h = s_max / settings.max_cells as f64;
+            } else {
+                h = s_max / next;
+            }
+            if cells >= settings.max_cells {
+                return Err(DriverError::QuadratureBudget { error_bound: k.remainder, tol, nodes: cells });
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn build(
+        L: &DMatrix<f64>, LF: &DMatrix<f64>, LF2: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, s_max: f64,
+        cells: usize, d_theta: f64, nF: f64, nE: f64, r: usize, p: usize,
+    ) -> Self {
+        let mut minus = Vec::with_capacity(cells * p * r);
+        let mut mid = Vec::with_capacity(cells * p * r);
+        let mut plus = Vec::with_capacity(cells * p * r);
+        let mut half = Vec::with_capacity(cells);
+        let mut remainder = 0.0;
+        let mut k_l1 = 0.0;
+        let h = if cells == 0 { 0.0 } else { s_max / cells as f64 };
+        let rr = 0.5 * h;
+        let grow = (rr * nF).exp();
+        let step = expm(&(F * h));
+        let mut P = expm(&(F * rr));
+        let push_t = |buf: &mut Vec<f64>, M: &DMatrix<f64>| {
+            // M is r x p; store M^T (p x r) row-major, i.e. M column-major.
+            buf.extend(M.iter().copied());
+        };
+        for j in 0..cells {
+            if j > 0 {
+                if j % 64 == 0 {
+                    P = expm(&(F * (rr + j as f64 * h)));
+                } else {
+                    P = &P * &step;
+                }
+            }
+            let PE = &P * E;
+            let K = L * &PE;
+            let K1 = LF * &PE;
+            let M2 = frob(&(LF2 * &P)) * grow * nE;
+            let Km = &K - &K1 * rr;
+            let Kp = &K + &K1 * rr;
+            push_t(&mut minus, &Km);
+            push_t(&mut mid, &K);
+            push_t(&mut plus, &Kp);
+            half.push(rr);
+            remainder += d_theta * M2 * rr * rr * rr / 3.0;
+            k_l1 += 2.0 * rr * (frob(&K) + rr * frob(&K1) + 0.5 * rr * rr * M2);
+        }
+        Self {
+            r,
+            p,
+            theta: theta.clone(),
+            minus,
+            mid,
+            plus,
+            half,
+            remainder: remainder * (1.0 + 1e-10),
+            tail: 0.0,
+            k_l1,
+            d_theta,
+            zero_in_theta: true,
+            s_max,
+            h,
+        }
+    }
+
+    /// Dimension `r` of the directions `v`.
+    pub fn dim(&self) -> usize {
+        self.r
+    }
+
+    /// `sum_j w_j sigma_Theta(M_j^T v)` over the stored matrices.
+    fn sum(&self, mats: &[f64], v: &[f64], buf: &mut [f64]) -> f64 {
+        let (p, r) = (self.p, self.r);
+        let mut acc = 0.0;
+        for j in 0..self.half.len() {
+            let M = &mats[j * p * r..(j + 1) * p * r];
+            // M is stored column-major r x p: column i (entries i*r..) is row i of M^T.
+            for (i, b) in buf.iter_mut().enumerate() {
+                *b = M[i * r..(i + 1) * r].iter().zip(v).map(|(a, x)| a * x).sum();
+            }
+            acc += self.half[j] * self.theta.support(buf);
+        }
+        acc
+    }
+
+    /// Rigorous enclosure `[lower, upper]` of `sigma_{L Xi}(v)` (up to rounding).
+    pub fn support_bounds(&self, v: &[f64]) -> geometry::Bounds {
+        let mut buf = vec![0.0; self.p];
+        let nv = geometry::linalg::norm(v);
+        let up = self.sum(&self.minus, v, &mut buf) + self.sum(&self.plus, v, &mut buf) + nv * (self.remainder + self.tail);
+        let lo_tail = if self.zero_in_theta { 0.0 } else { nv * self.tail };
+        let lo = 2.0 * self.sum(&self.mid, v, &mut buf) - nv * self.remainder - lo_tail;
+        geometry::Bounds::new(lo, up.max(lo))
+    }
+
+    /// Upper bound of `sigma_{L Xi}(v)`.
+    pub fn support_upper(&self, v: &[f64]) -> f64 {
+        self.support_bounds(v).upper
+    }
+
+    /// Lipschitz constant (in `v`) of [`Self::support_upper`] and of the true support function:
+    /// `D_Theta int ||K|| ds` plus the remainder and tail terms.
+    pub fn lipschitz(&self) -> f64 {
+        (self.d_theta * self.k_l1 + self.remainder + self.tail) * (1.0 + 1e-10)
+    }
+
+    /// Upper bound of `D(L Xi, {0}) = max_{|v|=1} sigma(v)` without a search: `D_Theta int ||K||`.
+    pub fn deviation_upper_crude(&self) -> f64 {
+        self.lipschitz()
+    }
+
+    /// Tail bound of eq. (DXX) per unit `|v|` (0 for a finite horizon).
+    pub fn tail_bound(&self) -> f64 {
+        self.tail
+    }
+
+    /// Summed Taylor remainder per unit `|v|`.
+    pub fn remainder_bound(&self) -> f64 {
+        self.remainder
+    }
+
+    /// Number of quadrature cells.
+    pub fn cells(&self) -> usize {
+        self.half.len()
+    }
+}
