@@ -8,6 +8,7 @@ pub mod orbit;
 pub mod output;
 pub mod report;
 pub mod stationary;
+pub mod sweep;
 pub mod theta;
 pub mod tube;
 

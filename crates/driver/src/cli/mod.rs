@@ -8,6 +8,8 @@ pub mod diagnose;
 pub mod discover_bench;
 pub mod periodic;
 pub mod simulate;
+pub mod sweep;
+pub mod merge;
 pub mod theta;
 pub mod validate;
 
@@ -41,6 +43,11 @@ pub enum Command {
     Diagnose(diagnose::Args),
     /// Concealed-effect benchmark of `diagnose`: confusion matrix and parameter errors.
     DiscoverBench(discover_bench::Args),
+    /// Parameter sweep (TOML spec): theta, its parts and the measured rate per point, as CSV,
+    /// JSON, Markdown and LaTeX; parallel, resumable, `--shard K/N` for job arrays.
+    Sweep(sweep::Args),
+    /// Join the shards of one sweep (`moreau sweep --shard K/N`) into one table.
+    Merge(merge::Args),
 }
 
 /// Runs the CLI: prints errors on one line (`error: ...`) and returns a non-zero exit code.
@@ -55,6 +62,8 @@ pub fn main() -> ExitCode {
         Command::Convergence(a) => convergence::run(&a),
         Command::Diagnose(a) => diagnose::run(&a),
         Command::DiscoverBench(a) => discover_bench::run(&a),
+        Command::Sweep(a) => sweep::run(&a),
+        Command::Merge(a) => merge::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,88 @@
+//! `moreau merge`: joins the result files of the shards of one sweep into one table. Refuses
+//! files of different specs (spec hash), conflicting duplicates and, unless asked, missing
+//! points.
+use super::table::{PointRecord, SweepResult};
+use super::SweepError;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Result files named by `inputs`: files as given, directories expanded to their
+/// `sweep*.json` files (sorted by name).
+pub fn collect_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, SweepError> {
+    let mut files = Vec::new();
+    for p in inputs {
+        if p.is_dir() {
+            let rd = std::fs::read_dir(p).map_err(|source| SweepError::Io { path: p.clone(), source })?;
+            let mut found: Vec<PathBuf> = rd
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|f| f.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("sweep") && n.ends_with(".json")))
+                .collect();
+            if found.is_empty() {
+                return Err(SweepError::NothingToMerge { path: p.clone() });
+            }
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    if files.is_empty() {
+        return Err(SweepError::NothingToMerge { path: PathBuf::from(".") });
+    }
+    Ok(files)
+}
+
+/// Merges result files of one spec. With `partial`, missing points are allowed.
+pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError> {
+    let mut merged: Option<(PathBuf, SweepResult)> = None;
+    let mut points: BTreeMap<usize, (PointRecord, PathBuf)> = BTreeMap::new();
+    for f in files {
+        let r = SweepResult::read(f)?;
+        if let Some((first, m)) = &merged {
+            if m.spec_hash != r.spec_hash {
+                return Err(SweepError::MergeSpecMismatch { a: first.clone(), hash_a: m.spec_hash.clone(), b: f.clone(), hash_b: r.spec_hash });
+            }
+        }
+        for p in &r.points {
+            match points.get(&p.index) {
+                Some((q, from)) if !same_record(q, p) => return Err(SweepError::MergeConflict { index: p.index, a: from.clone(), b: f.clone() }),
+                Some(_) => {}
+                None => {
+                    points.insert(p.index, (p.clone(), f.clone()));
+                }
+            }
+        }
+        if merged.is_none() {
+            merged = Some((f.clone(), r));
+        }
+    }
+    let (_, mut m) = merged.ok_or_else(|| SweepError::NothingToMerge { path: PathBuf::from(".") })?;
+    m.shard = None;
+    m.points = points.into_values().map(|(p, _)| p).collect();
+    let missing: Vec<usize> = (0..m.total_points).filter(|i| m.points.binary_search_by_key(i, |p| p.index).is_err()).collect();
+    if !missing.is_empty() && !partial {
+        return Err(SweepError::MergeIncomplete { missing: missing.len(), total: m.total_points, first: missing[0] });
+    }
+    Ok(m)
+}
+
+/// Equal records (NaN equal to NaN).
+fn same_record(a: &PointRecord, b: &PointRecord) -> bool {
+    a.index == b.index && a.status == b.status && a.params.len() == b.params.len() && a.params.iter().zip(&b.params).all(|(x, y)| x.to_bits() == y.to_bits()) && a.cells.len() == b.cells.len() && a.cells.iter().zip(&b.cells).all(|(x, y)| match (x, y) {
+        (super::eval::Cell::Num(x), super::eval::Cell::Num(y)) => x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+        _ => x == y,
+    })
+}
+
+/// Merges and writes `sweep.{json,csv,md,tex}` into `out` (all or none).
+pub fn merge_into(inputs: &[PathBuf], out: &Path, partial: bool, digits: Option<usize>) -> Result<(SweepResult, Vec<PathBuf>), SweepError> {
+    let files = collect_inputs(inputs)?;
+    let mut m = merge(&files, partial)?;
+    let digits = digits.unwrap_or(m.table.digits);
+    if !(1..=17).contains(&digits) {
+        return Err(SweepError::BadDigits { digits });
+    }
+    m.table.digits = digits;
+    let written = super::run::write_tables(&m, out, "sweep", digits)?;
+    Ok((m, written))
+}
