@@ -13,7 +13,7 @@ pub mod table;
 pub mod theta_eval;
 
 pub use error::SweepError;
-pub use eval::{Cell, Column, ColumnKind, Evaluator, FnEvaluator};
+pub use eval::{Cell, Column, ColumnKind, Evaluator, FnEvaluator, PointError};
 pub use run::{run, RunOptions, RunSummary};
 pub use shard::Shard;
 pub use spec::SweepSpec;
