@@ -92,7 +92,13 @@ pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettin
             out.fit_before = rep.fit_before.fit_percent[0];
             out.fit_after = rep.fit_after.fit_percent[0];
             if out.correct {
-                if let (Some(t), Some(e)) = (case.truth.as_ref(), fitted.iter().find(|e| e.kind() == class)) {
+                // Compare like with like: the same kind and, for forces, the same state (a force
+                // on another state is an observationally equivalent but different parameter).
+                let same = |a: &Effect, b: &Effect| match (a, b) {
+                    (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. }) | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. }) => i == j,
+                    _ => a.kind() == b.kind(),
+                };
+                if let (Some(t), Some(e)) = (case.truth.as_ref(), case.truth.as_ref().and_then(|t| fitted.iter().find(|e| same(t, e)))) {
                     let (tv, ev) = (main_param(t), main_param(e));
                     out.est_param = Some(ev);
                     out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
