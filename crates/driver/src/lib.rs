@@ -4,6 +4,7 @@
 
 pub mod cli;
 pub mod error;
+pub mod figures;
 pub mod orbit;
 pub mod output;
 pub mod report;

@@ -10,6 +10,7 @@ pub mod periodic;
 pub mod simulate;
 pub mod sweep;
 pub mod merge;
+pub mod figure;
 pub mod theta;
 pub mod validate;
 
@@ -48,6 +49,8 @@ pub enum Command {
     Sweep(sweep::Args),
     /// Join the shards of one sweep (`moreau sweep --shard K/N`) into one table.
     Merge(merge::Args),
+    /// Figures for papers (SVG and PNG): psi (Fig. psi1), tube (Fig. loop), trajectory, sweep.
+    Figure(figure::Args),
 }
 
 /// Runs the CLI: prints errors on one line (`error: ...`) and returns a non-zero exit code.
@@ -64,6 +67,7 @@ pub fn main() -> ExitCode {
         Command::DiscoverBench(a) => discover_bench::run(&a),
         Command::Sweep(a) => sweep::run(&a),
         Command::Merge(a) => merge::run(&a),
+        Command::Figure(a) => figure::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,200 @@
+//! A small figure description (lines, dashed lines, bands, filled polygons, markers) and its
+//! rendering with plotters to SVG and PNG. Fonts: [`crate::plot::register_fonts`].
+use super::FigureError;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Colours used by the figures (colour-blind friendly "tab10" subset).
+pub const BLUE: RGBColor = RGBColor(31, 119, 180);
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+pub const GREEN: RGBColor = RGBColor(44, 160, 44);
+pub const RED: RGBColor = RGBColor(214, 39, 40);
+pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+/// Colour number `i` of the palette.
+pub fn palette(i: usize) -> RGBColor {
+    [BLUE, ORANGE, GREEN, RED, PURPLE, GREY][i % 6]
+}
+
+/// One thing drawn in a figure.
+#[derive(Debug, Clone)]
+pub enum Element {
+    /// A polyline (`dashed` for reference lines).
+    Line { label: String, pts: Vec<(f64, f64)>, color: RGBColor, dashed: bool },
+    /// The region between `lo(x)` and `hi(x)`, translucent.
+    Band { label: String, x: Vec<f64>, lo: Vec<f64>, hi: Vec<f64>, color: RGBColor },
+    /// A filled translucent polygon (closed automatically); `label` empty: no legend entry.
+    Polygon { label: String, pts: Vec<(f64, f64)>, color: RGBColor },
+    /// Markers with optional text next to each.
+    Markers { label: String, pts: Vec<(f64, f64)>, text: Vec<String>, color: RGBColor },
+}
+
+impl Element {
+    fn points(&self) -> Vec<(f64, f64)> {
+        match self {
+            Element::Line { pts, .. } | Element::Polygon { pts, .. } | Element::Markers { pts, .. } => pts.clone(),
+            Element::Band { x, lo, hi, .. } => x.iter().zip(lo).map(|(&a, &b)| (a, b)).chain(x.iter().zip(hi).map(|(&a, &b)| (a, b))).collect(),
+        }
+    }
+}
+
+/// A figure: title, axis labels, elements; `equal_aspect` keeps one unit the same length on
+/// both axes (plane curves).
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub elements: Vec<Element>,
+    pub equal_aspect: bool,
+    /// Pixel size. Default `900 x 600`.
+    pub size: (u32, u32),
+}
+
+impl Figure {
+    pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
+        Self { title: title.into(), x_label: x_label.into(), y_label: y_label.into(), elements: vec![], equal_aspect: false, size: (900, 600) }
+    }
+
+    /// Data ranges with 5 % padding; `None` when nothing is finite.
+    pub fn ranges(&self) -> Option<((f64, f64), (f64, f64))> {
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+        for e in &self.elements {
+            for (x, y) in e.points() {
+                if x.is_finite() && y.is_finite() {
+                    x0 = x0.min(x);
+                    x1 = x1.max(x);
+                    y0 = y0.min(y);
+                    y1 = y1.max(y);
+                }
+            }
+        }
+        if !(x0 <= x1 && y0 <= y1) {
+            return None;
+        }
+        let pad = |a: f64, b: f64| {
+            let w = (b - a).max(1e-12 * (1.0 + a.abs().max(b.abs())));
+            (a - 0.05 * w, b + 0.05 * w)
+        };
+        let (mut xr, mut yr) = (pad(x0, x1), pad(y0, y1));
+        if self.equal_aspect {
+            let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
+            let (pw, ph) = (self.size.0 as f64 - 110.0, self.size.1 as f64 - 110.0);
+            let scale = (w / pw).max(h / ph);
+            let (cx, cy) = (0.5 * (xr.0 + xr.1), 0.5 * (yr.0 + yr.1));
+            xr = (cx - 0.5 * scale * pw, cx + 0.5 * scale * pw);
+            yr = (cy - 0.5 * scale * ph, cy + 0.5 * scale * ph);
+        }
+        Some((xr, yr))
+    }
+}
+
+fn finite(p: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    p.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite()).collect()
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, f: &Figure) -> Result<(), FigureError>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: &dyn std::fmt::Debug| FigureError::Draw { figure: f.title.clone(), reason: format!("{e:?}") };
+    let ((x0, x1), (y0, y1)) = f.ranges().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&f.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    chart.configure_mesh().x_desc(f.x_label.as_str()).y_desc(f.y_label.as_str()).label_style(("sans-serif", 15)).axis_desc_style(("sans-serif", 17)).light_line_style(RGBColor(235, 235, 235)).draw().map_err(|e| err(&e))?;
+    let mut legend = false;
+    for e in &f.elements {
+        match e {
+            Element::Band { label, x, lo, hi, color } => {
+                let mut pts: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
+                pts.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
+                let c = *color;
+                let a = chart.draw_series(std::iter::once(Polygon::new(finite(&pts), c.mix(0.22).filled()))).map_err(|e| err(&e))?;
+                if !label.is_empty() {
+                    legend = true;
+                    a.label(label.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
+                }
+            }
+            Element::Polygon { label, pts, color } => {
+                let c = *color;
+                let a = chart.draw_series(std::iter::once(Polygon::new(finite(pts), c.mix(0.12).filled()))).map_err(|e| err(&e))?;
+                if !label.is_empty() {
+                    legend = true;
+                    a.label(label.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
+                }
+            }
+            Element::Line { label, pts, color, dashed } => {
+                let c = *color;
+                let style = c.stroke_width(2);
+                let a = if *dashed {
+                    chart.draw_series(DashedLineSeries::new(finite(pts), 8, 6, style)).map_err(|e| err(&e))?
+                } else {
+                    chart.draw_series(LineSeries::new(finite(pts), style)).map_err(|e| err(&e))?
+                };
+                if !label.is_empty() {
+                    legend = true;
+                    a.label(label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                }
+            }
+            Element::Markers { label, pts, text, color } => {
+                let c = *color;
+                let a = chart.draw_series(finite(pts).into_iter().map(|p| Circle::new(p, 5, c.filled()))).map_err(|e| err(&e))?;
+                if !label.is_empty() {
+                    legend = true;
+                    a.label(label.clone()).legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+                }
+                for (p, t) in pts.iter().zip(text) {
+                    if p.0.is_finite() && p.1.is_finite() && !t.is_empty() {
+                        chart.draw_series(std::iter::once(Text::new(t.clone(), *p, ("sans-serif", 15).into_font().color(&BLACK)))).map_err(|e| err(&e))?;
+                    }
+                }
+            }
+        }
+    }
+    if legend {
+        chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 15)).draw().map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// The figure as an SVG document.
+pub fn to_svg(f: &Figure) -> Result<String, FigureError> {
+    crate::plot::register_fonts();
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, f.size).into_drawing_area();
+        draw(root, f)?;
+    }
+    Ok(buf)
+}
+
+/// Writes the figure as PNG to `path`.
+pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
+    crate::plot::register_fonts();
+    let root = BitMapBackend::new(path, f.size).into_drawing_area();
+    draw(root, f)
+}
+
+/// Writes `stem.svg` and `stem.png` for every `(stem, figure)` into `out`, all or none.
+pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf>, FigureError> {
+    let werr = |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
+    let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
+    let mut files = vec![];
+    for (stem, f) in figs {
+        let svg = to_svg(f)?;
+        let p = staged.path(&format!("{stem}.svg"));
+        std::fs::write(&p, svg).map_err(|e| werr(&p, &e))?;
+        write_png(f, &staged.path(&format!("{stem}.png")))?;
+        files.push(out.join(format!("{stem}.svg")));
+        files.push(out.join(format!("{stem}.png")));
+    }
+    staged.commit().map_err(|e| werr(out, &e))?;
+    Ok(files)
+}

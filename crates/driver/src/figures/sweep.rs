@@ -1,0 +1,53 @@
+//! theta (eq. (theta)) and the measured exponent against a swept parameter, from a sweep
+//! result file (`moreau sweep`). With several axes, one curve per combination of the others.
+use super::canvas::{palette, Element, Figure};
+use super::FigureError;
+use crate::sweep::{Cell, ColumnKind, SweepResult};
+use std::collections::BTreeMap;
+
+/// Curves of the numeric `columns` against axis `x` (default: the first axis).
+pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Result<Figure, FigureError> {
+    let names = || r.axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>().join(", ");
+    let xi = match x {
+        None => 0,
+        Some(n) => r.axes.iter().position(|a| a.name == n).ok_or_else(|| FigureError::UnknownAxis { name: n.into(), known: names() })?,
+    };
+    let col_idx: Vec<usize> = columns
+        .iter()
+        .map(|c| {
+            r.columns.iter().position(|k| k.name == *c && k.kind == ColumnKind::Number).ok_or_else(|| FigureError::UnknownColumn {
+                name: c.to_string(),
+                known: r.columns.iter().filter(|k| k.kind == ColumnKind::Number).map(|k| k.name.as_str()).collect::<Vec<_>>().join(", "),
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let xname = &r.axes[xi].name;
+    let mut f = Figure::new(&format!("{}: {} against {xname}", r.name, columns.join(", ")), xname, &columns.join(", "));
+    // group by the other axes' values
+    let mut groups: BTreeMap<Vec<u64>, Vec<&crate::sweep::PointRecord>> = BTreeMap::new();
+    for p in r.points.iter().filter(|p| p.ok()) {
+        let key: Vec<u64> = p.params.iter().enumerate().filter(|(k, _)| *k != xi).map(|(_, v)| v.to_bits()).collect();
+        groups.entry(key).or_default().push(p);
+    }
+    let multi = groups.len() > 1;
+    let mut colour = 0;
+    for (key_bits, pts) in &groups {
+        let suffix = if multi {
+            let others: Vec<String> = r.axes.iter().enumerate().filter(|(k, _)| *k != xi).zip(key_bits).map(|((_, a), b)| format!("{} = {}", a.name, f64::from_bits(*b))).collect();
+            format!(" ({})", others.join(", "))
+        } else {
+            String::new()
+        };
+        for (&c, name) in col_idx.iter().zip(columns) {
+            let mut xy: Vec<(f64, f64)> = pts.iter().filter_map(|p| if let Cell::Num(v) = p.cells[c] { Some((p.params[xi], v)) } else { None }).collect();
+            xy.sort_by(|a, b| a.0.total_cmp(&b.0));
+            f.elements.push(Element::Line { label: format!("{name}{suffix}"), pts: xy.clone(), color: palette(colour), dashed: false });
+            f.elements.push(Element::Markers { label: String::new(), pts: xy, text: vec![], color: palette(colour) });
+            colour += 1;
+        }
+    }
+    if f.ranges().is_none() {
+        return Err(FigureError::NoData { figure: f.title });
+    }
+    Ok(f)
+}
