@@ -233,15 +233,15 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             t = Some(match t {
                 None => ti,
                 Some(prev) => {
-                    let (white, unc) = (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated);
-                    ResidualTests { white, uncorrelated: unc, ..prev }
+                    let (white, unc, zm) = (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
+                    ResidualTests { white, uncorrelated: unc, zero_mean: zm, ..prev }
                 }
             });
         }
         t.expect("p >= 1")
     };
     let residual_nominal = tests_for(&e_nom);
-    let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated;
+    let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated && residual_nominal.zero_mean;
     let contact = nominal_ext.has_play().then_some(&nom_sim.contact[..]);
     let half_width = ((0.1 * tau_slow / dt).round() as usize).max(3);
     let loc: Localisation = localise::localise(rec.t0, dt, &ctx.y, &e_nom, p, &ctx.w, m, contact, half_width, 10);
@@ -354,7 +354,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         None => vec![],
     };
     let verdict = if nominal_adequate {
-        "no missing physics found: the nominal residual is white and uncorrelated with the input (1 % level)".to_string()
+        "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)".to_string()
     } else if let Some(c) = &chosen {
         format!("missing physics: {} (validation fit {} -> {} %)", c.label, fmt_vec(&fit_before.fit_percent), fmt_vec(&fit_after.fit_percent))
     } else {
@@ -424,8 +424,8 @@ impl Report {
         s += "## Residual tests (nominal model)\n\n";
         let r = &self.residual_nominal;
         s += &format!(
-            "- whiteness: Q = {:.1} against the 99 % threshold {:.1} ({} lags of {} sample(s)): **{}**\n- input cross-correlation: Q = {} against {:.1}: **{}**\n- after fitting: white = {}, uncorrelated = {} (Q = {:.1}, cross Q = {})\n\n",
-            r.q_auto, r.q_auto_threshold, r.lags, r.lag_step, if r.white { "white" } else { "not white" }, fmt_vec(&r.q_cross), r.q_cross_threshold, if r.uncorrelated { "uncorrelated" } else { "correlated" },
+            "- mean: {:.3e} against the 99 % bound {:.3e}: **{}**\n- whiteness: Q = {:.1} against the 99 % threshold {:.1} ({} lags of {} sample(s)): **{}**\n- input cross-correlation: Q = {} against {:.1}: **{}**\n- after fitting: white = {}, uncorrelated = {} (Q = {:.1}, cross Q = {})\n\n",
+            r.mean, r.mean_bound, if r.zero_mean { "zero mean" } else { "offset" }, r.q_auto, r.q_auto_threshold, r.lags, r.lag_step, if r.white { "white" } else { "not white" }, fmt_vec(&r.q_cross), r.q_cross_threshold, if r.uncorrelated { "uncorrelated" } else { "correlated" },
             self.residual_fitted.white, self.residual_fitted.uncorrelated, self.residual_fitted.q_auto, fmt_vec(&self.residual_fitted.q_cross)
         );
         s += "## Where the mismatch is\n\n| regime | share of time | share of residual energy | enrichment |\n|---|---|---|---|\n";

@@ -34,6 +34,11 @@ pub struct ResidualTests {
     pub white: bool,
     /// `e` uncorrelated with every input at the 1 % level.
     pub uncorrelated: bool,
+    /// Mean of the residual and its 99 % bound `2.576 std(e) / sqrt(N)` (a constant offset is
+    /// invisible to the centred correlations, so it is tested on its own).
+    pub mean: f64,
+    pub mean_bound: f64,
+    pub zero_mean: bool,
 }
 
 /// Upper `alpha` quantile of chi-square with `k` degrees of freedom (Wilson-Hilferty).
@@ -64,8 +69,12 @@ fn centred(a: &[f64]) -> Vec<f64> {
 /// decimated by `lag_step` (averaging blocks), with `lags` lags.
 pub fn test(e: &[f64], u: &[Vec<f64>], lags: usize, lag_step: usize) -> ResidualTests {
     let dec = |a: &[f64]| -> Vec<f64> { a.chunks(lag_step.max(1)).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect() };
-    let e = centred(&dec(e));
-    let n = e.len();
+    let raw = dec(e);
+    let n = raw.len();
+    let mean = raw.iter().sum::<f64>() / n as f64;
+    let e = centred(&raw);
+    let sd = (e.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    let mean_bound = 2.576 * sd / (n as f64).sqrt();
     let m = lags.min(n / 4).max(1);
     let ee = xcorr(&e, &e, 0).max(1e-300);
     let r_e: Vec<f64> = (0..=m).map(|t| xcorr(&e, &e, t as isize) / ee).collect();
@@ -90,7 +99,7 @@ pub fn test(e: &[f64], u: &[Vec<f64>], lags: usize, lag_step: usize) -> Residual
     let q_cross_threshold = chi2_quantile(2 * m + 1, 2.326);
     let white = q_auto <= q_auto_threshold;
     let uncorrelated = q_cross.iter().all(|&q| q <= q_cross_threshold);
-    ResidualTests { lags: m, lag_step, autocorr: r_e[1..].to_vec(), autocorr_bound: z99 / nf.sqrt(), q_auto, q_auto_threshold, crosscorr, crosscorr_bound: bounds, q_cross, q_cross_threshold, white, uncorrelated }
+    ResidualTests { lags: m, lag_step, autocorr: r_e[1..].to_vec(), autocorr_bound: z99 / nf.sqrt(), q_auto, q_auto_threshold, crosscorr, crosscorr_bound: bounds, q_cross, q_cross_threshold, white, uncorrelated, mean, mean_bound, zero_mean: mean.abs() <= mean_bound }
 }
 
 #[cfg(test)]
@@ -112,7 +121,11 @@ mod tests {
         }
         assert!(!test(&f, &[u.clone()], 20, 1).white);
         let g: Vec<f64> = e.iter().zip(&u).map(|(a, b)| a + 0.3 * b).collect();
-        assert!(!test(&g, &[u], 20, 1).uncorrelated);
+        assert!(!test(&g, &[u.clone()], 20, 1).uncorrelated);
+        // A constant offset passes the centred tests but not the mean test.
+        let o: Vec<f64> = e.iter().map(|a| a + 0.05).collect();
+        let t = test(&o, &[u], 20, 1);
+        assert!(t.white && !t.zero_mean, "{t:?}");
     }
 
     #[test]
