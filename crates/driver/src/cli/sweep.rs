@@ -25,6 +25,10 @@ pub struct Args {
     /// Replace results of a different spec found in --out instead of refusing.
     #[arg(long)]
     pub overwrite: bool,
+    /// Recompute every point, ignoring earlier results of the same spec in --out (after a
+    /// change of the program: the spec hash covers inputs and settings, not the code).
+    #[arg(long)]
+    pub fresh: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -37,7 +41,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let spec = SweepSpec::load(&a.spec).with_context(|| format!("sweep spec {}", a.spec.display()))?;
     let evaluator = ThetaEvaluator::from_table(&spec.evaluate, &spec.path)?;
-    let opts = RunOptions { out: a.out.clone(), shard, threads: a.threads, progress: !a.quiet, overwrite: a.overwrite, digits: a.digits };
+    let opts = RunOptions { out: a.out.clone(), shard, threads: a.threads, progress: !a.quiet, overwrite: a.overwrite, fresh: a.fresh, digits: a.digits };
     let s = crate::sweep::run(&spec, &evaluator, &opts)?;
     eprintln!(
         "sweep `{}`: {} points in scope, {} resumed, {} computed, {} failed; spec hash {}",

@@ -26,6 +26,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Replace results of a different spec in `out` instead of refusing.
     pub overwrite: bool,
+    /// Recompute every point, ignoring earlier results of the same spec (e.g. after a change
+    /// of the code: the spec hash covers the inputs and settings, not the program).
+    pub fresh: bool,
     /// Significant digits of Markdown / LaTeX (default: the spec's `[table] digits`).
     pub digits: Option<usize>,
 }
@@ -78,7 +81,7 @@ pub fn result_header(spec: &SweepSpec, evaluator: &dyn Evaluator, shard: Option<
     SweepResult {
         name: spec.name.clone(),
         spec_hash: spec.hash(&evaluator.fingerprint()),
-        model: spec.model_path.display().to_string(),
+        model: spec.model.clone(),
         evaluator: evaluator.fingerprint(),
         axes: spec.axes.iter().map(|a| AxisInfo { name: a.parameter.name(), label: a.label.clone(), values: a.values.clone() }).collect(),
         columns: evaluator.columns(),
@@ -160,6 +163,9 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     }
     let stem = stem(opts.shard);
     let mut done = previous_points(&header, &opts.out, &stem, opts.overwrite)?;
+    if opts.fresh {
+        done.clear();
+    }
     let in_scope: Vec<usize> = (0..header.total_points).filter(|&i| opts.shard.is_none_or(|s| s.contains(i))).collect();
     done.retain(|i, _| opts.shard.is_none_or(|s| s.contains(*i)));
     let todo: Vec<usize> = in_scope.iter().copied().filter(|i| !done.contains_key(i)).collect();
@@ -169,7 +175,7 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     std::fs::create_dir_all(&opts.out).map_err(|e| SweepError::Write { path: opts.out.clone(), reason: e.to_string() })?;
     let cp = checkpoint_path(&opts.out, &stem);
     let mut cp_file = {
-        let exists_same = cp.exists() && previous_points(&header, &opts.out, &stem, false).is_ok();
+        let exists_same = !opts.fresh && cp.exists() && previous_points(&header, &opts.out, &stem, false).is_ok();
         let mut f = std::fs::OpenOptions::new().create(true).append(exists_same).write(true).truncate(!exists_same).open(&cp).map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;
         if !exists_same {
             writeln!(f, "{}", header.header_json()).map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;

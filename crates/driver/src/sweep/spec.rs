@@ -48,6 +48,8 @@ impl Default for TableSettings {
 pub struct SweepSpec {
     pub path: PathBuf,
     pub name: String,
+    /// The `model` key as written (relative to the spec file).
+    pub model: String,
     pub model_path: PathBuf,
     /// The base model file's text (part of the spec hash).
     pub model_text: String,
@@ -203,7 +205,7 @@ impl SweepSpec {
             }
             Some(_) => return Err(wrong(path, "table", "a table")),
         }
-        let spec = Self { path: path.to_path_buf(), name, model_path, model_text, base, axes, evaluate, table };
+        let spec = Self { path: path.to_path_buf(), name, model: model_rel, model_path, model_text, base, axes, evaluate, table };
         // every axis value must give a valid model on its own (e.g. no z0 outside Theta)
         for a in &spec.axes {
             for &v in &a.values {
