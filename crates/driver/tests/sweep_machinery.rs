@@ -154,6 +154,14 @@ fn resume_skips_points_already_in_the_output() {
     assert_eq!((resumed.resumed, resumed.computed, calls.load(Ordering::SeqCst)), (12, 18, 18));
     assert_eq!(read_all(&cut, "sweep"), reference, "resumed tables equal a fresh run");
     assert!(!cut.join(".sweep.checkpoint.jsonl").exists(), "the checkpoint is removed once the tables are written");
+    // --retry-failed recomputes exactly the 3 failed points; --fresh recomputes everything
+    calls.store(0, Ordering::SeqCst);
+    let retry = sweep::run(&spec, &ev, &RunOptions { retry_failed: true, ..opts(&cut) }).unwrap();
+    assert_eq!((retry.resumed, retry.computed, retry.failed, calls.load(Ordering::SeqCst)), (27, 3, 3, 3));
+    calls.store(0, Ordering::SeqCst);
+    let fresh = sweep::run(&spec, &ev, &RunOptions { fresh: true, ..opts(&cut) }).unwrap();
+    assert_eq!((fresh.resumed, fresh.computed, calls.load(Ordering::SeqCst)), (0, 30, 30));
+    assert_eq!(read_all(&cut, "sweep"), reference);
 }
 
 #[test]

@@ -29,6 +29,9 @@ pub struct Args {
     /// change of the program: the spec hash covers inputs and settings, not the code).
     #[arg(long)]
     pub fresh: bool,
+    /// Recompute points whose earlier evaluation failed.
+    #[arg(long)]
+    pub retry_failed: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -41,7 +44,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let spec = SweepSpec::load(&a.spec).with_context(|| format!("sweep spec {}", a.spec.display()))?;
     let evaluator = ThetaEvaluator::from_table(&spec.evaluate, &spec.path)?;
-    let opts = RunOptions { out: a.out.clone(), shard, threads: a.threads, progress: !a.quiet, overwrite: a.overwrite, fresh: a.fresh, digits: a.digits };
+    let opts = RunOptions { out: a.out.clone(), shard, threads: a.threads, progress: !a.quiet, overwrite: a.overwrite, fresh: a.fresh, retry_failed: a.retry_failed, digits: a.digits };
     let s = crate::sweep::run(&spec, &evaluator, &opts)?;
     eprintln!(
         "sweep `{}`: {} points in scope, {} resumed, {} computed, {} failed; spec hash {}",

@@ -29,6 +29,8 @@ pub struct RunOptions {
     /// Recompute every point, ignoring earlier results of the same spec (e.g. after a change
     /// of the code: the spec hash covers the inputs and settings, not the program).
     pub fresh: bool,
+    /// Recompute points whose earlier evaluation failed (their `status` is an error).
+    pub retry_failed: bool,
     /// Significant digits of Markdown / LaTeX (default: the spec's `[table] digits`).
     pub digits: Option<usize>,
 }
@@ -165,6 +167,9 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     let mut done = previous_points(&header, &opts.out, &stem, opts.overwrite)?;
     if opts.fresh {
         done.clear();
+    }
+    if opts.retry_failed {
+        done.retain(|_, p| p.ok());
     }
     let in_scope: Vec<usize> = (0..header.total_points).filter(|&i| opts.shard.is_none_or(|s| s.contains(i))).collect();
     done.retain(|i, _| opts.shard.is_none_or(|s| s.contains(*i)));
