@@ -16,7 +16,10 @@ pub mod lemma_a1;
 pub mod lemma_a2;
 pub mod lemma_b;
 pub mod pp;
+pub mod qzdot;
 pub mod rr;
+pub mod simulation;
+pub mod theorem2;
 pub mod zy;
 
 /// Whether to check the paper's claim or its negative control.
@@ -288,7 +291,7 @@ pub fn system_counterexample(sys: &model::System, e: &Eval, property: &str, extr
 
 /// Common imports of the property modules.
 pub(crate) mod sets_prelude {
-    pub use super::{fp_tol, geometric_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant};
+    pub use super::{fp_tol, geometric_counterexample, system_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant};
     pub use crate::strategies::sets::*;
     pub use geometry::linalg::{dist, dot, norm};
     pub use geometry::ConvexSet;

@@ -1,0 +1,63 @@
+//! Simulation-based properties: Theorem 2 (path), (zinf) and (QZdot). Each case simulates
+//! the closed loop for tens of periods, so the default is 8 cases per property (a few
+//! seconds); raise with `THEOREMS_SIM_CASES` (e.g. `THEOREMS_SIM_CASES=2000`). The negative
+//! controls must be caught.
+use proptest::prelude::*;
+use proptest::test_runner::{Config, FileFailurePersistence, TestCaseError, TestError, TestRunner};
+use theorems::properties::{qzdot, theorem2, Eval, Variant};
+
+fn cases() -> u32 {
+    std::env::var("THEOREMS_SIM_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(8).max(1)
+}
+
+fn config() -> Config {
+    Config {
+        cases: cases(),
+        max_shrink_iters: 50,
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct("proptest-regressions/dynamic.txt"))),
+        source_file: Some(file!()),
+        ..Config::default()
+    }
+}
+
+fn holds(e: Eval) -> Result<(), TestCaseError> {
+    prop_assert!(!e.violated(), "lhs = {:e} > rhs = {:e} + tol {:e}", e.lhs, e.rhs, e.tol);
+    Ok(())
+}
+
+fn negative_control<C: std::fmt::Debug + Clone>(strategy: BoxedStrategy<C>, eval: fn(&C, Variant) -> Eval, cases: u32) -> C {
+    let mut runner = TestRunner::new(Config { cases, ..config() });
+    match runner.run(&strategy, |c| holds(eval(&c, Variant::NegativeControl))) {
+        Err(TestError::Fail(_, minimal)) => {
+            assert!(eval(&minimal, Variant::NegativeControl).violated());
+            minimal
+        }
+        other => panic!("negative control not detected: {other:?}"),
+    }
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn theorem2_path_length(c in theorem2::strategy()) { holds(theorem2::eval_path(&c, Variant::Claim))?; }
+
+    #[test]
+    fn theorem2_zinf_speed(c in theorem2::strategy()) { holds(theorem2::eval_zinf(&c, Variant::Claim))?; }
+
+    #[test]
+    fn qzdot_pairs_of_trajectories(c in qzdot::strategy()) { holds(qzdot::eval(&c, Variant::Claim))?; }
+}
+
+#[test]
+fn theorem2_path_negative_control_fails() {
+    negative_control(theorem2::strategy(), theorem2::eval_path, 32);
+}
+#[test]
+fn theorem2_zinf_negative_control_fails() {
+    negative_control(theorem2::strategy(), theorem2::eval_zinf, 32);
+}
+#[test]
+fn qzdot_negative_control_fails() {
+    negative_control(qzdot::strategy(), qzdot::eval, 64);
+}
