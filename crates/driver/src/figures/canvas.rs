@@ -107,7 +107,19 @@ where
         .y_label_area_size(72)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| err(&e))?;
-    chart.configure_mesh().x_desc(f.x_label.as_str()).y_desc(f.y_label.as_str()).label_style(("sans-serif", 15)).axis_desc_style(("sans-serif", 17)).light_line_style(RGBColor(235, 235, 235)).draw().map_err(|e| err(&e))?;
+    // tick labels with as many decimals as the range needs (and no "-0.0")
+    let decimals = |a: f64, b: f64| (2.0 - (b - a).abs().max(1e-300).log10().floor()).clamp(0.0, 12.0) as usize;
+    let (dx, dy) = (decimals(x0, x1), decimals(y0, y1));
+    let fx = move |v: &f64| format!("{:.*}", dx, if v.abs() < 1e-300 { 0.0 } else { *v });
+    let fy = move |v: &f64| {
+        let s = format!("{:.*}", dy, v);
+        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') { s.trim_start_matches('-').to_string() } else { s }
+    };
+    let fx = move |v: &f64| {
+        let s = fx(v);
+        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') { s.trim_start_matches('-').to_string() } else { s }
+    };
+    chart.configure_mesh().x_label_formatter(&fx).y_label_formatter(&fy).x_desc(f.x_label.as_str()).y_desc(f.y_label.as_str()).label_style(("sans-serif", 15)).axis_desc_style(("sans-serif", 17)).light_line_style(RGBColor(235, 235, 235)).draw().map_err(|e| err(&e))?;
     let mut legend = false;
     for e in &f.elements {
         match e {
@@ -151,7 +163,9 @@ where
                 }
                 for (p, t) in pts.iter().zip(text) {
                     if p.0.is_finite() && p.1.is_finite() && !t.is_empty() {
-                        chart.draw_series(std::iter::once(Text::new(t.clone(), *p, ("sans-serif", 15).into_font().color(&BLACK)))).map_err(|e| err(&e))?;
+                        // text set off above right of the marker (pixels), clear of the curves
+                        let label = EmptyElement::at(*p) + Text::new(t.clone(), (6, -22), ("sans-serif", 15).into_font().color(&BLACK));
+                        chart.draw_series(std::iter::once(label)).map_err(|e| err(&e))?;
                     }
                 }
             }
