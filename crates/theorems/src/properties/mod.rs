@@ -6,7 +6,7 @@
 //! - an export of a failing case to a file that reproduces it.
 //!
 //! Slack normalisation (unless a module says otherwise): for a claim `lhs <= rhs`,
-//! `slack = (rhs - lhs) / (|lhs| + |rhs| + tiny)` in `[-1, 1]`; a case is *violated* when
+//! `slack = (rhs - lhs) / (|lhs| + |rhs| + tol + tiny)` in `[-1, 1]`; a case is *violated* when
 //! `lhs > rhs + tol` with `tol` a floating-point allowance ([`fp_tol`]) scaled with the
 //! magnitudes involved, documented per property.
 use proptest::strategy::{BoxedStrategy, Strategy, ValueTree};
@@ -55,9 +55,11 @@ impl Eval {
     pub fn skipped() -> Self {
         Self { lhs: 0.0, rhs: 0.0, tol: 0.0, skipped: true }
     }
-    /// `(rhs - lhs) / (|lhs| + |rhs| + tiny)`; NaN counts as `-1` (a violation).
+    /// `(rhs - lhs) / (|lhs| + |rhs| + tol + tiny)`; NaN counts as `-1` (a violation). The
+    /// tolerance in the denominator keeps cases where both sides vanish up to rounding near 0
+    /// (any value above `-1/2` is within the floating-point allowance).
     pub fn slack(&self) -> f64 {
-        let s = (self.rhs - self.lhs) / (self.lhs.abs() + self.rhs.abs() + TINY);
+        let s = (self.rhs - self.lhs) / (self.lhs.abs() + self.rhs.abs() + self.tol + TINY);
         if s.is_nan() { -1.0 } else { s }
     }
     /// `lhs > rhs + tol`, or NaN on either side.

@@ -39,7 +39,7 @@ fn point(set: &geometry::Shape, v: &([f64; MAX_P], f64), size: f64) -> Vec<f64> 
 pub fn eval(case: &PpCase, variant: Variant) -> Eval {
     let set = case.set.build();
     let p = set.dim();
-    let size = set.deviation_from_origin().upper;
+    let size = case.set.scale() * case.set.max_cond; // >= the set's size, no sphere search
     let a = point(&set, &case.a, size);
     let b = point(&set, &case.b, size);
     let mut pa = vec![0.0; p];
@@ -60,7 +60,7 @@ pub fn eval(case: &PpCase, variant: Variant) -> Eval {
 
 pub fn export(case: &PpCase, e: &Eval) -> Counterexample {
     let set = case.set.build();
-    let size = set.deviation_from_origin().upper;
+    let size = case.set.scale() * case.set.max_cond; // >= the set's size, no sphere search
     let a = point(&set, &case.a, size);
     let b = point(&set, &case.b, size);
     geometric_counterexample(&set, &[("a", &a), ("b", &b)], e, "pp")

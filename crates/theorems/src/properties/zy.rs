@@ -35,7 +35,7 @@ pub fn strategy() -> BoxedStrategy<ZyCase> {
 pub fn eval(case: &ZyCase, variant: Variant) -> Eval {
     let set = case.set.build();
     let p = set.dim();
-    let size = set.deviation_from_origin().upper;
+    let size = case.set.scale() * case.set.max_cond; // >= the set's size, no sphere search
     let (q, _) = case.q.build(&set);
     let ydot: Vec<f64> = case.ydot.0[..p].iter().map(|x| x * 10f64.powf(case.ydot.1)).collect();
     let mut zdot = vec![0.0; p];
