@@ -192,7 +192,7 @@ fn shards_merge_to_the_full_table() {
     assert_eq!(p.points.len(), 23);
     // the whole directory merges to exactly the tables of the unsharded run
     let merged = tmp.path().join("merged");
-    sweep::merge::merge_into(&[shards.clone()], &merged, false, None).unwrap();
+    sweep::merge::merge_into(std::slice::from_ref(&shards), &merged, false, None).unwrap();
     assert_eq!(read_all(&merged, "sweep"), read_all(&full, "sweep"));
 }
 

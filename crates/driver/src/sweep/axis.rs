@@ -198,7 +198,7 @@ impl Parameter {
             }
             Parameter::InputOmega | Parameter::InputPhase => {
                 self.check_applicable(sys)?;
-                if !(value > 0.0) && *self == Parameter::InputOmega {
+                if *self == Parameter::InputOmega && (value.is_nan() || value <= 0.0) {
                     return Err(SweepError::NotApplicable { name, reason: "omega must be positive" });
                 }
                 if let Input::Sine { omega, phase, .. } | Input::Square { omega, phase, .. } = &mut sys.input {
