@@ -67,6 +67,7 @@ pub fn registry() -> Vec<Box<dyn Property>> {
         Box::new(properties::lemma_a2::property()),
         Box::new(properties::rr::property()),
         Box::new(properties::lemma_b::property()),
+        Box::new(properties::theorem1::property()),
         Box::new(properties::theorem2::property_path()),
         Box::new(properties::theorem2::property_zinf()),
         Box::new(properties::qzdot::property()),

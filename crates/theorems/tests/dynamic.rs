@@ -61,3 +61,19 @@ fn theorem2_zinf_negative_control_fails() {
 fn qzdot_negative_control_fails() {
     negative_control(qzdot::strategy(), qzdot::eval, 64);
 }
+
+/// Theorem 1 (stat1), p = 1: rest inside R(T), motion outside; 2,000 cases by default
+/// (`THEOREMS_THEOREM1_CASES` to change).
+#[test]
+fn theorem1_rest_set_campaign() {
+    let cases = std::env::var("THEOREMS_THEOREM1_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2000u64).max(1);
+    let prop = theorems::properties::theorem1::property();
+    let settings = theorems::CampaignSettings { cases: Some(cases), ..Default::default() };
+    let rep = theorems::run_property(&prop, &settings, &|_| {}).unwrap();
+    eprintln!("theorem1: {} cases, {} skipped, min slack {:e}, {:.2} s", rep.cases, rep.skipped, rep.min_slack, rep.seconds);
+    assert_eq!(rep.violations, 0, "{:?}", rep.counterexample.map(|c| c.summary));
+    assert!(rep.skipped * 2 < rep.cases, "too many skipped: {} of {}", rep.skipped, rep.cases);
+    let neg = theorems::CampaignSettings { cases: Some(200), variant: Variant::NegativeControl, ..Default::default() };
+    let rep = theorems::run_property(&prop, &neg, &|_| {}).unwrap();
+    assert!(rep.violations > 0, "negative control (rest claimed outside R(T)) not caught");
+}

@@ -19,6 +19,7 @@ pub mod pp;
 pub mod qzdot;
 pub mod rr;
 pub mod simulation;
+pub mod theorem1;
 pub mod theorem2;
 pub mod zy;
 
