@@ -27,6 +27,7 @@ pub mod fit;
 pub mod hypothesis;
 pub mod localise;
 pub mod metrics;
+pub mod play_width;
 pub mod recording;
 pub mod residual;
 pub mod select;
