@@ -13,6 +13,7 @@ pub mod merge;
 pub mod figure;
 pub mod theta;
 pub mod validate;
+pub mod play_width;
 
 /// Convergence to periodic regimes with a strongly convex backlash: simulate, certify, check.
 #[derive(Debug, Parser)]
@@ -51,6 +52,9 @@ pub enum Command {
     Merge(merge::Args),
     /// Figures for papers (SVG and PNG): psi (Fig. psi1), tube (Fig. loop), trajectory, sweep.
     Figure(figure::Args),
+    /// Play (backlash) width from a quasi-static two-sided loading log (Robonine stand):
+    /// loaded and unloaded flank-to-flank difference with its uncertainty over cycles.
+    PlayWidth(play_width::Args),
 }
 
 /// Runs the CLI: prints errors on one line (`error: ...`) and returns a non-zero exit code.
@@ -68,6 +72,7 @@ pub fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Figure(a) => figure::run(&a),
+        Command::PlayWidth(a) => play_width::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,58 @@
+//! `moreau play-width --data LOG.csv --config CONFIG.json [--json OUT]`: play (backlash) width
+//! from a quasi-static two-sided loading log of the Robonine test stand
+//! (`discovery::play_width`): loaded and unloaded flank-to-flank position difference per tested
+//! servo, with its standard uncertainty from the spread over load cycles and the 1-count
+//! encoder resolution.
+use anyhow::Context;
+use discovery::play_width::{robonine, PlayWidthSettings};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Telemetry CSV (columns `target pos (ID)`, `pos (ID)` in encoder counts).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Upstream analysis config (`analysis_config_*.json`: home position, tested servos,
+    /// puller relaxed/stretched targets and tolerances).
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Shortest steady segment (samples).
+    #[arg(long, default_value_t = 2)]
+    pub min_segment_samples: usize,
+    /// Samples dropped at the start of each segment.
+    #[arg(long, default_value_t = 0)]
+    pub skip_samples: usize,
+    /// Also write the full result (segments, per-cycle differences) as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    let text = std::fs::read_to_string(&a.data).with_context(|| format!("cannot read {}", a.data.display()))?;
+    let cfg_text = std::fs::read_to_string(&a.config).with_context(|| format!("cannot read {}", a.config.display()))?;
+    let cfg = robonine::StandConfig::from_json_str(&cfg_text).with_context(|| a.config.display().to_string())?;
+    let s = PlayWidthSettings { min_segment_samples: a.min_segment_samples, skip_samples: a.skip_samples, resolution: 1.0, ..Default::default() };
+    let res = robonine::analyse(&text, &a.data.display().to_string(), &cfg, &s)?;
+    println!("play width from {} (1 count = {:.4} deg; +- is one standard uncertainty)", a.data.display(), robonine::COUNT_DEG);
+    println!("{:>6} {:>9} {:>22} {:>16} {:>7}", "servo", "state", "width (counts)", "width (deg)", "cycles");
+    for r in &res {
+        for (state, e) in [("unloaded", &r.unloaded), ("loaded", &r.loaded)] {
+            println!(
+                "{:>6} {:>9} {:>13.2} +- {:<5.2} {:>7.3} +- {:<5.3} {:>7}",
+                r.motor_id,
+                state,
+                e.width,
+                e.std_uncertainty,
+                e.width * robonine::COUNT_DEG,
+                e.std_uncertainty * robonine::COUNT_DEG,
+                e.cycle_differences.len()
+            );
+        }
+    }
+    println!("the unloaded width is the closer reading of the play (2 x the half-width of Theta); the loaded one adds gear and holding-controller deflection under the band force");
+    if let Some(p) = &a.json {
+        crate::output::write_atomic(p, serde_json::to_string_pretty(&res)?.as_bytes())?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
