@@ -7,4 +7,4 @@ pub mod phi;
 pub mod rest_set;
 
 pub use phi::{phi, scan_phi, PhiScan};
-pub use rest_set::{rest_set, RestSet, RestSetSettings};
+pub use rest_set::{confirm_at_rest, rest_set, RestSet, RestSetSettings};

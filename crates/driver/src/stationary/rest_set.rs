@@ -145,14 +145,7 @@ pub fn rest_set(sys: &System, settings: &RestSetSettings) -> Result<RestSet, Dri
     };
     let mut out = RestSet { period: T, phi: phi_scan, empty, verified, slack, point, max_drift: None, method };
     if let Some(z) = out.point.clone() {
-        let mut s2 = sys.clone();
-        s2.z0 = DVector::from_column_slice(&z);
-        let (N, h) = dynamics::periodic::steps_per_period(T, settings.sim_dt)?;
-        let traj = dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, N, 1)?;
-        let mut drift = 0.0f64;
-        for i in 0..traj.len() {
-            drift = drift.max(geometry::linalg::dist(traj.z_at(i), &z));
-        }
+        let drift = confirm_at_rest(sys, &z, settings.sim_dt)?;
         out.max_drift = Some(drift);
         out.verified = drift <= settings.tol_rest;
         if !out.verified {
@@ -161,6 +154,21 @@ pub fn rest_set(sys: &System, settings: &RestSetSettings) -> Result<RestSet, Dri
         }
     }
     Ok(out)
+}
+
+/// Simulates the closed loop from `(sys.x0, z)` over one period (catching-up scheme, step
+/// `<= dt`) and returns `max_t |z(t) - z|`: zero (to rounding) iff `z` stays at rest.
+pub fn confirm_at_rest(sys: &System, z: &[f64], dt: f64) -> Result<f64, DriverError> {
+    let T = sys.period().ok_or(DriverError::NoPeriod { kind: sys.input.kind() })?;
+    let mut s2 = sys.clone();
+    s2.z0 = DVector::from_column_slice(z);
+    let (N, h) = dynamics::periodic::steps_per_period(T, dt)?;
+    let traj = dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, N, 1)?;
+    let mut drift = 0.0f64;
+    for i in 0..traj.len() {
+        drift = drift.max(geometry::linalg::dist(traj.z_at(i), z));
+    }
+    Ok(drift)
 }
 
 /// `min s` s.t. `Phi_k z - c_k in Theta + s` (cone form per shape). Variables `(z, s)`.

@@ -3,8 +3,9 @@
 //! estimate ([`crate::report::Quantity`]).
 //!
 //! Safe directions (NOTES.md): `d`, `||eta_T'||_inf`, `D(C(F Xi_inf + E Theta), {0})` from
-//! above (tube quadrature with rigorous remainders, maxima over the unit sphere by
-//! `geometry::sphere_max` with a valid Lipschitz constant); `osc` from below; `alpha`, `lambda`
+//! above (tube quadrature with rigorous remainders, maxima over the unit sphere of
+//! sublinear functions certified by conic combination on arcs, `crate::tube::sublinear_max`,
+//! or by `geometry::sphere_max` with a valid Lipschitz constant for `p >= 3`); `osc` from below; `alpha`, `lambda`
 //! from below and `beta` from above (`lmi` certificate); `R` from above. `theta` is increasing
 //! in `R` (the ratio `gamma_1 / gamma_inf` does not depend on `R` and `psi(gamma_inf / R)`
 //! increases with `R`), so both `gamma`s are evaluated at the upper bound of `R`: `gamma_inf` is
@@ -16,9 +17,9 @@ use crate::report::{BoundKind, Quantity};
 use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
-use crate::tube::{Horizon, TubeKernel, TubeSettings};
+use crate::tube::{sublinear_sphere_max, Horizon, TubeKernel, TubeSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
-use geometry::{sphere_max, ConvexSet, Shape, SphereMaxSettings};
+use geometry::{ConvexSet, Shape, SphereMaxSettings};
 use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
 use model::System;
 use nalgebra::DMatrix;
@@ -30,7 +31,8 @@ use std::sync::Arc;
 pub struct ThetaSettings {
     /// Tube quadrature (eqs. (Xinfsupp), (DXX)). Default [`TubeSettings::default`].
     pub tube: TubeSettings,
-    /// Maxima over the unit sphere (eqs. (d), (zinf)). Default: `tol_abs 1e-9`, `tol_rel 1e-6`,
+    /// Maxima over the unit sphere (eqs. (d), (zinf)) of sublinear functions
+    /// ([`crate::tube::sublinear_sphere_max`]). Default: `tol_abs 1e-9`, `tol_rel 1e-6`,
     /// `max_evals 20_000` (the bounds stay valid, only wider, when the budget runs out).
     pub sphere: SphereMaxSettings,
     /// Outer search over `lambda` and the beta SDPs. Default [`LambdaSearchSettings::default`].
@@ -193,7 +195,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
 
     // d = max_{|v|=1} sigma_{C Xi_inf + Theta}(v) + sigma_{C Xi_inf + Theta}(-v), eq. (d).
     let lip_d = 2.0 * (tube_C.lipschitz() + d_theta);
-    let d_b = sphere_max(
+    let d_b = sublinear_sphere_max(
         p,
         |v| {
             let neg: Vec<f64> = v.iter().map(|x| -x).collect();
@@ -211,7 +213,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
     let CEt = (C * E).transpose();
     let nCE = CEt.iter().map(|x| x * x).sum::<f64>().sqrt();
     let lip_f = tube_CF.lipschitz() + nCE * d_theta * (1.0 + 1e-12);
-    let df_b = sphere_max(
+    let df_b = sublinear_sphere_max(
         p,
         |v| {
             let w = &CEt * nalgebra::DVector::from_column_slice(v);

@@ -31,7 +31,7 @@ use nalgebra::DMatrix;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TubeSettings {
     /// Target absolute width (per unit `|v|`) of the enclosure of a support value, half for the
-    /// quadrature remainder and half for the tail. Default `1e-6`.
+    /// quadrature remainder and half for the tail. Default `1e-5`.
     pub tol_abs: f64,
     /// Maximum number of quadrature cells. Default `400_000`.
     pub max_cells: usize,
@@ -39,7 +39,7 @@ pub struct TubeSettings {
 
 impl Default for TubeSettings {
     fn default() -> Self {
-        Self { tol_abs: 1e-6, max_cells: 400_000 }
+        Self { tol_abs: 1e-5, max_cells: 400_000 }
     }
 }
 
@@ -89,7 +89,7 @@ pub struct TubeKernel {
     zero_in_theta: bool,
     /// Truncation point `S` of the infinite integral (or the finite horizon).
     pub s_max: f64,
-    /// Cell width used.
+    /// Width of the first (smallest) cell; cells grow geometrically with `s`.
     pub h: f64,
 }
 
@@ -158,73 +158,86 @@ impl TubeKernel {
                 (S, tail)
             }
         };
-        // Cell width: start from a guess and shrink (remainder ~ h^2) until the summed
-        // remainders are below tol / 2.
-        let mut h = (0.05_f64).min(0.5 / nF.max(1e-300));
+        // Cell widths: graded as h(s) = h0 e^{grade s} (the remainder per cell decays like
+        // e^{mu s} h^3), capped at 1 / ||F||; h0 shrinks (remainder ~ h0^2) until the summed
+        // remainders are below tol / 2. The grading only affects efficiency, not rigour.
+        let grade = match horizon {
+            Horizon::Infinite => (-lmi::spectral_abscissa(F).map_err(DriverError::Lmi)?).max(0.0) / 3.0,
+            Horizon::Finite(_) => 0.0,
+        };
+        let h_cap = 1.0 / nF.max(1e-300);
+        let mut h0 = (0.05_f64).min(0.5 * h_cap);
         loop {
-            let cells = if s_max == 0.0 { 0 } else { ((s_max / h).ceil() as usize).max(1) };
-            if cells > settings.max_cells {
-                return Err(DriverError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: cells });
-            }
-            let k = Self::build(L, &LF, &LF2, F, E, theta, s_max, cells, d_theta, nF, nE, r, p);
-            if k.remainder <= 0.5 * tol || cells == 0 {
+            let k = Self::build(L, &LF, &LF2, F, E, theta, s_max, h0, grade, h_cap, d_theta, nF, nE, r, p, settings.max_cells);
+            let Some(k) = k else {
+                return Err(DriverError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: settings.max_cells });
+            };
+            if k.remainder <= 0.5 * tol || k.cells() == 0 {
                 return Ok(Self { tail: tail_unit, zero_in_theta, s_max, ..k });
             }
-            let factor = (k.remainder / (0.4 * tol)).sqrt().max(1.5);
-            let next = (cells as f64 * factor).ceil();
-            if next > settings.max_cells as f64 && cells < settings.max_cells {
-                h = s_max / settings.max_cells as f64;
-            } else {
-                h = s_max / next;
-            }
-            if cells >= settings.max_cells {
-                return Err(DriverError::QuadratureBudget { error_bound: k.remainder, tol, nodes: cells });
-            }
+            h0 /= (k.remainder / (0.4 * tol)).sqrt().max(1.5);
         }
     }
 
     #[allow(clippy::too_many_arguments)]
     fn build(
         L: &DMatrix<f64>, LF: &DMatrix<f64>, LF2: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, s_max: f64,
-        cells: usize, d_theta: f64, nF: f64, nE: f64, r: usize, p: usize,
-    ) -> Self {
-        let mut minus = Vec::with_capacity(cells * p * r);
-        let mut mid = Vec::with_capacity(cells * p * r);
-        let mut plus = Vec::with_capacity(cells * p * r);
-        let mut half = Vec::with_capacity(cells);
+        h0: f64, grade: f64, h_cap: f64, d_theta: f64, nF: f64, nE: f64, r: usize, p: usize, max_cells: usize,
+    ) -> Option<Self> {
+        const BLOCK: usize = 32;
+        let mut minus = Vec::new();
+        let mut mid = Vec::new();
+        let mut plus = Vec::new();
+        let mut half = Vec::new();
         let mut remainder = 0.0;
         let mut k_l1 = 0.0;
-        let h = if cells == 0 { 0.0 } else { s_max / cells as f64 };
-        let rr = 0.5 * h;
-        let grow = (rr * nF).exp();
-        let step = expm(&(F * h));
-        let mut P = expm(&(F * rr));
         let push_t = |buf: &mut Vec<f64>, M: &DMatrix<f64>| {
             // M is r x p; store M^T (p x r) row-major, i.e. M column-major.
             buf.extend(M.iter().copied());
         };
-        for j in 0..cells {
-            if j > 0 {
-                if j % 64 == 0 {
-                    P = expm(&(F * (rr + j as f64 * h)));
-                } else {
+        let mut sb = 0.0;
+        let mut h_first = f64::NAN;
+        while sb < s_max {
+            let mut hb = (h0 * (grade * sb).exp()).min(h_cap).max(h0);
+            let mut count = BLOCK;
+            if sb + BLOCK as f64 * hb >= s_max {
+                count = (((s_max - sb) / hb).ceil() as usize).max(1);
+                hb = (s_max - sb) / count as f64;
+            }
+            if h_first.is_nan() {
+                h_first = hb;
+            }
+            if half.len() + count > max_cells {
+                return None;
+            }
+            let rr = 0.5 * hb;
+            let grow = (rr * nF).exp();
+            let step = expm(&(F * hb));
+            let mut P = expm(&(F * (sb + rr)));
+            for j in 0..count {
+                if j > 0 {
                     P = &P * &step;
                 }
+                let PE = &P * E;
+                let K = L * &PE;
+                let K1 = LF * &PE;
+                let M2 = frob(&(LF2 * &P)) * grow * nE;
+                let Km = &K - &K1 * rr;
+                let Kp = &K + &K1 * rr;
+                push_t(&mut minus, &Km);
+                push_t(&mut mid, &K);
+                push_t(&mut plus, &Kp);
+                half.push(rr);
+                remainder += d_theta * M2 * rr * rr * rr / 3.0;
+                k_l1 += 2.0 * rr * (frob(&K) + rr * frob(&K1) + 0.5 * rr * rr * M2);
             }
-            let PE = &P * E;
-            let K = L * &PE;
-            let K1 = LF * &PE;
-            let M2 = frob(&(LF2 * &P)) * grow * nE;
-            let Km = &K - &K1 * rr;
-            let Kp = &K + &K1 * rr;
-            push_t(&mut minus, &Km);
-            push_t(&mut mid, &K);
-            push_t(&mut plus, &Kp);
-            half.push(rr);
-            remainder += d_theta * M2 * rr * rr * rr / 3.0;
-            k_l1 += 2.0 * rr * (frob(&K) + rr * frob(&K1) + 0.5 * rr * rr * M2);
+            sb += count as f64 * hb;
+            if count < BLOCK {
+                break;
+            }
         }
-        Self {
+        let h = if h_first.is_nan() { 0.0 } else { h_first };
+        Some(Self {
             r,
             p,
             theta: theta.clone(),
@@ -239,7 +252,7 @@ impl TubeKernel {
             zero_in_theta: true,
             s_max,
             h,
-        }
+        })
     }
 
     /// Dimension `r` of the directions `v`.
