@@ -63,6 +63,7 @@ pub fn registry() -> Vec<Box<dyn Property>> {
     vec![
         Box::new(properties::pp::property()),
         Box::new(properties::zy::property()),
+        Box::new(properties::lemma2::property()),
         Box::new(properties::lemma_a1::property()),
         Box::new(properties::lemma_a2::property()),
         Box::new(properties::rr::property()),

@@ -77,3 +77,41 @@ fn theorem1_rest_set_campaign() {
     let rep = theorems::run_property(&prop, &neg, &|_| {}).unwrap();
     assert!(rep.violations > 0, "negative control (rest claimed outside R(T)) not caught");
 }
+
+/// The Theorem 1 campaign is not vacuous: both a rest point and an outside point occur often.
+#[test]
+fn theorem1_cases_exercise_both_sides() {
+    use proptest::strategy::ValueTree;
+    use theorems::properties::theorem1;
+    let mut runner = TestRunner::deterministic();
+    let (mut rest, mut out, mut empty, n) = (0, 0, 0, 400);
+    for _ in 0..n {
+        let c = theorem1::strategy().new_tree(&mut runner).unwrap().current();
+        let sys = c.sys.build();
+        if let Some(rs) = theorem1::rest_set(&sys, c.horizon) {
+            let (r, o) = theorem1::points(&c, &sys, &rs);
+            rest += r.is_some() as u32;
+            out += o.is_some() as u32;
+            empty += (rs.lower > rs.upper) as u32;
+        }
+    }
+    eprintln!("theorem1: of {n} cases, {rest} with a rest point, {out} with an outside point, {empty} with R(T) empty");
+    assert!(rest * 5 > n && out * 5 > n);
+}
+
+/// Lemma 2 (xX): tube about the linearised trajectory; 2,000 cases by default
+/// (`THEOREMS_LEMMA2_CASES` to change).
+#[test]
+fn lemma2_tube_campaign() {
+    let cases = std::env::var("THEOREMS_LEMMA2_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2000u64).max(1);
+    let prop = theorems::properties::lemma2::property();
+    let settings = theorems::CampaignSettings { cases: Some(cases), ..Default::default() };
+    let rep = theorems::run_property(&prop, &settings, &|_| {}).unwrap();
+    eprintln!("lemma2: {} cases, {} skipped, min slack {:e}, {:.2} s", rep.cases, rep.skipped, rep.min_slack, rep.seconds);
+    assert_eq!(rep.violations, 0, "{:?}", rep.counterexample.map(|c| c.summary));
+    assert_eq!(rep.skipped, 0);
+    let neg = theorems::CampaignSettings { cases: Some(200), variant: Variant::NegativeControl, ..Default::default() };
+    let rep = theorems::run_property(&prop, &neg, &|_| {}).unwrap();
+    eprintln!("lemma2 negative control: {} of {} cases caught", rep.violations, rep.cases);
+    assert!(rep.violations > 0, "negative control (Xi shrunk by 0.5) not caught");
+}

@@ -14,6 +14,7 @@ use proptest::test_runner::{Config, TestRng, TestRunner};
 
 pub mod lemma_a1;
 pub mod lemma_a2;
+pub mod lemma2;
 pub mod lemma_b;
 pub mod pp;
 pub mod qzdot;

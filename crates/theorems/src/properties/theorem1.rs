@@ -22,12 +22,13 @@
 //! fails) or where neither point exists are skipped. The case's slack is the smaller of the two.
 //! Negative control: claim rest from the outside point `z_o`.
 use super::sets_prelude::*;
+use super::simulation::linear_response_exact;
 use crate::strategies::inputs::InputStrategyConfig;
 use crate::strategies::systems::{system_params, SystemParams, SystemStrategyConfig};
 use dynamics::integrators::catching_up::{CatchingUp, CatchingUpSettings};
 use dynamics::linear::expm::t_psi;
 use dynamics::linear::step_map::{InputHold, SystemStepMap};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Grid steps over `[0, T]`.
 pub const STEPS: usize = 100;
@@ -88,33 +89,9 @@ impl RestSet {
     }
 }
 
-/// Exact `C x_*(t_k)` for a sine (or zero) input; `None` for other inputs.
+/// Exact `C x_*(t_k)` (eq. (xz0)) for a sine (or zero) input; `None` for other inputs.
 fn c_xstar_exact(sys: &model::System, h: f64, steps: usize) -> Option<Vec<f64>> {
-    let n = sys.n();
-    let (a, omega, phase) = match &sys.input {
-        model::Input::Sine { amplitudes, omega, phase } => (DVector::from_column_slice(amplitudes), *omega, *phase),
-        model::Input::Zero { m } => (DVector::zeros(*m), 0.0, 0.0),
-        _ => return None,
-    };
-    // state [x; s; c], s = sin(omega t + phase), c = cos(omega t + phase)
-    let mut M = DMatrix::<f64>::zeros(n + 2, n + 2);
-    M.view_mut((0, 0), (n, n)).copy_from(&sys.A);
-    M.view_mut((0, n), (n, 1)).copy_from(&(&sys.B * a));
-    M[(n, n + 1)] = omega;
-    M[(n + 1, n)] = -omega;
-    let step = (M * h).exp();
-    let mut s = DVector::<f64>::zeros(n + 2);
-    s.rows_mut(0, n).copy_from(&sys.x0);
-    s[n] = phase.sin();
-    s[n + 1] = phase.cos();
-    let mut out = Vec::with_capacity(steps + 1);
-    for k in 0..=steps {
-        if k > 0 {
-            s = &step * &s;
-        }
-        out.push((&sys.C * s.rows(0, n))[0]);
-    }
-    Some(out)
+    Some(linear_response_exact(sys, &sys.A, h, steps)?.iter().map(|x| (&sys.C * x)[0]).collect())
 }
 
 /// `C x^h_*(t_k)`: the scheme's own feedback-free state (linear hold of `w`).
