@@ -5,3 +5,15 @@
 pub mod inputs;
 pub mod sets;
 pub mod systems;
+
+/// `count` values drawn from `strategy` by a deterministic generator seeded with `seed`
+/// (ChaCha), without shrinking: for callers that need sample cases but not the proptest
+/// machinery (e.g. the driver's theta-vs-measured test).
+pub fn draw<T: std::fmt::Debug>(strategy: &proptest::strategy::BoxedStrategy<T>, seed: u64, count: usize) -> Vec<T> {
+    use proptest::strategy::{Strategy, ValueTree};
+    let mut runner = proptest::test_runner::TestRunner::new_with_rng(
+        proptest::test_runner::Config::default(),
+        crate::campaign::chunk_rng(seed, "draw", 0),
+    );
+    (0..count).map(|_| strategy.new_tree(&mut runner).expect("strategies never reject").current()).collect()
+}
