@@ -21,8 +21,12 @@ impl Psi {
     pub fn eval(&self, gamma: f64) -> f64 {
         let a = 0.5 * (self.alpha - self.lambda + gamma);
         let s = (self.beta + a * a).sqrt();
-        let v = if a > 0.0 { self.beta / (s + a) - self.lambda } else { s - a - self.lambda };
-        v + 8.0 * f64::EPSILON * (s + a.abs() + self.lambda.abs())
+        if a > 0.0 {
+            let t = self.beta / (s + a);
+            t - self.lambda + 8.0 * f64::EPSILON * (t.abs() + self.lambda.abs())
+        } else {
+            s - a - self.lambda + 8.0 * f64::EPSILON * (s + a.abs() + self.lambda.abs())
+        }
     }
 
     /// `psi(0)`, eq. (psilim).

@@ -109,7 +109,8 @@ mod tests {
             1.0 + 10.0 * (-((a - 0.05) / 1e-3).powi(2)).exp()
         };
         let b = sublinear_sphere_max(2, bump, 1.0, &SphereMaxSettings { tol_abs: 1e-6, tol_rel: 1e-6, max_evals: 1000 });
-        assert!(b.upper < 5.0, "the harness must be able to see a violated hypothesis: {b:?}");
+        // true maximum 11 at angle 0.05: the "upper bound" misses it
+        assert!(b.upper < 10.0, "the harness must be able to see a violated hypothesis: {b:?}");
         // and the arc bound itself is exact at the end points for a linear function
         assert!((arc_bound(1.0, 1.0, 0.1) - 1.0 / (0.05f64).cos()).abs() < 1e-12);
     }
