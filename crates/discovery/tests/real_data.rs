@@ -50,3 +50,30 @@ fn robonine_other_configurations_agree_with_the_authors() {
     let s = stand("motor_telemetry_single.csv", "analysis_config_m5.json");
     assert!(s[0].unloaded.width - u.width > 3.0 * (s[0].unloaded.std_uncertainty.powi(2) + u.std_uncertainty.powi(2)).sqrt());
 }
+
+/// BAM XL330 pendulum at kp = 100 (the logs where the linear class applies: torque on,
+/// voltage command below the supply, |theta| <= 0.49 rad), nominal model written from the
+/// upstream documentation (`examples/real/bam-xl330-kp100.toml`). What is asserted is what is
+/// stable across the two trajectories: the nominal model is rejected (residual not white),
+/// the same pair of effects is selected on both logs, it improves the validation fit by more
+/// than 15 points, and the fitted input-play widths agree within 0.1 rad. The width
+/// (~0.5 rad) is NOT a gear play: see data/bam-servo/SOURCE.md (stiction dead zone).
+#[test]
+fn bam_xl330_kp100_diagnosis_is_stable() {
+    let sys = model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/real/bam-xl330-kp100.toml")).unwrap();
+    let mut widths = Vec::new();
+    for log in ["xl330-kp100-sin_sin.csv", "xl330-kp100-sin_time_square.csv"] {
+        let rec = discovery::Recording::load(&data(&format!("bam-servo/{log}"))).unwrap();
+        let r = discovery::diagnose(&sys, &rec, &discovery::DiagnoseSettings::default()).unwrap();
+        eprintln!("{log}: {} (fit {:?} -> {:?})", r.verdict, r.fit_before.fit_percent, r.fit_after.fit_percent);
+        assert!(!r.nominal_adequate);
+        assert!(!r.residual_nominal.white);
+        let mut kinds: Vec<&str> = r.effects.iter().map(|e| e.label.as_str()).collect();
+        kinds.sort();
+        assert_eq!(kinds, ["backlash(input)", "input_saturation"], "{log}");
+        assert!(r.fit_after.fit_percent[0] > r.fit_before.fit_percent[0] + 15.0);
+        let w = r.effects.iter().find(|e| e.label == "backlash(input)").unwrap().params[0].1;
+        widths.push(w);
+    }
+    assert!((widths[0] - widths[1]).abs() < 0.1, "{widths:?}");
+}
