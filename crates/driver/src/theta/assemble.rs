@@ -185,7 +185,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
     }
     let sc = theta_set.strong_convexity();
     let R = sc.upper();
-    let R_verified = sc.is_verified_upper();
+    // R = inf is trivially a valid upper bound (polytopes: gamma = 0).
+    let R_verified = sc.is_verified_upper() || R == f64::INFINITY;
     let d_theta = theta_set.deviation_from_origin().upper;
 
     // Tubes C Xi_inf and C F Xi_inf (eqs. (d), (zinf)).

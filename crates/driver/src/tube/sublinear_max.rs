@@ -8,8 +8,13 @@
 //! right-hand side is `sqrt(A^2 + B^2)` with `A = g1`, `B = (g2 - g1 cos delta)/sin delta` when
 //! the maximiser `atan2(B, A)` lies in `[0, delta]`, else `max(g1, g2)`. The bound exceeds the
 //! true arc maximum by `O(delta^2)`; arcs whose bound exceeds the best sampled value by more than
-//! the tolerance are bisected. For `p = 1` the maximum is exact (`v = +-1`). For `p >= 3` the
-//! Lipschitz branch and bound `geometry::sphere_max` is used.
+//! the tolerance are bisected. For `p = 1` the maximum is exact (`v = +-1`).
+//!
+//! For `p = 3`: spherical triangles with vertices `v1, v2, v3` (starting from the 8 octants);
+//! on the cone they span `g(v) <= l^T v` with `l = V^{-T} (g1, g2, g3)`, whose maximum over the
+//! unit vectors of the cone is `|l|` if `l` lies in the cone and otherwise the largest of the
+//! three edge (arc) bounds. Triangles are split at the midpoint of their longest edge.
+//! For `p >= 4` the Lipschitz branch and bound `geometry::sphere_max` is used.
 use geometry::{sphere_max, Bounds, SphereMaxSettings};
 use std::collections::BinaryHeap;
 
@@ -79,8 +84,117 @@ pub fn sublinear_sphere_max(p: usize, mut g: impl FnMut(&[f64]) -> f64, lipschit
             let upper = heap.peek().map(|a| a.ub).unwrap_or(lower).max(lower);
             Bounds::new(lower, upper)
         }
+        3 => triangles_max(g, s),
         _ => sphere_max(p, g, lipschitz, s),
     }
+}
+
+struct Tri {
+    ub: f64,
+    v: [[f64; 3]; 3],
+    g: [f64; 3],
+}
+impl PartialEq for Tri {
+    fn eq(&self, o: &Self) -> bool {
+        self.ub == o.ub
+    }
+}
+impl Eq for Tri {}
+impl PartialOrd for Tri {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Tri {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.ub.total_cmp(&o.ub)
+    }
+}
+
+fn angle(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let c: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    c.clamp(-1.0, 1.0).acos()
+}
+
+/// Upper bound of a sublinear `g` over the spherical triangle `v` with vertex values `g`.
+fn tri_bound(v: &[[f64; 3]; 3], g: &[f64; 3]) -> f64 {
+    let V = nalgebra::Matrix3::from_fn(|i, j| v[j][i]); // columns v_j
+    let gmax = g.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let edges = || {
+        let mut e = f64::NEG_INFINITY;
+        for (i, j) in [(0, 1), (1, 2), (0, 2)] {
+            e = e.max(arc_bound(g[i], g[j], angle(&v[i], &v[j])));
+        }
+        e
+    };
+    let Some(Vi) = V.try_inverse() else { return f64::INFINITY };
+    let l = Vi.transpose() * nalgebra::Vector3::new(g[0], g[1], g[2]);
+    let coef = Vi * l;
+    let inside = coef.iter().all(|c| *c >= 0.0);
+    let b = if inside { l.norm() } else { edges() };
+    b * (1.0 + 1e-12) + 1e-12 * gmax
+}
+
+fn triangles_max(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bounds {
+    let mut evals = 0usize;
+    let mut lower = f64::NEG_INFINITY;
+    let mut ev = |v: &[f64; 3], evals: &mut usize, lower: &mut f64| {
+        *evals += 1;
+        let x = g(v);
+        *lower = lower.max(x);
+        x
+    };
+    let mut heap = BinaryHeap::new();
+    let axes = |i: usize, sgn: f64| {
+        let mut a = [0.0; 3];
+        a[i] = sgn;
+        a
+    };
+    let mut vals = std::collections::HashMap::new();
+    for i in 0..3 {
+        for sgn in [1.0, -1.0] {
+            let a = axes(i, sgn);
+            vals.insert((i, sgn as i8), ev(&a, &mut evals, &mut lower));
+        }
+    }
+    for sx in [1.0, -1.0] {
+        for sy in [1.0, -1.0] {
+            for sz in [1.0, -1.0] {
+                let v = [axes(0, sx), axes(1, sy), axes(2, sz)];
+                let gv = [vals[&(0, sx as i8)], vals[&(1, sy as i8)], vals[&(2, sz as i8)]];
+                heap.push(Tri { ub: tri_bound(&v, &gv), v, g: gv });
+            }
+        }
+    }
+    while let Some(top) = heap.peek() {
+        if top.ub - lower <= s.tol_abs.max(s.tol_rel * lower.abs()) || evals >= s.max_evals {
+            break;
+        }
+        let t = heap.pop().expect("nonempty");
+        // longest edge (i, j), opposite vertex k
+        let mut best = (0, 1, 2, -1.0);
+        for (i, j, k) in [(0, 1, 2), (1, 2, 0), (0, 2, 1)] {
+            let a = angle(&t.v[i], &t.v[j]);
+            if a > best.3 {
+                best = (i, j, k, a);
+            }
+        }
+        let (i, j, k, _) = best;
+        let mut m = [0.0; 3];
+        for d in 0..3 {
+            m[d] = t.v[i][d] + t.v[j][d];
+        }
+        let nm = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+        m.iter_mut().for_each(|x| *x /= nm);
+        let gm = ev(&m, &mut evals, &mut lower);
+        for (a, ga) in [(i, t.g[i]), (j, t.g[j])] {
+            let v = [t.v[a], m, t.v[k]];
+            let gv = [ga, gm, t.g[k]];
+            heap.push(Tri { ub: tri_bound(&v, &gv), v, g: gv });
+        }
+    }
+    let upper = heap.peek().map(|t| t.ub).unwrap_or(lower).max(lower);
+    Bounds::new(lower, upper)
 }
 
 #[cfg(test)]
@@ -98,6 +212,19 @@ mod tests {
         let b = sublinear_sphere_max(2, g, 3.0, &SphereMaxSettings { tol_abs: 1e-12, tol_rel: 1e-10, max_evals: 10_000 });
         assert!(b.lower <= 3.0 + 1e-12 && b.upper >= 3.0 - 1e-12, "{b:?}");
         assert!(b.width() < 1e-9, "{b:?}");
+    }
+
+    #[test]
+    fn ellipsoid_support_max_in_3d() {
+        // support of the ellipsoid with semi-axes (1, 2, 0.5) rotated: max = 2.
+        let R = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+        let g = |v: &[f64]| {
+            let w = R.inverse() * nalgebra::Vector3::new(v[0], v[1], v[2]);
+            (w[0] * w[0] + 4.0 * w[1] * w[1] + 0.25 * w[2] * w[2]).sqrt()
+        };
+        let b = sublinear_sphere_max(3, g, 2.0, &SphereMaxSettings { tol_abs: 1e-10, tol_rel: 1e-8, max_evals: 20_000 });
+        assert!(b.lower <= 2.0 + 1e-12 && b.upper >= 2.0 - 1e-12, "{b:?}");
+        assert!(b.width() < 1e-7, "{b:?}");
     }
 
     #[test]

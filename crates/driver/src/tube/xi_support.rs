@@ -62,6 +62,77 @@ pub enum Horizon {
     Infinite,
 }
 
+/// Support function of `Theta` for the quadrature's inner loop. Intersections of discs
+/// (`p = 2`) get a fast exact form: the maximiser of `u^T x` is either `c_i + r_i u/|u|` (if it
+/// lies in every disc) or one of the precomputed vertices (pairwise circle intersections lying
+/// in every disc). Other shapes use their own closed forms.
+#[derive(Debug, Clone)]
+pub enum ThetaSupport {
+    Shape(Shape),
+    Discs { centres: Vec<[f64; 2]>, radii: Vec<f64>, vertices: Vec<[f64; 2]> },
+}
+
+impl ThetaSupport {
+    pub fn new(theta: &Shape) -> Self {
+        match theta {
+            Shape::BallIntersection(bi) if bi.dim() == 2 => {
+                let centres: Vec<[f64; 2]> = bi.centres().iter().map(|c| [c[0], c[1]]).collect();
+                let radii = bi.radii().to_vec();
+                let inside = |x: &[f64; 2], centres: &[[f64; 2]], radii: &[f64]| {
+                    centres.iter().zip(radii).all(|(c, r)| ((x[0] - c[0]).powi(2) + (x[1] - c[1]).powi(2)).sqrt() <= r * (1.0 + 1e-12) + 1e-15)
+                };
+                let mut vertices = Vec::new();
+                for i in 0..centres.len() {
+                    for j in i + 1..centres.len() {
+                        let (a, b) = (centres[i], centres[j]);
+                        let d = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                        let (ri, rj) = (radii[i], radii[j]);
+                        if d == 0.0 || d > ri + rj || d < (ri - rj).abs() {
+                            continue;
+                        }
+                        let l = (ri * ri - rj * rj + d * d) / (2.0 * d);
+                        let h = (ri * ri - l * l).max(0.0).sqrt();
+                        let (ex, ey) = ((b[0] - a[0]) / d, (b[1] - a[1]) / d);
+                        for sg in [1.0, -1.0] {
+                            let x = [a[0] + l * ex - sg * h * ey, a[1] + l * ey + sg * h * ex];
+                            if inside(&x, &centres, &radii) {
+                                vertices.push(x);
+                            }
+                        }
+                    }
+                }
+                ThetaSupport::Discs { centres, radii, vertices }
+            }
+            other => ThetaSupport::Shape(other.clone()),
+        }
+    }
+
+    #[inline]
+    pub fn support(&self, u: &[f64]) -> f64 {
+        match self {
+            ThetaSupport::Shape(s) => s.support(u),
+            ThetaSupport::Discs { centres, radii, vertices } => {
+                let nu = (u[0] * u[0] + u[1] * u[1]).sqrt();
+                let mut best = f64::NEG_INFINITY;
+                for v in vertices {
+                    best = best.max(u[0] * v[0] + u[1] * v[1]);
+                }
+                if nu == 0.0 {
+                    return best.max(0.0);
+                }
+                for (c, r) in centres.iter().zip(radii) {
+                    let x = [c[0] + r * u[0] / nu, c[1] + r * u[1] / nu];
+                    let ok = centres.iter().zip(radii.iter()).all(|(c2, r2)| ((x[0] - c2[0]).powi(2) + (x[1] - c2[1]).powi(2)).sqrt() <= r2 * (1.0 + 1e-12) + 1e-15);
+                    if ok {
+                        best = best.max(u[0] * x[0] + u[1] * x[1]);
+                    }
+                }
+                best
+            }
+        }
+    }
+}
+
 fn frob(M: &DMatrix<f64>) -> f64 {
     M.iter().map(|x| x * x).sum::<f64>().sqrt() * (1.0 + 1e-14)
 }
@@ -72,7 +143,7 @@ fn frob(M: &DMatrix<f64>) -> f64 {
 pub struct TubeKernel {
     r: usize,
     p: usize,
-    theta: Shape,
+    theta: ThetaSupport,
     /// Per cell: `(K(m) - r K'(m))^T`, `K(m)^T`, `(K(m) + r K'(m))^T`, each `p x r`, row-major.
     minus: Vec<f64>,
     mid: Vec<f64>,
@@ -240,7 +311,7 @@ impl TubeKernel {
         Some(Self {
             r,
             p,
-            theta: theta.clone(),
+            theta: ThetaSupport::new(theta),
             minus,
             mid,
             plus,
@@ -314,5 +385,33 @@ impl TubeKernel {
     /// Number of quadrature cells.
     pub fn cells(&self) -> usize {
         self.half.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_disc_intersection_support_matches_geometry() {
+        let lens = geometry::BallIntersection::new(vec![vec![-0.15, 0.0], vec![0.15, 0.0]], vec![0.2, 0.2]).unwrap();
+        let three = geometry::BallIntersection::new(vec![vec![0.0, 0.0], vec![0.3, 0.1], vec![0.1, -0.25]], vec![0.3, 0.35, 0.4]).unwrap();
+        for bi in [lens, three] {
+            let shape = Shape::BallIntersection(bi);
+            let fast = ThetaSupport::new(&shape);
+            assert!(matches!(fast, ThetaSupport::Discs { .. }));
+            for k in 0..720 {
+                let a = std::f64::consts::TAU * k as f64 / 720.0 + 0.001;
+                let u = [2.0 * a.cos(), 2.0 * a.sin()];
+                let (x, y) = (fast.support(&u), shape.support(&u));
+                assert!((x - y).abs() <= 1e-12 * (1.0 + y.abs()), "{a}: {x} vs {y}");
+            }
+        }
+        // Negative control: dropping the vertices breaks the support at the lens' tips.
+        let shape = Shape::BallIntersection(geometry::BallIntersection::new(vec![vec![-0.15, 0.0], vec![0.15, 0.0]], vec![0.2, 0.2]).unwrap());
+        if let ThetaSupport::Discs { centres, radii, .. } = ThetaSupport::new(&shape) {
+            let broken = ThetaSupport::Discs { centres, radii, vertices: vec![] };
+            assert!((broken.support(&[0.0, 1.0]) - shape.support(&[0.0, 1.0])).abs() > 1e-3);
+        }
     }
 }
