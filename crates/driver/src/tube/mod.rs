@@ -5,4 +5,4 @@ pub mod sublinear_max;
 pub mod xi_support;
 
 pub use sublinear_max::sublinear_sphere_max;
-pub use xi_support::{Horizon, TubeKernel, TubeSettings};
+pub use xi_support::{dxx_bound, exp_norm_integral, Horizon, TubeKernel, TubeSettings};

@@ -193,6 +193,13 @@ pub fn exp_norm_integral(F: &DMatrix<f64>) -> Result<f64, DriverError> {
     Err(DriverError::NoTailBound { tau_max: tau })
 }
 
+/// Eq. (DXX): `D(Xi_inf, Xi(t)) <= D(Theta, {0}) ||E|| int_t^inf ||e^{sF}|| ds`, bounded by
+/// `D_Theta ||E||_F ||e^{tF}||_F int_0^inf ||e^{rF}|| dr` (see [`exp_norm_integral`]).
+pub fn dxx_bound(F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, t: f64) -> Result<f64, DriverError> {
+    let i_inf = exp_norm_integral(F)?;
+    Ok(theta.deviation_from_origin().upper * frob(E) * frob(&expm(&(F * t))) * i_inf)
+}
+
 impl TubeKernel {
     /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
     pub fn new(L: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, horizon: Horizon, settings: &TubeSettings) -> Result<Self, DriverError> {
@@ -391,6 +398,32 @@ impl TubeKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn dxx_bounds_the_hausdorff_gap_between_xi_t_and_xi_inf() {
+        let F = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.6]);
+        let E = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+        let theta = Shape::Interval(geometry::Interval::symmetric(0.1).unwrap());
+        let I = DMatrix::<f64>::identity(2, 2);
+        let st = TubeSettings { tol_abs: 1e-7, ..Default::default() };
+        let kinf = TubeKernel::new(&I, &F, &E, &theta, Horizon::Infinite, &st).unwrap();
+        for t in [1.0, 5.0, 15.0] {
+            let kt = TubeKernel::new(&I, &F, &E, &theta, Horizon::Finite(t), &st).unwrap();
+            let bound = dxx_bound(&F, &E, &theta, t).unwrap();
+            let mut gap = 0.0f64;
+            for k in 0..64 {
+                let a = std::f64::consts::TAU * k as f64 / 64.0;
+                let u = [a.cos(), a.sin()];
+                gap = gap.max(kinf.support_bounds(&u).lower - kt.support_upper(&u));
+            }
+            assert!(gap <= bound, "t = {t}: gap {gap} > (DXX) {bound}");
+            assert!(gap > 0.0 || t > 10.0);
+            // Negative control: a rate faster than mu (e^{-t} instead of e^{-0.3 t}) is violated.
+            if t == 5.0 {
+                assert!(gap > 0.1 * (-t).exp(), "{gap}");
+            }
+        }
+    }
 
     #[test]
     fn fast_disc_intersection_support_matches_geometry() {
