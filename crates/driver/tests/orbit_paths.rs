@@ -1,5 +1,6 @@
 //! eta_T closed form against the dynamics crate's samples, and the path-length bounds
 //! (path), (path1), (path2) on curves with known answers.
+#![allow(non_snake_case)]
 use driver::orbit::{packing_bound, partition_bound, path_bound, EtaOrbit, OrbitSettings};
 use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
 

@@ -23,8 +23,8 @@ fn phi_matches_its_closed_form_for_a_diagonal_system() {
     // A = -1 (n = 1), C = E = 1: Phi(t) = 1 - (1 - e^{-t}).
     let A = DMatrix::from_element(1, 1, -1.0);
     let I = DMatrix::from_element(1, 1, 1.0);
-    for t in [0.0, 0.5, 2.0] {
-        assert!((phi(&A, &I, &I, t)[(0, 0)] - (-t as f64).exp()).abs() < 1e-13);
+    for t in [0.0f64, 0.5, 2.0] {
+        assert!((phi(&A, &I, &I, t)[(0, 0)] - (-t).exp()).abs() < 1e-13);
     }
     // A lightly damped oscillator with E = [0, 0.8]: the step response overshoots 1, so
     // Phi(t) = 1 - C int e^{sA} E becomes singular although F = A + E C is Hurwitz.

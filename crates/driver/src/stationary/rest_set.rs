@@ -11,6 +11,7 @@
 //! - otherwise a second-order cone program in Clarabel: balls, ellipsoids and intersections of
 //!   balls are second-order cones, polytopes linear inequalities (`s*` is the solver's value:
 //!   an estimate).
+//!
 //! When the grid set is nonempty, its most interior point is simulated (catching-up scheme,
 //! `sim_dt`) and `z` is confirmed to stay at rest over `[0, T]`.
 use crate::error::DriverError;

@@ -117,11 +117,12 @@ pub struct ThetaReport {
     pub osc_sampled: f64,
     pub orbit_verified: bool,
     pub orbit_method: String,
-    /// `d = diam(C Xi_inf + Theta)`, eq. (d): upper bound and the sampled lower end.
+    /// `d = diam(C Xi_inf + Theta)`, eq. (d): upper bound; `d_lower` is indicative only (best
+    /// sampled value of the upper function minus the quadrature remainders), not a bound.
     pub d: f64,
     pub d_lower: f64,
     pub eta_dot_inf: f64,
-    /// `D(C(F Xi_inf + E Theta), {0})`, eq. (zinf): upper bound and lower end.
+    /// `D(C(F Xi_inf + E Theta), {0})`, eq. (zinf): upper bound; `d_ftheta_lower` indicative only.
     pub d_ftheta: f64,
     pub d_ftheta_lower: f64,
     /// Right-hand side of (zinf): `||eta_T'||_inf + D(...)`.
@@ -138,6 +139,8 @@ pub struct ThetaReport {
     pub convergence_guaranteed: bool,
     pub path_bound: f64,
     pub path1_bound: f64,
+    /// Number of grid points of the (path1) dynamic programme.
+    pub path1_grid: usize,
     pub path2: PackingBound,
     /// Certified curve `(lambda, beta, theta)` of the lambda search.
     pub curve: Vec<(f64, f64, f64)>,
@@ -355,6 +358,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
         convergence_guaranteed: theta_verified && theta < 0.0,
         path_bound: path_b,
         path1_bound: path1,
+        path1_grid: sub.len(),
         path2,
         curve,
         stationary,
@@ -414,7 +418,7 @@ impl ThetaReport {
             Quantity::new("psi_limit", "-lambda", "(psilim)", -self.lambda, Exact, self.certificate_verified, "limit of psi at infinity"),
             Quantity::new("theta", "theta", "(theta)", self.theta, Upper, self.theta_verified, "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))"),
             Quantity::new("path_bound", "(osc - d)_+", "(path)", self.path_bound, Lower, self.orbit_verified, "liminf path length of z per period"),
-            Quantity::new("path1_bound", "sup_partitions", "(path1)", self.path1_bound, Lower, self.orbit_verified, format!("dynamic programming over a {}-point grid", self.orbit.subsample(600).len())),
+            Quantity::new("path1_bound", "sup_partitions", "(path1)", self.path1_bound, Lower, self.orbit_verified, format!("dynamic programming over a {}-point grid", self.path1_grid)),
             Quantity::new("path2_bound", "sup_eps (2eps-d)N_eps", "(path2)", self.path2.value, Lower, self.orbit_verified, format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count)),
         ];
         if let Some(s) = &self.stationary {
@@ -483,6 +487,8 @@ impl ThetaReport {
         m.insert("stationary_verified".into(), json!(self.stationary.as_ref().map(|s| s.verified)));
         m.insert("stationary_point".into(), json!(self.stationary.as_ref().and_then(|s| s.point.clone())));
         m.insert("phi_first_singular".into(), json!(self.stationary.as_ref().and_then(|s| s.phi.first_singular)));
+        m.insert("tube_cells".into(), json!(self.tube_cells));
+        m.insert("tube_tail_dxx".into(), json!(f(self.tube_tail)));
         m.insert("lambda_curve".into(), json!(self.curve));
         m.insert("notes".into(), json!(self.notes));
         m.insert("quantities".into(), json!(quantities));

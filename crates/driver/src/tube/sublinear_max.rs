@@ -180,10 +180,7 @@ fn triangles_max(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bou
             }
         }
         let (i, j, k, _) = best;
-        let mut m = [0.0; 3];
-        for d in 0..3 {
-            m[d] = t.v[i][d] + t.v[j][d];
-        }
+        let mut m: [f64; 3] = std::array::from_fn(|d| t.v[i][d] + t.v[j][d]);
         let nm = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
         m.iter_mut().for_each(|x| *x /= nm);
         let gm = ev(&m, &mut evals, &mut lower);
