@@ -82,3 +82,24 @@ fn bad_inputs_give_named_errors_or_reported_cases() {
     assert!(r.theta > 0.0 && !r.convergence_guaranteed, "alpha = 0 gives psi(0) > 0");
     assert!(r.notes.iter().any(|n| n.contains("not strongly convex")));
 }
+
+#[test]
+fn assemble_is_deterministic_and_thread_safe() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<driver::theta::ThetaReport>();
+    let sys = load("ellipse-p2.toml");
+    let s = ThetaSettings::bound_only();
+    let reference = assemble(&sys, &s).unwrap();
+    let results: Vec<f64> = std::thread::scope(|sc| {
+        let hs: Vec<_> = (0..3).map(|_| sc.spawn(|| assemble(&sys, &s).unwrap().theta)).collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for t in results {
+        assert_eq!(t.to_bits(), reference.theta.to_bits());
+    }
+    // psi as a function and the tube support function are usable from the report.
+    let psi = reference.psi();
+    assert!(psi.eval(0.0) == reference.psi_0 && psi.limit() == -reference.lambda);
+    let up = reference.tube_theta_support_upper(&[1.0, 0.0]);
+    assert!(up > reference.tube_support(&[1.0, 0.0]).upper);
+}
