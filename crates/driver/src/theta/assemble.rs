@@ -414,7 +414,7 @@ impl ThetaReport {
             Quantity::new("gamma_1", "gamma_1", "(g1)", self.gamma_1, Lower, self.orbit_verified && r_ok, "(osc - d)_+ / (T R), R upper"),
             Quantity::new("gamma_inf", "gamma_inf", "(ginf)", self.gamma_inf, Upper, self.orbit_verified && r_ok, "(||eta_T'|| + D(...)) / R at R upper (safe for theta)"),
             Quantity::new("psi_0", "psi(0)", "(psilim)", self.psi_0, Upper, self.alpha.verified && self.certificate_verified, "at (alpha, lambda) lower, beta upper"),
-            Quantity::new("psi_inf", "psi(gamma_inf)", "(phipsi)", self.psi_inf, Upper, self.alpha.verified && self.certificate_verified, ""),
+            Quantity::new("psi_inf", "psi(gamma_inf)", "(phipsi)", self.psi_inf, Upper, self.alpha.verified && self.certificate_verified, "at gamma_inf (R upper)"),
             Quantity::new("psi_limit", "-lambda", "(psilim)", -self.lambda, Exact, self.certificate_verified, "limit of psi at infinity"),
             Quantity::new("theta", "theta", "(theta)", self.theta, Upper, self.theta_verified, "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))"),
             Quantity::new("path_bound", "(osc - d)_+", "(path)", self.path_bound, Lower, self.orbit_verified, "liminf path length of z per period"),
