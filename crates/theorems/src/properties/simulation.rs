@@ -94,3 +94,35 @@ pub fn linear_response_exact(sys: &System, M: &DMatrix<f64>, h: f64, steps: usiz
     }
     Some(out)
 }
+
+/// The nodes of [`XiNodes`] right-multiplied by a fixed `K` (`n x r`, `r <= 4`): the support
+/// function `v -> sigma_{Xi_inf}(K v)` without a matrix-vector product per node and call.
+pub struct MappedNodes {
+    pub ds: f64,
+    /// `(e^{s_i F} E)^T K`, `p x r` each.
+    pub mats: Vec<DMatrix<f64>>,
+}
+
+impl XiNodes {
+    pub fn mapped(&self, K: &DMatrix<f64>) -> MappedNodes {
+        MappedNodes { ds: self.ds, mats: self.nodes.iter().map(|M| M * K).collect() }
+    }
+}
+
+impl MappedNodes {
+    /// `sigma_{Xi_inf}(K v)` by the trapezoid rule over all nodes (as [`XiNodes::support`] with `t = inf`).
+    pub fn support(&self, theta: &geometry::Shape, v: &[f64]) -> f64 {
+        let k = self.mats.len();
+        let mut buf = [0.0f64; 4];
+        let mut s = 0.0;
+        for (i, M) in self.mats.iter().enumerate() {
+            let (p, r) = M.shape();
+            for a in 0..p {
+                buf[a] = (0..r).map(|b| M[(a, b)] * v[b]).sum();
+            }
+            let f = theta.support(&buf[..p]);
+            s += if i == 0 || i + 1 == k { 0.5 * f } else { f };
+        }
+        s * self.ds
+    }
+}

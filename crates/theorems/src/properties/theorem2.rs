@@ -20,6 +20,20 @@ use crate::strategies::systems::{system_params, SystemParams, SystemStrategyConf
 use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
 use geometry::{sphere_max, SphereMaxSettings};
 
+/// Steps per period of the catching-up scheme (capped by [`MAX_DT`]).
+pub const STEPS_PER_PERIOD: usize = 500;
+/// Largest step.
+pub const MAX_DT: f64 = 1e-2;
+/// Transient: `TRANSIENT_DECAYS / |mu|` (at least `2 T`), rounded up to whole periods.
+pub const TRANSIENT_DECAYS: f64 = 15.0;
+/// Quadrature step of `sigma_{Xi_inf}`.
+pub const XI_DS: f64 = 5e-2;
+
+/// Backlash sets of the default campaign: the strongly convex kinds whose projection is cheap
+/// (ball intersections cost ~50x more per projection in `geometry`; they are covered by
+/// [`config_ball_intersection`], run by the `#[ignore]`d test).
+pub const THETA_KINDS: [SetKind; 3] = [SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid];
+
 /// Which half of Theorem 2.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {
@@ -48,7 +62,8 @@ pub fn info(part: Part) -> PropertyInfo {
 
 pub fn config() -> SystemStrategyConfig {
     SystemStrategyConfig {
-        mu: (-2.0, -0.5),
+        mu: (-2.0, -1.0),
+        theta: SetStrategyConfig { kinds: THETA_KINDS.to_vec(), max_cond: 5.0, scale_exp: 0.75, ..SetStrategyConfig::default() },
         input: InputStrategyConfig { amp_exp: (-1.0, 1.3), ..Default::default() },
         ..Default::default()
     }
@@ -56,6 +71,13 @@ pub fn config() -> SystemStrategyConfig {
 
 pub fn strategy() -> BoxedStrategy<SystemParams> {
     system_params(&config())
+}
+
+/// As [`config`] with ball intersections only.
+pub fn config_ball_intersection() -> SystemStrategyConfig {
+    let mut c = config();
+    c.theta.kinds = vec![SetKind::BallIntersection];
+    c
 }
 
 /// Every quantity of Theorem 2 for one system, and the measured ones.
@@ -81,13 +103,14 @@ pub fn measure(sys: &model::System) -> Option<Measured> {
     let osc = lin.osc_lower();
     let deta_inf = lin.deta_inf_sampled();
     let p = sys.p();
-    let xi = XiNodes::new(sys, 2e-2, 200.0);
+    let xi = XiNodes::new(sys, XI_DS, 200.0);
     let d_theta = sys.theta.deviation_from_origin().upper;
     let d_xi = d_theta * op_norm(&sys.E) * xi.int_norm; // >= D(Xi_inf, {0}), eq. (DXX)
     let Ct = sys.C.transpose();
     let st = SphereMaxSettings { tol_abs: 1e-9, tol_rel: 1e-2, max_evals: 400 };
     let cn = op_norm(&sys.C);
-    let sig_cxi = |u: &[f64]| xi.support(&sys.theta, (&Ct * nalgebra::DVector::from_column_slice(u)).as_slice(), f64::INFINITY);
+    let xi_c = xi.mapped(&Ct);
+    let sig_cxi = |u: &[f64]| xi_c.support(&sys.theta, u);
     let d_upper = sphere_max(
         p,
         |u| {
@@ -100,20 +123,21 @@ pub fn measure(sys: &model::System) -> Option<Measured> {
     .upper;
     let FtCt = sys.F().transpose() * &Ct;
     let EtCt = sys.E.transpose() * &Ct;
+    let xi_f = xi.mapped(&FtCt);
     let D_upper = sphere_max(
         p,
         |u| {
             let v = nalgebra::DVector::from_column_slice(u);
-            xi.support(&sys.theta, (&FtCt * &v).as_slice(), f64::INFINITY) + sys.theta.support((&EtCt * &v).as_slice())
+            xi_f.support(&sys.theta, u) + sys.theta.support((&EtCt * &v).as_slice())
         },
         op_norm(&FtCt) * d_xi + op_norm(&EtCt) * d_theta,
         &st,
     )
     .upper;
-    let dt = (T / 2000.0).min(5e-3);
+    let dt = (T / STEPS_PER_PERIOD as f64).min(MAX_DT);
     let spp = (T / dt).round().max(1.0) as usize;
     let dt = T / spp as f64;
-    let transient_periods = ((30.0 / mu.abs()).max(2.0 * T) / T).ceil() as usize;
+    let transient_periods = ((TRANSIENT_DECAYS / mu.abs()).max(2.0 * T) / T).ceil() as usize;
     let mut x: Vec<f64> = sys.x0.iter().copied().collect();
     let mut z: Vec<f64> = sys.z0.iter().copied().collect();
     if !simulate(sys, dt, 0.0, &mut x, &mut z, transient_periods * spp, |_, _, _| {}) {
