@@ -16,7 +16,7 @@ use theorems::{CampaignSettings, PropertyReport, Variant};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Cases per property (default: each property's own default, thousands for the geometric
-    /// lemmas, tens for simulation-based results).
+    /// lemmas, 2,000 for the simulation-based results).
     #[arg(long)]
     pub cases: Option<u64>,
     /// Master seed; the campaign is deterministic given the seed and the number of cases.

@@ -108,7 +108,7 @@ pub struct PropertyInfo {
     /// Result, in words.
     pub title: &'static str,
     /// Default number of cases in `moreau check` and in `cargo test` (cheap properties:
-    /// thousands; simulation-based ones: tens).
+    /// thousands; simulation-based ones: 2,000, short horizons).
     pub default_cases: u64,
     /// What the negative control changes.
     pub negative_control: &'static str,

@@ -20,7 +20,7 @@ pub fn info() -> PropertyInfo {
         name: "qzdot",
         label: "(QZdot)",
         title: "Q^T Z' <= -(|z1'|+|z2'|)|Q|^2/(2R) along pairs of trajectories",
-        default_cases: 64,
+        default_cases: 2000,
         negative_control: "1/R instead of 1/(2R)",
     }
 }

@@ -6,9 +6,9 @@
 //! Computation: `eta_T` from `dynamics::periodic::linearised_periodic` (exact for sines, eq.
 //! (xT) with its typo corrected); `osc` = largest distance between 1000 samples;
 //! `||eta_T'||_inf` = sampled maximum; `d` and `D(...)` as certified upper bounds by
-//! `geometry::sphere_max` of support functions, `sigma_{Xi_inf}` by the trapezoid rule (step `0.02`)
+//! `geometry::sphere_max` of support functions, `sigma_{Xi_inf}` by the trapezoid rule (step `0.05`)
 //! ([`super::simulation::XiNodes`]). The closed loop is simulated by catching-up
-//! (`h = min(T/2000, 5e-3)`) for a transient of `max(30/|mu|, 2T)` rounded up to whole periods,
+//! (`h = min(T/500, 0.01)`) for a transient of `max(15/|mu|, 2T)` rounded up to whole periods (mu in `[-2, -1]`),
 //! then 3 periods are measured: path length per period `sum |Dz|` (minimum over the periods)
 //! and speed `max |Dz|/h`.
 //! Tolerance (discretisation, first-order scheme): `2%` of the right-hand side.
@@ -47,14 +47,14 @@ pub fn info(part: Part) -> PropertyInfo {
             name: "theorem2_path",
             label: "(path)",
             title: "Theorem 2: path of z per period >= (osc(eta_T) - diam(C Xi_inf + Theta))_+",
-            default_cases: 24,
+            default_cases: 2000,
             negative_control: "d replaced by 0",
         },
         Part::Zinf => PropertyInfo {
             name: "theorem2_zinf",
             label: "(zinf)",
             title: "Theorem 2: limsup |z'| <= ||eta_T'||_inf + D(C(F Xi_inf + E Theta), {0})",
-            default_cases: 24,
+            default_cases: 2000,
             negative_control: "bound halved",
         },
     }
