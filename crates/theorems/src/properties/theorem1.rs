@@ -153,7 +153,7 @@ fn run_from(sys: &model::System, rs: &RestSet, z: f64) -> Option<(f64, f64)> {
 
 /// The rest point and the outside point of a case (either may be absent).
 pub fn points(case: &Theorem1Case, sys: &model::System, rs: &RestSet) -> (Option<f64>, Option<f64>) {
-    let rest = (rs.lower <= rs.upper).then(|| 0.5 * (rs.lower + rs.upper)).filter(|z| rs.violation(*z) <= -rs.delta);
+    let rest = (rs.lower <= rs.upper).then_some(0.5 * (rs.lower + rs.upper)).filter(|z| rs.violation(*z) <= -rs.delta);
     let c0 = (&sys.C * &sys.x0)[0];
     let zo = c0 + rs.lo + case.frac * (rs.hi - rs.lo);
     let outside = Some(zo).filter(|z| rs.violation(*z) >= rs.delta);
