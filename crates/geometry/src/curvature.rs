@@ -13,8 +13,9 @@ fn rho(h: &dyn Fn(f64) -> f64, phi: f64, delta: f64) -> f64 {
 /// `R = max_phi h(phi) + h''(phi)` with `h''` by central differences at steps `delta` and
 /// `delta/2` on a grid of 1440 angles, the largest refined by golden section.
 /// The stated error is the Richardson difference between the two steps plus the rounding
-/// error of the difference quotient (`~ 4 eps max|h| / delta^2`) plus the grid spacing times
-/// the local slope of `rho`. Sets with corners have unbounded curvature radius; the estimate
+/// error of the difference quotient (`~ 4 eps max|h| / delta^2`) plus the amount by which a
+/// peak between two grid angles can exceed them (`|rho''| step^2 / 8`, with `|rho''| step^2`
+/// estimated by the largest second difference on the grid). Sets with corners have unbounded curvature radius; the estimate
 /// then grows as `delta` shrinks and the stated error is large.
 pub fn planar_strong_convexity(sigma: impl Fn(&[f64]) -> f64) -> StrongConvexity {
     let h = |phi: f64| sigma(&[phi.cos(), phi.sin()]);
@@ -42,9 +43,11 @@ pub fn planar_strong_convexity(sigma: impl Fn(&[f64]) -> f64) -> StrongConvexity
     let richardson = (coarse - fine).abs() / 3.0;
     let hmax = vals.iter().map(|v| v.abs()).fold(0.0, f64::max).max(h(0.0).abs());
     let rounding = 16.0 * f64::EPSILON * hmax / (delta * delta / 4.0);
-    let slope = vals.iter().zip(vals.iter().cycle().skip(1)).map(|(a, b)| (b - a).abs()).fold(0.0, f64::max);
+    // A peak between two neighbouring grid angles exceeds the larger of the two values by at
+    // most |rho''| step^2 / 8; |rho''| step^2 is estimated by the largest second difference.
+    let second = (0..n).map(|i| (vals[(i + 1) % n] - 2.0 * vals[i] + vals[(i + n - 1) % n]).abs()).fold(0.0, f64::max);
     let value = fine.max(vals[ib]) + richardson;
-    let error = 2.0 * richardson + rounding + slope * 0.05;
+    let error = 2.0 * richardson + rounding + second / 8.0;
     StrongConvexity::Numerical { value, error }
 }
 
