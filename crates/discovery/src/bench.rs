@@ -95,10 +95,13 @@ pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettin
                 // Compare like with like: the same kind and, for forces, the same state (a force
                 // on another state is an observationally equivalent but different parameter).
                 let same = |a: &Effect, b: &Effect| match (a, b) {
-                    (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. }) | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. }) => i == j,
+                    (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. })
+                    | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. }) => i == j,
                     _ => a.kind() == b.kind(),
                 };
-                if let (Some(t), Some(e)) = (case.truth.as_ref(), case.truth.as_ref().and_then(|t| fitted.iter().find(|e| same(t, e)))) {
+                if let (Some(t), Some(e)) =
+                    (case.truth.as_ref(), case.truth.as_ref().and_then(|t| fitted.iter().find(|e| same(t, e))))
+                {
                     let (tv, ev) = (main_param(t), main_param(e));
                     out.est_param = Some(ev);
                     out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
@@ -152,9 +155,21 @@ impl BenchResult {
         let non_none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class != "none").collect();
         let none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class == "none").collect();
         let false_alarms = none.iter().filter(|c| c.predicted != "none").count();
-        s += &format!("\ncorrect names: {correct}/{total} ({:.1} %); counting reported ties: {tied}/{total} ({:.1} %)\n", 100.0 * correct as f64 / total.max(1) as f64, 100.0 * tied as f64 / total.max(1) as f64);
-        s += &format!("false alarms on none: {false_alarms}/{} ({:.1} %)\n", none.len(), 100.0 * false_alarms as f64 / none.len().max(1) as f64);
-        s += &format!("missed effects (predicted none): {}/{}\n", non_none.iter().filter(|c| c.predicted == "none").count(), non_none.len());
+        s += &format!(
+            "\ncorrect names: {correct}/{total} ({:.1} %); counting reported ties: {tied}/{total} ({:.1} %)\n",
+            100.0 * correct as f64 / total.max(1) as f64,
+            100.0 * tied as f64 / total.max(1) as f64
+        );
+        s += &format!(
+            "false alarms on none: {false_alarms}/{} ({:.1} %)\n",
+            none.len(),
+            100.0 * false_alarms as f64 / none.len().max(1) as f64
+        );
+        s += &format!(
+            "missed effects (predicted none): {}/{}\n",
+            non_none.iter().filter(|c| c.predicted == "none").count(),
+            non_none.len()
+        );
         s += "\nparameter error of the main parameter (correctly named cases):\n";
         for c in self.classes.iter().skip(1) {
             let errs: Vec<f64> = self.cases.iter().filter(|r| &r.class == c).filter_map(|r| r.param_error).collect();
@@ -165,7 +180,12 @@ impl BenchResult {
             let mut e = errs.clone();
             e.sort_by(f64::total_cmp);
             let within = e.iter().filter(|x| **x <= 0.15).count();
-            s += &format!("  {c:>18}: median {:.1} %, max {:.1} %, within 15 %: {within}/{}\n", 100.0 * e[e.len() / 2], 100.0 * e[e.len() - 1], e.len());
+            s += &format!(
+                "  {c:>18}: median {:.1} %, max {:.1} %, within 15 %: {within}/{}\n",
+                100.0 * e[e.len() / 2],
+                100.0 * e[e.len() - 1],
+                e.len()
+            );
         }
         let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
         s += &format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / total.max(1) as f64);

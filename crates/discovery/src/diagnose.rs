@@ -40,7 +40,17 @@ pub struct DiagnoseSettings {
 
 impl Default for DiagnoseSettings {
     fn default() -> Self {
-        Self { estimation_fraction: 0.7, max_substeps: 8, substep_ratio: 10.0, max_effects: 2, max_second: 4, lags: 20, fit: FitSettings::default(), select: SelectSettings::default(), parallel: true }
+        Self {
+            estimation_fraction: 0.7,
+            max_substeps: 8,
+            substep_ratio: 10.0,
+            max_effects: 2,
+            max_second: 4,
+            lags: 20,
+            fit: FitSettings::default(),
+            select: SelectSettings::default(),
+            parallel: true,
+        }
     }
 }
 
@@ -142,7 +152,21 @@ struct Ctx<'a> {
 
 impl<'a> Ctx<'a> {
     fn problem(&'a self, fixed: Vec<Effect>, parts: Vec<Hypothesis>) -> Problem<'a> {
-        Problem { sys: self.sys, fixed, parts, scales: &self.scales, w: &self.w, y: &self.y, m: self.m, p: self.p, dt: self.dt, k_est: self.k_est, weights: self.weights.clone(), maps: self.maps.clone(), substeps: self.substeps }
+        Problem {
+            sys: self.sys,
+            fixed,
+            parts,
+            scales: &self.scales,
+            w: &self.w,
+            y: &self.y,
+            m: self.m,
+            p: self.p,
+            dt: self.dt,
+            k_est: self.k_est,
+            weights: self.weights.clone(),
+            maps: self.maps.clone(),
+            substeps: self.substeps,
+        }
     }
     fn weighted_sse(&self, yhat: &[f64], k0: usize, k1: usize) -> f64 {
         let p = self.p;
@@ -157,14 +181,28 @@ fn flat(v: &[Vec<f64>]) -> Vec<f64> {
 /// Diagnoses `rec` against nominal model `sys`.
 pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<Report, DiscoveryError> {
     if !(0.2..=0.95).contains(&s.estimation_fraction) {
-        return Err(DiscoveryError::BadSetting { field: "estimation_fraction", value: s.estimation_fraction, reason: "must lie in [0.2, 0.95]" });
+        return Err(DiscoveryError::BadSetting {
+            field: "estimation_fraction",
+            value: s.estimation_fraction,
+            reason: "must lie in [0.2, 0.95]",
+        });
     }
     let (m, p) = (rec.m(), rec.p());
     if sys.m() != m {
-        return Err(DiscoveryError::DimensionMismatch { what: "inputs m", model: sys.m(), recording: m, columns: "w columns".into() });
+        return Err(DiscoveryError::DimensionMismatch {
+            what: "inputs m",
+            model: sys.m(),
+            recording: m,
+            columns: "w columns".into(),
+        });
     }
     if sys.p() != p {
-        return Err(DiscoveryError::DimensionMismatch { what: "outputs p", model: sys.p(), recording: p, columns: "y columns".into() });
+        return Err(DiscoveryError::DimensionMismatch {
+            what: "outputs p",
+            model: sys.p(),
+            recording: p,
+            columns: "y columns".into(),
+        });
     }
     let mu = sys.mu();
     if !(mu < 0.0) {
@@ -180,7 +218,8 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let y = flat(&rec.y);
     let k_est = ((n_samp as f64) * s.estimation_fraction).round() as usize;
     let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
-    let substeps = if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, s.max_substeps.max(1)) } else { 1 };
+    let substeps =
+        if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, s.max_substeps.max(1)) } else { 1 };
     let range = |v: &[f64], c: usize, j: usize| {
         let lo = (0..v.len() / c).map(|k| v[k * c + j]).fold(f64::INFINITY, f64::min);
         let hi = (0..v.len() / c).map(|k| v[k * c + j]).fold(f64::NEG_INFINITY, f64::max);
@@ -205,7 +244,8 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     // Initial state: minimum-norm solution of C x0 = y_0; scales from a nominal run.
     let C = &sys.C;
     let y0 = nalgebra::DVector::from_column_slice(&y[..p]);
-    let x0_init: Vec<f64> = C.clone().pseudo_inverse(1e-12).map(|pi| (pi * y0).iter().copied().collect()).unwrap_or(vec![0.0; sys.n()]);
+    let x0_init: Vec<f64> =
+        C.clone().pseudo_inverse(1e-12).map(|pi| (pi * y0).iter().copied().collect()).unwrap_or(vec![0.0; sys.n()]);
     let nominal_ext = ExtendedModel::from_maps(sys, &[], maps.clone(), substeps)?;
     let probe = nominal_ext.simulate(&w, dt, &x0_init);
     let xmax = probe.x_rms.iter().copied().fold(0.0, f64::max).max(1e-9);
@@ -233,7 +273,8 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             t = Some(match t {
                 None => ti,
                 Some(prev) => {
-                    let (white, unc, zm) = (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
+                    let (white, unc, zm) =
+                        (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
                     ResidualTests { white, uncorrelated: unc, zero_mean: zm, ..prev }
                 }
             });
@@ -253,7 +294,14 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         let r: FitResult = fit::fit(&pb, x0, &ctx.x_scale, warm.as_deref(), &s.fit);
         let (val, val_sse) = match pb.simulate(&r.theta, &r.x0, None) {
             Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
-            None => (Fit { fit_percent: vec![f64::NEG_INFINITY; p], rmse: vec![f64::INFINITY; p], velocity_fit_percent: vec![f64::NEG_INFINITY; p] }, f64::INFINITY),
+            None => (
+                Fit {
+                    fit_percent: vec![f64::NEG_INFINITY; p],
+                    rmse: vec![f64::INFINITY; p],
+                    velocity_fit_percent: vec![f64::NEG_INFINITY; p],
+                },
+                f64::INFINITY,
+            ),
         };
         let k = pb.k() + nx;
         let b = select::bic(r.sse, n_res, k);
@@ -289,21 +337,36 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let mut ties = Vec::new();
     if !nominal_adequate {
         if let Some(best) = singles.iter().find(|r| r.beats_nominal) {
-            ties = singles.iter().filter(|r| r.label != best.label && r.beats_nominal && (r.bic - best.bic).abs() < s.select.tie_bic).map(|r| r.label.clone()).collect();
+            ties = singles
+                .iter()
+                .filter(|r| r.label != best.label && r.beats_nominal && (r.bic - best.bic).abs() < s.select.tie_bic)
+                .map(|r| r.label.clone())
+                .collect();
             let mut cur = best.clone();
             // Greedy forward selection.
             while cur.parts.len() < s.max_effects {
-                let seconds: Vec<&Ranked> = singles.iter().filter(|r| !cur.parts.iter().any(|p| p.kind.name() == r.parts[0].kind.name())).take(s.max_second).collect();
+                let seconds: Vec<&Ranked> = singles
+                    .iter()
+                    .filter(|r| !cur.parts.iter().any(|p| p.kind.name() == r.parts[0].kind.name()))
+                    .take(s.max_second)
+                    .collect();
                 let combos: Vec<Ranked> = {
                     let f = |r: &&Ranked| {
                         let mut parts = cur.parts.clone();
                         parts.push(r.parts[0].clone());
                         run_one(parts, vec![], Some(cur.params.clone()), &cur.x0)
                     };
-                    if s.parallel { seconds.par_iter().map(f).collect() } else { seconds.iter().map(f).collect() }
+                    if s.parallel {
+                        seconds.par_iter().map(f).collect()
+                    } else {
+                        seconds.iter().map(f).collect()
+                    }
                 };
                 ranking.extend(combos.iter().cloned());
-                let next = combos.into_iter().filter(|c| select::beats(c.bic, c.val_sse, cur.bic, cur.val_sse, &s.select)).min_by(|a, b| a.bic.total_cmp(&b.bic));
+                let next = combos
+                    .into_iter()
+                    .filter(|c| select::beats(c.bic, c.val_sse, cur.bic, cur.val_sse, &s.select))
+                    .min_by(|a, b| a.bic.total_cmp(&b.bic));
                 match next {
                     Some(nx) => cur = nx,
                     None => break,
@@ -344,7 +407,12 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                         label: h.kind.label(),
                         description: h.kind.description(),
                         params: h.names.iter().zip(&c.params[off..off + k]).map(|(n, v)| (n.to_string(), *v)).collect(),
-                        uncertainty: h.names.iter().zip(&c.std[off..off + k]).map(|(n, v)| (n.to_string(), *v)).collect(),
+                        uncertainty: h
+                            .names
+                            .iter()
+                            .zip(&c.std[off..off + k])
+                            .map(|(n, v)| (n.to_string(), *v))
+                            .collect(),
                     };
                     off += k;
                     fe
@@ -354,19 +422,34 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         None => vec![],
     };
     let verdict = if nominal_adequate {
-        "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)".to_string()
+        "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)"
+            .to_string()
     } else if let Some(c) = &chosen {
-        format!("missing physics: {} (validation fit {} -> {} %)", c.label, fmt_vec(&fit_before.fit_percent), fmt_vec(&fit_after.fit_percent))
+        format!(
+            "missing physics: {} (validation fit {} -> {} %)",
+            c.label,
+            fmt_vec(&fit_before.fit_percent),
+            fmt_vec(&fit_after.fit_percent)
+        )
     } else {
         "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC and validation): the mismatch is outside the library".to_string()
     };
     if fit_before.fit_percent.iter().any(|f| *f > 97.0) {
         notes.push("Plain fit % is above 97 % (a tightly tracking loop saturates it): judge by the RMSE ratio (validation_ratio), the velocity fit and BIC instead.".into());
     }
-    if matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset)) || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset")) {
+    if matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset))
+        || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset"))
+    {
         notes.push("A constant force b on state j and a sensor offset C F^{-1} e_j b are observationally equivalent when the initial state is free (the play is translation invariant): the recording cannot tell them apart; physics must.".into());
     }
-    let series = Series { t: (0..n_samp).map(|k| rec.time(k)).collect(), p, y: ctx.y.clone(), yhat_nominal: nom_sim.y.clone(), yhat_fitted: fit_sim.y.clone(), energy: loc.energy.clone() };
+    let series = Series {
+        t: (0..n_samp).map(|k| rec.time(k)).collect(),
+        p,
+        y: ctx.y.clone(),
+        yhat_nominal: nom_sim.y.clone(),
+        yhat_fitted: fit_sim.y.clone(),
+        energy: loc.energy.clone(),
+    };
     let _ = ctx.n;
     Ok(Report {
         model: sys.name.clone(),
@@ -419,8 +502,18 @@ impl Report {
             self.samples, self.dt, if self.resampled { " (resampled from irregular stamps)" } else { "" }, self.substeps, self.estimation_segment[0], self.estimation_segment[1], self.validation_segment[0], self.validation_segment[1], self.tau_slow
         );
         s += "## Fit on the validation segment\n\n| | fit % | RMSE | velocity fit % |\n|---|---|---|---|\n";
-        s += &format!("| nominal | {} | {} | {} |\n", fmt_vec(&self.fit_before.fit_percent), fmt_e(&self.fit_before.rmse), fmt_vec(&self.fit_before.velocity_fit_percent));
-        s += &format!("| fitted | {} | {} | {} |\n\n", fmt_vec(&self.fit_after.fit_percent), fmt_e(&self.fit_after.rmse), fmt_vec(&self.fit_after.velocity_fit_percent));
+        s += &format!(
+            "| nominal | {} | {} | {} |\n",
+            fmt_vec(&self.fit_before.fit_percent),
+            fmt_e(&self.fit_before.rmse),
+            fmt_vec(&self.fit_before.velocity_fit_percent)
+        );
+        s += &format!(
+            "| fitted | {} | {} | {} |\n\n",
+            fmt_vec(&self.fit_after.fit_percent),
+            fmt_e(&self.fit_after.rmse),
+            fmt_vec(&self.fit_after.velocity_fit_percent)
+        );
         s += "## Residual tests (nominal model)\n\n";
         let r = &self.residual_nominal;
         s += &format!(
@@ -430,11 +523,26 @@ impl Report {
         );
         s += "## Where the mismatch is\n\n| regime | share of time | share of residual energy | enrichment |\n|---|---|---|---|\n";
         for g in &self.regimes {
-            s += &format!("| {} | {:.1} % | {:.1} % | {:.2} |\n", g.regime, 100.0 * g.share_time, 100.0 * g.share_energy, g.enrichment);
+            s += &format!(
+                "| {} | {:.1} % | {:.1} % | {:.2} |\n",
+                g.regime,
+                100.0 * g.share_time,
+                100.0 * g.share_energy,
+                g.enrichment
+            );
         }
         s += "\n| window | start (s) | end (s) | share of energy | share of time | dominant regime |\n|---|---|---|---|---|---|\n";
         for (i, w) in self.windows.iter().enumerate() {
-            s += &format!("| {} | {:.4} | {:.4} | {:.1} % | {:.1} % | {} ({:.0} %) |\n", i + 1, w.t_start, w.t_end, 100.0 * w.share_energy, 100.0 * w.share_time, w.dominant_regime, 100.0 * w.dominant_fraction);
+            s += &format!(
+                "| {} | {:.4} | {:.4} | {:.1} % | {:.1} % | {} ({:.0} %) |\n",
+                i + 1,
+                w.t_start,
+                w.t_end,
+                100.0 * w.share_energy,
+                100.0 * w.share_time,
+                w.dominant_regime,
+                100.0 * w.dominant_fraction
+            );
         }
         s += "\n## Effects added\n\n";
         if self.effects.is_empty() {
@@ -443,15 +551,28 @@ impl Report {
         for e in &self.effects {
             s += &format!("- **{}**: {}\n", e.label, e.description);
             for ((n, v), (_, u)) in e.params.iter().zip(&e.uncertainty) {
-                s += &format!("  - {n} = {v:.6} +- {u:.2e} (1 sigma, Gauss-Newton; optimistic if residuals are coloured)\n");
+                s += &format!(
+                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma, Gauss-Newton; optimistic if residuals are coloured)\n"
+                );
             }
         }
         if !self.ties.is_empty() {
-            s += &format!("\nIndistinguishable on this recording (BIC within the tie margin): {}.\n", self.ties.join(", "));
+            s += &format!(
+                "\nIndistinguishable on this recording (BIC within the tie margin): {}.\n",
+                self.ties.join(", ")
+            );
         }
         s += "\n## Ranking of all hypotheses\n\n| hypothesis | params | delta BIC | validation fit % | validation SSE ratio | accepted vs nominal |\n|---|---|---|---|---|---|\n";
         for r in &self.ranking {
-            s += &format!("| {} | {} | {:.1} | {} | {:.3} | {} |\n", r.label, fmt_e(&r.params), r.delta_bic, fmt_vec(&r.validation.fit_percent), r.validation_ratio, r.beats_nominal);
+            s += &format!(
+                "| {} | {} | {:.1} | {} | {:.3} | {} |\n",
+                r.label,
+                fmt_e(&r.params),
+                r.delta_bic,
+                fmt_vec(&r.validation.fit_percent),
+                r.validation_ratio,
+                r.beats_nominal
+            );
         }
         if !self.notes.is_empty() {
             s += "\n## Notes\n\n";

@@ -19,7 +19,9 @@ pub enum DiscoveryError {
     TooFewSamples { path: String, rows: usize, min: usize },
     #[error("recording lasts {duration} s, shorter than 3 x the model's slowest time constant ({tau_slow} s): the dynamics cannot be seen")]
     TooShort { duration: f64, tau_slow: f64 },
-    #[error("model and recording disagree: the model has {what} = {model} but the recording has {recording} ({columns})")]
+    #[error(
+        "model and recording disagree: the model has {what} = {model} but the recording has {recording} ({columns})"
+    )]
     DimensionMismatch { what: &'static str, model: usize, recording: usize, columns: String },
     #[error("the model is not stable (max Re eig(F) = {mu}); a free-run simulation fit is meaningless")]
     Unstable { mu: f64 },

@@ -99,7 +99,10 @@ impl Hypothesis {
     pub fn effect(&self, theta: &[f64], s: &Scales) -> Effect {
         let _ = s;
         match self.kind {
-            Kind::Backlash { at_input } => Effect::Backlash { width: theta[0].max(0.0), location: if at_input { PlayLocation::Input } else { PlayLocation::Loop } },
+            Kind::Backlash { at_input } => Effect::Backlash {
+                width: theta[0].max(0.0),
+                location: if at_input { PlayLocation::Input } else { PlayLocation::Loop },
+            },
             Kind::GapWidth => Effect::GapWidth { relative_change: theta[0] },
             Kind::CoulombFriction { state } => Effect::CoulombFriction { state, level: theta[0].max(0.0) },
             Kind::ConstantForce { state } => Effect::ConstantForce { state, force: theta[0] },
@@ -148,7 +151,13 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
     let e_nonzero = sys.E.iter().any(|v| *v != 0.0);
     let yr = s.y_range.iter().copied().fold(0.0, f64::max).max(1e-12);
     let wr = s.w_range.iter().copied().fold(0.0, f64::max).max(1e-12);
-    let one = |kind, lo: f64, hi: f64, name| Hypothesis { kind, lower: vec![lo], upper: vec![hi], starts: vec![vec![0.1], vec![0.4], vec![0.8]], names: vec![name] };
+    let one = |kind, lo: f64, hi: f64, name| Hypothesis {
+        kind,
+        lower: vec![lo],
+        upper: vec![hi],
+        starts: vec![vec![0.1], vec![0.4], vec![0.8]],
+        names: vec![name],
+    };
     let mut out = Vec::new();
     if point && e_nonzero {
         out.push(one(Kind::Backlash { at_input: false }, 0.0, 0.5 * yr, "width"));

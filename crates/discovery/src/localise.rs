@@ -72,7 +72,16 @@ fn percentile(a: &[f64], q: f64) -> f64 {
 }
 
 /// Regime masks (name, mask) for a recording.
-pub fn regimes(t0: f64, dt: f64, y: &[f64], p: usize, w: &[f64], m: usize, contact: Option<&[bool]>, half_width: usize) -> Vec<(String, Vec<bool>)> {
+pub fn regimes(
+    t0: f64,
+    dt: f64,
+    y: &[f64],
+    p: usize,
+    w: &[f64],
+    m: usize,
+    contact: Option<&[bool]>,
+    half_width: usize,
+) -> Vec<(String, Vec<bool>)> {
     let _ = t0;
     let n = y.len() / p;
     let sw = (n / 200).max(5);
@@ -81,7 +90,8 @@ pub fn regimes(t0: f64, dt: f64, y: &[f64], p: usize, w: &[f64], m: usize, conta
     for i in 0..p {
         let yi: Vec<f64> = (0..n).map(|k| y[k * p + i]).collect();
         let ys = moving_average(&yi, sw);
-        let v: Vec<f64> = (0..n).map(|k| if k == 0 || k + 1 == n { 0.0 } else { (ys[k + 1] - ys[k - 1]) / (2.0 * dt) }).collect();
+        let v: Vec<f64> =
+            (0..n).map(|k| if k == 0 || k + 1 == n { 0.0 } else { (ys[k + 1] - ys[k - 1]) / (2.0 * dt) }).collect();
         let vs = moving_average(&v, sw);
         let vscale = percentile(&vs.iter().map(|x| x.abs()).collect::<Vec<_>>(), 0.5);
         // A reversal: sign change of the smoothed velocity between two samples where the
@@ -98,7 +108,8 @@ pub fn regimes(t0: f64, dt: f64, y: &[f64], p: usize, w: &[f64], m: usize, conta
                 last_sign = s;
             }
         }
-        let a: Vec<f64> = (0..n).map(|k| if k == 0 || k + 1 == n { 0.0 } else { (vs[k + 1] - vs[k - 1]) / (2.0 * dt) }).collect();
+        let a: Vec<f64> =
+            (0..n).map(|k| if k == 0 || k + 1 == n { 0.0 } else { (vs[k + 1] - vs[k - 1]) / (2.0 * dt) }).collect();
         let aa: Vec<f64> = moving_average(&a, sw).iter().map(|x| x.abs()).collect();
         let thr = percentile(&aa, 0.9);
         for k in 0..n {
@@ -126,7 +137,18 @@ pub fn regimes(t0: f64, dt: f64, y: &[f64], p: usize, w: &[f64], m: usize, conta
 }
 
 /// Localises residual `e = y - yhat` (flat, `p` outputs).
-pub fn localise(t0: f64, dt: f64, y: &[f64], e: &[f64], p: usize, w: &[f64], m: usize, contact: Option<&[bool]>, half_width: usize, max_windows: usize) -> Localisation {
+pub fn localise(
+    t0: f64,
+    dt: f64,
+    y: &[f64],
+    e: &[f64],
+    p: usize,
+    w: &[f64],
+    m: usize,
+    contact: Option<&[bool]>,
+    half_width: usize,
+    max_windows: usize,
+) -> Localisation {
     let n = y.len() / p;
     let mut energy = vec![0.0; n];
     for i in 0..p {
@@ -145,7 +167,12 @@ pub fn localise(t0: f64, dt: f64, y: &[f64], e: &[f64], p: usize, w: &[f64], m: 
             let en: f64 = energy.iter().zip(mask).filter(|(_, b)| **b).map(|(e, _)| e).sum();
             let st = cnt as f64 / n as f64;
             let se = en / total;
-            RegimeShare { regime: name.clone(), share_time: st, share_energy: se, enrichment: if st > 0.0 { se / st } else { 0.0 } }
+            RegimeShare {
+                regime: name.clone(),
+                share_time: st,
+                share_energy: se,
+                enrichment: if st > 0.0 { se / st } else { 0.0 },
+            }
         })
         .collect();
     let wlen = (n / 100).max(5);
@@ -180,7 +207,14 @@ pub fn localise(t0: f64, dt: f64, y: &[f64], e: &[f64], p: usize, w: &[f64], m: 
                     best = (name.clone(), frac, lift);
                 }
             }
-            Window { t_start: t0 + dt * s as f64, t_end: t0 + dt * (e - 1) as f64, share_energy: en / total, share_time: (e - s) as f64 / n as f64, dominant_regime: best.0, dominant_fraction: best.1 }
+            Window {
+                t_start: t0 + dt * s as f64,
+                t_end: t0 + dt * (e - 1) as f64,
+                share_energy: en / total,
+                share_time: (e - s) as f64 / n as f64,
+                dominant_regime: best.0,
+                dominant_fraction: best.1,
+            }
         })
         .collect();
     windows.sort_by(|a, b| b.share_energy.total_cmp(&a.share_energy));

@@ -100,15 +100,27 @@ pub enum PlayWidthError {
 
 /// Estimates the play width from positions `y` and per-sample phase labels (see the module
 /// documentation for the formula).
-pub fn estimate_play_width(y: &[f64], phase: &[Phase], s: &PlayWidthSettings) -> Result<PlayWidthEstimate, PlayWidthError> {
+pub fn estimate_play_width(
+    y: &[f64],
+    phase: &[Phase],
+    s: &PlayWidthSettings,
+) -> Result<PlayWidthEstimate, PlayWidthError> {
     if y.len() != phase.len() {
         return Err(PlayWidthError::LengthMismatch { positions: y.len(), phases: phase.len() });
     }
     if !(s.resolution.is_finite() && s.resolution >= 0.0) {
-        return Err(PlayWidthError::BadSetting { field: "resolution", value: s.resolution, reason: "must be finite and non-negative" });
+        return Err(PlayWidthError::BadSetting {
+            field: "resolution",
+            value: s.resolution,
+            reason: "must be finite and non-negative",
+        });
     }
     if s.min_segment_samples == 0 {
-        return Err(PlayWidthError::BadSetting { field: "min_segment_samples", value: 0.0, reason: "must be at least 1" });
+        return Err(PlayWidthError::BadSetting {
+            field: "min_segment_samples",
+            value: 0.0,
+            reason: "must be at least 1",
+        });
     }
     if s.min_cycles == 0 {
         return Err(PlayWidthError::BadSetting { field: "min_cycles", value: 0.0, reason: "must be at least 1" });
@@ -157,7 +169,14 @@ pub fn estimate_play_width(y: &[f64], phase: &[Phase], s: &PlayWidthSettings) ->
     let mean = d.iter().sum::<f64>() / n;
     let spread = if d.len() > 1 { (d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt() } else { 0.0 };
     let u = (spread * spread / n + 2.0 * s.resolution * s.resolution / 12.0).sqrt();
-    Ok(PlayWidthEstimate { width: mean.abs(), std_uncertainty: u, spread, signed_difference: mean, cycle_differences: d, segments })
+    Ok(PlayWidthEstimate {
+        width: mean.abs(),
+        std_uncertainty: u,
+        spread,
+        signed_difference: mean,
+        cycle_differences: d,
+        segments,
+    })
 }
 
 /// The Robonine backlash test stand (roboninecom/Measuring-Backlash-in-Popular-UART-Servos):
@@ -206,9 +225,15 @@ pub mod robonine {
 
     impl StandConfig {
         pub fn from_json_str(text: &str) -> Result<Self, PlayWidthError> {
-            let c: StandConfig = serde_json::from_str(text).map_err(|e| PlayWidthError::BadConfig { reason: e.to_string() })?;
+            let c: StandConfig =
+                serde_json::from_str(text).map_err(|e| PlayWidthError::BadConfig { reason: e.to_string() })?;
             if c.actuated_motors.len() != 2 {
-                return Err(PlayWidthError::BadConfig { reason: format!("actuated_motors has {} entries; the stand has exactly 2 pullers", c.actuated_motors.len()) });
+                return Err(PlayWidthError::BadConfig {
+                    reason: format!(
+                        "actuated_motors has {} entries; the stand has exactly 2 pullers",
+                        c.actuated_motors.len()
+                    ),
+                });
             }
             if c.report_motor_ids.is_empty() {
                 return Err(PlayWidthError::BadConfig { reason: "report_motor_ids is empty".into() });
@@ -228,10 +253,19 @@ pub mod robonine {
     /// Parses a telemetry CSV for the motors `ids`.
     pub fn parse_log(text: &str, source_name: &str, ids: &[u32]) -> Result<StandLog, PlayWidthError> {
         let bad = |reason: String| PlayWidthError::BadLog { source_name: source_name.into(), reason };
-        let mut rdr = csv::ReaderBuilder::new().has_headers(true).flexible(true).trim(csv::Trim::All).from_reader(text.as_bytes());
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
         let header: Vec<String> = rdr.headers().map_err(|e| bad(e.to_string()))?.iter().map(String::from).collect();
-        let col = |name: String| header.iter().position(|h| *h == name).ok_or_else(|| bad(format!("no column `{name}` (header {header:?})")));
-        let cols: Vec<(u32, usize, usize)> = ids.iter().map(|&id| Ok((id, col(format!("target pos ({id})"))?, col(format!("pos ({id})"))?))).collect::<Result<_, PlayWidthError>>()?;
+        let col = |name: String| {
+            header.iter().position(|h| *h == name).ok_or_else(|| bad(format!("no column `{name}` (header {header:?})")))
+        };
+        let cols: Vec<(u32, usize, usize)> = ids
+            .iter()
+            .map(|&id| Ok((id, col(format!("target pos ({id})"))?, col(format!("pos ({id})"))?)))
+            .collect::<Result<_, PlayWidthError>>()?;
         let mut target: BTreeMap<u32, Vec<f64>> = ids.iter().map(|&i| (i, Vec::new())).collect();
         let mut pos = target.clone();
         for (r, rec) in rdr.records().enumerate() {
@@ -246,7 +280,13 @@ pub mod robonine {
                         blank = true;
                         break;
                     }
-                    *slot = v.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| PlayWidthError::BadValue { source_name: source_name.into(), row: r + 2, column: header[c].clone(), value: v.into() })?;
+                    *slot =
+                        v.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| PlayWidthError::BadValue {
+                            source_name: source_name.into(),
+                            row: r + 2,
+                            column: header[c].clone(),
+                            value: v.into(),
+                        })?;
                 }
                 vals.push(pair);
             }
@@ -276,7 +316,10 @@ pub mod robonine {
     pub fn label(log: &StandLog, cfg: &StandConfig, dut: u32, state: LoadState) -> Vec<Phase> {
         let p = &cfg.actuated_motors;
         let near = |id: u32, k: usize, target: f64, tol: f64| (log.pos[&id][k] - target).abs() <= tol;
-        let relaxed = |i: usize, k: usize| (log.target[&p[i].motor_id][k] - p[i].relaxed_target).abs() < 0.5 && near(p[i].motor_id, k, p[i].relaxed_target, p[i].relaxed_tolerance);
+        let relaxed = |i: usize, k: usize| {
+            (log.target[&p[i].motor_id][k] - p[i].relaxed_target).abs() < 0.5
+                && near(p[i].motor_id, k, p[i].relaxed_target, p[i].relaxed_tolerance)
+        };
         let mut last: Option<usize> = None;
         (0..log.rows)
             .map(|k| {
@@ -285,7 +328,9 @@ pub mod robonine {
                     last = None;
                     return Phase::Ignore;
                 }
-                let loaded_by = (0..2).find(|&i| near(p[i].motor_id, k, p[i].stretched_target, p[i].stretched_tolerance) && relaxed(1 - i, k));
+                let loaded_by = (0..2).find(|&i| {
+                    near(p[i].motor_id, k, p[i].stretched_target, p[i].stretched_tolerance) && relaxed(1 - i, k)
+                });
                 if let Some(i) = loaded_by {
                     last = Some(i);
                 }
@@ -317,7 +362,12 @@ pub mod robonine {
     }
 
     /// Runs both estimates for every motor of `report_motor_ids` (resolution: 1 count).
-    pub fn analyse(text: &str, source_name: &str, cfg: &StandConfig, s: &PlayWidthSettings) -> Result<Vec<StandResult>, PlayWidthError> {
+    pub fn analyse(
+        text: &str,
+        source_name: &str,
+        cfg: &StandConfig,
+        s: &PlayWidthSettings,
+    ) -> Result<Vec<StandResult>, PlayWidthError> {
         let mut ids: Vec<u32> = cfg.report_motor_ids.clone();
         ids.extend(cfg.actuated_motors.iter().map(|p| p.motor_id));
         let log = parse_log(text, source_name, &ids)?;
@@ -376,7 +426,12 @@ mod tests {
         let lo = estimate_play_width(&y, &l, &s).unwrap();
         assert_eq!(un.cycle_differences.len(), 12);
         assert!((un.width - 2.0 * delta).abs() < 4.0 * un.std_uncertainty, "{} +- {}", un.width, un.std_uncertainty);
-        assert!((lo.width - 2.0 * (delta + e)).abs() < 4.0 * lo.std_uncertainty, "{} +- {}", lo.width, lo.std_uncertainty);
+        assert!(
+            (lo.width - 2.0 * (delta + e)).abs() < 4.0 * lo.std_uncertainty,
+            "{} +- {}",
+            lo.width,
+            lo.std_uncertainty
+        );
         assert!(un.std_uncertainty > 0.0 && un.std_uncertainty < 0.5);
         // The wrong claim (play = 0, or the loaded width as the play) is rejected.
         assert!(un.width > 10.0 * un.std_uncertainty);
@@ -407,10 +462,21 @@ mod tests {
         assert!(e.to_string().contains("2 positions but 1"), "{e}");
         let e = estimate_play_width(&[1.0; 10], &[Phase::Plus; 10], &PlayWidthSettings::default()).unwrap_err();
         assert!(matches!(e, PlayWidthError::TooFewCycles { found: 0, .. }), "{e}");
-        let ph = [Phase::Plus, Phase::Plus, Phase::Minus, Phase::Minus, Phase::Plus, Phase::Plus, Phase::Minus, Phase::Minus];
-        let e = estimate_play_width(&[1.0, f64::NAN, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0], &ph, &PlayWidthSettings::default()).unwrap_err();
+        let ph = [
+            Phase::Plus,
+            Phase::Plus,
+            Phase::Minus,
+            Phase::Minus,
+            Phase::Plus,
+            Phase::Plus,
+            Phase::Minus,
+            Phase::Minus,
+        ];
+        let e = estimate_play_width(&[1.0, f64::NAN, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0], &ph, &PlayWidthSettings::default())
+            .unwrap_err();
         assert!(e.to_string().contains("sample 1 is NaN"), "{e}");
-        let e = estimate_play_width(&[0.0; 8], &ph, &PlayWidthSettings { resolution: -1.0, ..Default::default() }).unwrap_err();
+        let e = estimate_play_width(&[0.0; 8], &ph, &PlayWidthSettings { resolution: -1.0, ..Default::default() })
+            .unwrap_err();
         assert!(e.to_string().contains("resolution = -1"), "{e}");
     }
 
@@ -425,11 +491,23 @@ mod tests {
         .unwrap();
         let mut text = String::from("timestamp,target pos (5),pos (5),target pos (3),pos (3),target pos (4),pos (4)\n");
         for _ in 0..4 {
-            for (t3, p3, t4, p4, y) in [(2147, 1900, 2347, 2347, 2047), (2147, 2140, 2347, 2347, 2040), (2147, 2145, 2347, 2347, 2040), (1747, 1748, 2347, 2347, 2044), (1747, 1748, 2347, 2347, 2044), (1747, 1748, 1947, 1950, 2054), (1747, 1748, 1947, 1949, 2054), (1747, 1748, 2347, 2347, 2050), (1747, 1748, 2347, 2347, 2050)] {
+            for (t3, p3, t4, p4, y) in [
+                (2147, 1900, 2347, 2347, 2047),
+                (2147, 2140, 2347, 2347, 2040),
+                (2147, 2145, 2347, 2347, 2040),
+                (1747, 1748, 2347, 2347, 2044),
+                (1747, 1748, 2347, 2347, 2044),
+                (1747, 1748, 1947, 1950, 2054),
+                (1747, 1748, 1947, 1949, 2054),
+                (1747, 1748, 2347, 2347, 2050),
+                (1747, 1748, 2347, 2347, 2050),
+            ] {
                 text.push_str(&format!("x,2047,{y},{t3},{p3},{t4},{p4}\n"));
             }
         }
-        let r = robonine::analyse(&text, "synthetic", &cfg, &PlayWidthSettings { resolution: 1.0, ..Default::default() }).unwrap();
+        let r =
+            robonine::analyse(&text, "synthetic", &cfg, &PlayWidthSettings { resolution: 1.0, ..Default::default() })
+                .unwrap();
         assert_eq!(r.len(), 1);
         assert!((r[0].loaded.width - 14.0).abs() < 1e-12, "{:?}", r[0].loaded);
         assert!((r[0].unloaded.width - 6.0).abs() < 1e-12, "{:?}", r[0].unloaded);

@@ -64,16 +64,27 @@ impl Recording {
 
     /// Reads a CSV file.
     pub fn load(path: &Path) -> Result<Self, DiscoveryError> {
-        let text = std::fs::read_to_string(path).map_err(|e| DiscoveryError::Io { path: path.display().to_string(), reason: e.to_string() })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| DiscoveryError::Io { path: path.display().to_string(), reason: e.to_string() })?;
         Self::parse_str(&text, &path.display().to_string())
     }
 
     /// Parses CSV text; `source` names it in errors.
     pub fn parse_str(text: &str, source: &str) -> Result<Self, DiscoveryError> {
         let path = source.to_string();
-        let mut rdr = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).flexible(true).from_reader(text.as_bytes());
-        let header: Vec<String> = rdr.headers().map_err(|e| DiscoveryError::Io { path: path.clone(), reason: e.to_string() })?.iter().map(|s| s.to_string()).collect();
-        let missing = |c: &str| DiscoveryError::MissingColumn { path: path.clone(), column: c.into(), header: header.clone() };
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .from_reader(text.as_bytes());
+        let header: Vec<String> = rdr
+            .headers()
+            .map_err(|e| DiscoveryError::Io { path: path.clone(), reason: e.to_string() })?
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let missing =
+            |c: &str| DiscoveryError::MissingColumn { path: path.clone(), column: c.into(), header: header.clone() };
         let it = header.iter().position(|h| h == "t").ok_or_else(|| missing("t"))?;
         let iw = col_names("w", &header);
         if iw.is_empty() {
@@ -92,13 +103,23 @@ impl Recording {
             let row = r + 2; // 1-based, header is row 1
             let rec = rec.map_err(|e| DiscoveryError::Io { path: path.clone(), reason: e.to_string() })?;
             if rec.len() != header.len() {
-                return Err(DiscoveryError::RowLength { path: path.clone(), row, got: rec.len(), expected: header.len() });
+                return Err(DiscoveryError::RowLength {
+                    path: path.clone(),
+                    row,
+                    got: rec.len(),
+                    expected: header.len(),
+                });
             }
             let get = |i: usize| -> Result<f64, DiscoveryError> {
                 let s = &rec[i];
                 match s.parse::<f64>() {
                     Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(DiscoveryError::NotFinite { path: path.clone(), row, column: header[i].clone(), value: s.to_string() }),
+                    _ => Err(DiscoveryError::NotFinite {
+                        path: path.clone(),
+                        row,
+                        column: header[i].clone(),
+                        value: s.to_string(),
+                    }),
                 }
             };
             let tk = get(it)?;
@@ -194,7 +215,8 @@ mod tests {
 
     #[test]
     fn reads_regular_and_resamples_irregular() {
-        let r = Recording::parse_str(&csv(100, |k| format!("{},{},{}", k as f64 * 0.01, (k as f64).sin(), k)), "a").unwrap();
+        let r = Recording::parse_str(&csv(100, |k| format!("{},{},{}", k as f64 * 0.01, (k as f64).sin(), k)), "a")
+            .unwrap();
         assert!(!r.resampled);
         assert_eq!(r.len(), 100);
         assert!((r.dt - 0.01).abs() < 1e-12);
@@ -214,9 +236,16 @@ mod tests {
     fn bad_inputs_are_named() {
         let e = Recording::parse_str("t,w\n0,1\n", "x").unwrap_err().to_string();
         assert!(e.contains("lacks column `y`"), "{e}");
-        let e = Recording::parse_str(&csv(60, |k| if k == 7 { "0.07,NaN,1".into() } else { format!("{},{},1", k as f64 * 0.01, k) }), "x").unwrap_err().to_string();
+        let e = Recording::parse_str(
+            &csv(60, |k| if k == 7 { "0.07,NaN,1".into() } else { format!("{},{},1", k as f64 * 0.01, k) }),
+            "x",
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("row 9") && e.contains("NaN"), "{e}");
-        let e = Recording::parse_str(&csv(60, |k| format!("{},{},1", if k == 5 { 0.0 } else { k as f64 }, k)), "x").unwrap_err().to_string();
+        let e = Recording::parse_str(&csv(60, |k| format!("{},{},1", if k == 5 { 0.0 } else { k as f64 }, k)), "x")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("increase strictly"), "{e}");
         let e = Recording::parse_str(&csv(60, |k| format!("{},3,{}", k, k)), "x").unwrap_err().to_string();
         assert!(e.contains("constant"), "{e}");

@@ -52,7 +52,8 @@ fn every_effect_at_zero_equals_the_nominal_model() {
         assert!(d < 1e-12, "{e:?} at zero differs by {d}");
     }
     // Negative control: a non-zero effect must differ.
-    let y = ExtendedModel::new(sys, &[Effect::SensorOffset { offset: vec![0.01] }], dt, 2).unwrap().simulate(&w, dt, &x0).y;
+    let y =
+        ExtendedModel::new(sys, &[Effect::SensorOffset { offset: vec![0.01] }], dt, 2).unwrap().simulate(&w, dt, &x0).y;
     assert!((y[0] - nominal[0] - 0.01).abs() < 1e-12);
 }
 
@@ -61,7 +62,13 @@ fn coulomb_friction_sticks_and_slips() {
     // x' = v, v' = -x - 0.2 v + w: a constant push of 0.5 against friction 1.0 never moves it;
     // a push of 2.0 does.
     let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-1.0, -0.2]]\nB = [0.0, 1.0]\nC = [[1.0, 0.0]]\nE = [0.0, 0.0]\n[input]\nkind = \"zero\"\nm = 1\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
-    let sys = model::parse_str(text).or_else(|_| model::parse_str(&text.replace("kind = \"zero\"\nm = 1", "kind = \"sine\"\namplitudes = [0.0]\nomega = 1.0"))).unwrap();
+    let sys = model::parse_str(text)
+        .or_else(|_| {
+            model::parse_str(
+                &text.replace("kind = \"zero\"\nm = 1", "kind = \"sine\"\namplitudes = [0.0]\nomega = 1.0"),
+            )
+        })
+        .unwrap();
     let fric = [Effect::CoulombFriction { state: 1, level: 1.0 }];
     let ext = ExtendedModel::new(&sys, &fric, 0.01, 1).unwrap();
     let stuck = ext.simulate(&vec![0.5; 500], 0.01, &[0.0, 0.0]).y;
@@ -90,12 +97,16 @@ fn bad_input_gives_named_errors() {
     let e = diagnose(sys, &rec, &DiagnoseSettings::default()).unwrap_err();
     assert!(matches!(e, DiscoveryError::TooShort { .. }), "{e}");
     // Dimensions disagree.
-    let text = "t,w1,w2,y\n".to_string() + &(0..100).map(|k| format!("{},{},{},{}\n", k as f64 * 0.1, (k as f64).sin(), (k as f64).cos(), k)).collect::<String>();
+    let text = "t,w1,w2,y\n".to_string()
+        + &(0..100)
+            .map(|k| format!("{},{},{},{}\n", k as f64 * 0.1, (k as f64).sin(), (k as f64).cos(), k))
+            .collect::<String>();
     let rec = Recording::parse_str(&text, "two-inputs.csv").unwrap();
     let e = diagnose(sys, &rec, &DiagnoseSettings::default()).unwrap_err();
     assert!(e.to_string().contains("inputs m"), "{e}");
     // Bad settings.
-    let e = diagnose(sys, &case.recording, &DiagnoseSettings { estimation_fraction: 1.5, ..Default::default() }).unwrap_err();
+    let e = diagnose(sys, &case.recording, &DiagnoseSettings { estimation_fraction: 1.5, ..Default::default() })
+        .unwrap_err();
     assert!(e.to_string().contains("estimation_fraction"), "{e}");
 }
 

@@ -8,7 +8,10 @@ fn data(rel: &str) -> PathBuf {
 
 fn stand(log: &str, cfg: &str) -> Vec<robonine::StandResult> {
     let text = std::fs::read_to_string(data(&format!("robonine-backlash/logs/{log}"))).unwrap();
-    let cfg = robonine::StandConfig::from_json_str(&std::fs::read_to_string(data(&format!("robonine-backlash/{cfg}"))).unwrap()).unwrap();
+    let cfg = robonine::StandConfig::from_json_str(
+        &std::fs::read_to_string(data(&format!("robonine-backlash/{cfg}"))).unwrap(),
+    )
+    .unwrap();
     robonine::analyse(&text, log, &cfg, &PlayWidthSettings { resolution: 1.0, ..Default::default() }).unwrap()
 }
 
@@ -20,7 +23,10 @@ fn robonine_single_sts3215_agrees_with_the_authors() {
     let r = stand("motor_telemetry_single.csv", "analysis_config_m5.json");
     assert_eq!(r.len(), 1);
     let (l, u) = (&r[0].loaded, &r[0].unloaded);
-    eprintln!("STS3215: loaded {:.2} +- {:.2} counts {:?}; unloaded {:.2} +- {:.2} counts {:?}", l.width, l.std_uncertainty, l.cycle_differences, u.width, u.std_uncertainty, u.cycle_differences);
+    eprintln!(
+        "STS3215: loaded {:.2} +- {:.2} counts {:?}; unloaded {:.2} +- {:.2} counts {:?}",
+        l.width, l.std_uncertainty, l.cycle_differences, u.width, u.std_uncertainty, u.cycle_differences
+    );
     assert!(l.cycle_differences.len() >= 5 && u.cycle_differences.len() >= 5);
     assert!((u.width - 7.03).abs() < 3.0 * u.std_uncertainty, "unloaded {} +- {}", u.width, u.std_uncertainty);
     assert!((l.width - 14.78).abs() < 3.0 * l.std_uncertainty, "loaded {} +- {}", l.width, l.std_uncertainty);
@@ -37,18 +43,27 @@ fn robonine_single_sts3215_agrees_with_the_authors() {
 fn robonine_other_configurations_agree_with_the_authors() {
     let r = stand("motor_telemetry_single_3250.csv", "analysis_config_m4.json");
     let (l, u) = (&r[0].loaded, &r[0].unloaded);
-    eprintln!("STS3250: loaded {:.2} +- {:.2}; unloaded {:.2} +- {:.2}", l.width, l.std_uncertainty, u.width, u.std_uncertainty);
+    eprintln!(
+        "STS3250: loaded {:.2} +- {:.2}; unloaded {:.2} +- {:.2}",
+        l.width, l.std_uncertainty, u.width, u.std_uncertainty
+    );
     assert!((u.width - 1.48).abs() < 3.0 * u.std_uncertainty);
     assert!((l.width - 3.78).abs() < 3.0 * l.std_uncertainty);
     let r = stand("motor_telemetry_nocomp2.csv", "analysis_config_m1_m2.json");
     for (x, lp, up) in [(&r[0], 7.00, 5.33), (&r[1], 7.67, 5.25)] {
-        eprintln!("coupled motor {}: loaded {:.2} +- {:.2}; unloaded {:.2} +- {:.2}", x.motor_id, x.loaded.width, x.loaded.std_uncertainty, x.unloaded.width, x.unloaded.std_uncertainty);
+        eprintln!(
+            "coupled motor {}: loaded {:.2} +- {:.2}; unloaded {:.2} +- {:.2}",
+            x.motor_id, x.loaded.width, x.loaded.std_uncertainty, x.unloaded.width, x.unloaded.std_uncertainty
+        );
         assert!((x.unloaded.width - up).abs() < 3.0 * x.unloaded.std_uncertainty);
         assert!((x.loaded.width - lp).abs() < 3.0 * x.loaded.std_uncertainty);
     }
     // The STS3250 play is resolved as smaller than the STS3215 one.
     let s = stand("motor_telemetry_single.csv", "analysis_config_m5.json");
-    assert!(s[0].unloaded.width - u.width > 3.0 * (s[0].unloaded.std_uncertainty.powi(2) + u.std_uncertainty.powi(2)).sqrt());
+    assert!(
+        s[0].unloaded.width - u.width
+            > 3.0 * (s[0].unloaded.std_uncertainty.powi(2) + u.std_uncertainty.powi(2)).sqrt()
+    );
 }
 
 /// BAM XL330 pendulum at kp = 100 (the logs where the linear class applies: torque on,
@@ -60,7 +75,8 @@ fn robonine_other_configurations_agree_with_the_authors() {
 /// (~0.5 rad) is NOT a gear play: see data/bam-servo/SOURCE.md (stiction dead zone).
 #[test]
 fn bam_xl330_kp100_diagnosis_is_stable() {
-    let sys = model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/real/bam-xl330-kp100.toml")).unwrap();
+    let sys = model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/real/bam-xl330-kp100.toml"))
+        .unwrap();
     let mut widths = Vec::new();
     for log in ["xl330-kp100-sin_sin.csv", "xl330-kp100-sin_time_square.csv"] {
         let rec = discovery::Recording::load(&data(&format!("bam-servo/{log}"))).unwrap();

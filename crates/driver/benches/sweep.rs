@@ -20,7 +20,14 @@ fn bench(c: &mut Criterion) {
     g.bench_function("point_worked_example_a1_theta_only", |b| b.iter(|| bound_only.evaluate(&sys).unwrap()));
     let tmp = tempfile::tempdir().unwrap();
     g.bench_function("sweep_10_points_2_threads", |b| {
-        b.iter(|| driver::sweep::run(&spec, &ev, &RunOptions { out: tmp.path().to_path_buf(), threads: Some(2), fresh: true, ..Default::default() }).unwrap())
+        b.iter(|| {
+            driver::sweep::run(
+                &spec,
+                &ev,
+                &RunOptions { out: tmp.path().to_path_buf(), threads: Some(2), fresh: true, ..Default::default() },
+            )
+            .unwrap()
+        })
     });
     g.finish();
 }

@@ -10,7 +10,8 @@ fn load(name: &str) -> model::System {
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("theta");
     g.sample_size(10);
-    for file in ["worked-example.toml", "worked-example-a5.toml", "ellipse-p2.toml", "lens-p2.toml", "polytope-p2.toml"] {
+    for file in ["worked-example.toml", "worked-example-a5.toml", "ellipse-p2.toml", "lens-p2.toml", "polytope-p2.toml"]
+    {
         let sys = load(file);
         let full = ThetaSettings::default();
         let bound = ThetaSettings::bound_only();

@@ -8,10 +8,13 @@ use std::path::{Path, PathBuf};
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create directory {}", dir.display()))?;
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
     tmp.write_all(bytes).with_context(|| format!("cannot write {}", path.display()))?;
     tmp.as_file().sync_all().ok();
-    tmp.persist(path).map_err(|e| e.error).with_context(|| format!("cannot move the finished file to {}", path.display()))?;
+    tmp.persist(path)
+        .map_err(|e| e.error)
+        .with_context(|| format!("cannot move the finished file to {}", path.display()))?;
     Ok(())
 }
 
@@ -27,7 +30,10 @@ impl StagedDir {
     pub fn new(out: &Path) -> Result<Self> {
         let parent = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create directory {}", parent.display()))?;
-        let stage = tempfile::Builder::new().prefix(".moreau-staging-").tempdir_in(parent).with_context(|| format!("cannot create a staging directory in {}", parent.display()))?;
+        let stage = tempfile::Builder::new()
+            .prefix(".moreau-staging-")
+            .tempdir_in(parent)
+            .with_context(|| format!("cannot create a staging directory in {}", parent.display()))?;
         Ok(Self { out: out.to_path_buf(), stage: Some(stage) })
     }
     /// Path of a file inside the staging directory.
@@ -37,11 +43,13 @@ impl StagedDir {
     /// Moves every staged file into the output directory (each by an atomic rename).
     pub fn commit(mut self) -> Result<()> {
         let stage = self.stage.take().expect("commit once");
-        std::fs::create_dir_all(&self.out).with_context(|| format!("cannot create directory {}", self.out.display()))?;
+        std::fs::create_dir_all(&self.out)
+            .with_context(|| format!("cannot create directory {}", self.out.display()))?;
         for entry in std::fs::read_dir(stage.path())? {
             let entry = entry?;
             let dest = self.out.join(entry.file_name());
-            std::fs::rename(entry.path(), &dest).with_context(|| format!("cannot move {} into place", dest.display()))?;
+            std::fs::rename(entry.path(), &dest)
+                .with_context(|| format!("cannot move {} into place", dest.display()))?;
         }
         Ok(())
     }

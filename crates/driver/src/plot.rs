@@ -87,13 +87,19 @@ where
         .map_err(|e| anyhow!("plot: {e:?}"))?;
     for &(a, b) in &p.windows {
         chart
-            .draw_series(std::iter::once(Rectangle::new([(a.max(x0), y0), (b.min(x1), y1)], RGBColor(200, 200, 200).mix(0.35).filled())))
+            .draw_series(std::iter::once(Rectangle::new(
+                [(a.max(x0), y0), (b.min(x1), y1)],
+                RGBColor(200, 200, 200).mix(0.35).filled(),
+            )))
             .map_err(|e| anyhow!("plot: {e:?}"))?;
     }
     for (i, s) in p.series.iter().enumerate() {
         let c = Palette99::pick(i).to_rgba();
         chart
-            .draw_series(LineSeries::new(s.x.iter().zip(&s.y).filter(|(x, y)| x.is_finite() && y.is_finite()).map(|(&x, &y)| (x, y)), c.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                s.x.iter().zip(&s.y).filter(|(x, y)| x.is_finite() && y.is_finite()).map(|(&x, &y)| (x, y)),
+                c.stroke_width(2),
+            ))
             .map_err(|e| anyhow!("plot: {e:?}"))?
             .label(s.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
@@ -112,7 +118,11 @@ where
 }
 
 fn size(p: &LinePlot) -> (u32, u32) {
-    if p.size.0 == 0 || p.size.1 == 0 { (1000, 600) } else { p.size }
+    if p.size.0 == 0 || p.size.1 == 0 {
+        (1000, 600)
+    } else {
+        p.size
+    }
 }
 
 /// The plot as an SVG document.
@@ -144,7 +154,10 @@ mod tests {
             title: "test".into(),
             x_label: "t".into(),
             y_label: "y".into(),
-            series: vec![Series { label: "sin".into(), x: x.clone(), y: x.iter().map(|t| t.sin()).collect() }, Series { label: "cos".into(), x: x.clone(), y: x.iter().map(|t| t.cos()).collect() }],
+            series: vec![
+                Series { label: "sin".into(), x: x.clone(), y: x.iter().map(|t| t.sin()).collect() },
+                Series { label: "cos".into(), x: x.clone(), y: x.iter().map(|t| t.cos()).collect() },
+            ],
             windows: vec![(1.0, 2.0)],
             size: (0, 0),
         };

@@ -45,7 +45,15 @@ pub struct Quantity {
 }
 
 impl Quantity {
-    pub fn new(key: &'static str, symbol: &'static str, label: &'static str, value: f64, kind: BoundKind, verified: bool, note: impl Into<String>) -> Self {
+    pub fn new(
+        key: &'static str,
+        symbol: &'static str,
+        label: &'static str,
+        value: f64,
+        kind: BoundKind,
+        verified: bool,
+        note: impl Into<String>,
+    ) -> Self {
         Self { key, symbol, label, value, kind, verified, note: note.into() }
     }
 }
@@ -55,7 +63,11 @@ pub fn fmt_value(v: f64) -> String {
     if v.is_nan() {
         "n/a".into()
     } else if v.is_infinite() {
-        if v > 0.0 { "inf".into() } else { "-inf".into() }
+        if v > 0.0 {
+            "inf".into()
+        } else {
+            "-inf".into()
+        }
     } else if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e5) {
         format!("{v:.6}")
     } else {
@@ -68,7 +80,10 @@ pub fn render_table(rows: &[Quantity]) -> String {
     let mut s = String::new();
     let w_sym = rows.iter().map(|q| q.symbol.len()).max().unwrap_or(6).max(6);
     let w_lab = rows.iter().map(|q| q.label.len()).max().unwrap_or(5).max(5);
-    s.push_str(&format!("{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n", "symbol", "eq.", "value", "kind", "verified", "how"));
+    s.push_str(&format!(
+        "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
+        "symbol", "eq.", "value", "kind", "verified", "how"
+    ));
     for q in rows {
         s.push_str(&format!(
             "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",

@@ -2,13 +2,27 @@
 use std::process::Command;
 
 fn moreau(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_moreau")).args(args).current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).output().unwrap();
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    let out = Command::new(env!("CARGO_BIN_EXE_moreau"))
+        .args(args)
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 #[test]
 fn validate_prints_summaries_of_the_examples() {
-    let (code, out, err) = moreau(&["validate", "examples/worked-example.toml", "examples/ellipse-p2.toml", "examples/ellipsoid-p3.toml", "examples/polytope-p2.toml"]);
+    let (code, out, err) = moreau(&[
+        "validate",
+        "examples/worked-example.toml",
+        "examples/ellipse-p2.toml",
+        "examples/ellipsoid-p3.toml",
+        "examples/polytope-p2.toml",
+    ]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("n = 2, m = 1, p = 1") && out.contains("mu:      -0.300000"), "{out}");
     assert!(out.contains("R:       0.1 (exact)"), "{out}");
@@ -19,9 +33,14 @@ fn validate_prints_summaries_of_the_examples() {
 #[test]
 fn bad_files_give_one_line_errors_and_nonzero_exit() {
     let dir = tempfile::tempdir().unwrap();
-    let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml")).unwrap();
+    let good =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml")).unwrap();
     let cases = [
-        ("a23.toml", good.replace("A = [[0.0, 1.0], [-2.0, -0.6]]", "A = [[0.0, 1.0, 0.0], [-2.0, -0.6, 0.0]]"), "plant.A"),
+        (
+            "a23.toml",
+            good.replace("A = [[0.0, 1.0], [-2.0, -0.6]]", "A = [[0.0, 1.0, 0.0], [-2.0, -0.6, 0.0]]"),
+            "plant.A",
+        ),
         ("nan.toml", good.replace("[-2.0, -0.6]", "[-2.0, nan]"), "plant.A[1][1]"),
         ("str.toml", good.replace("half_width = 0.1", "half_width = \"x\""), "theta.half_width"),
         ("shape.toml", good.replace("shape = \"interval\"", "shape = \"banana\""), "banana"),

@@ -32,10 +32,12 @@ fn path_bounds_on_a_circle() {
     // Unit circle sampled at 720 points (closed): (path1) with d = 0 is the inscribed polygon's
     // perimeter, (path) the diameter; with d = 2.5 > osc every bound vanishes.
     let K = 720;
-    let pts: Vec<Vec<f64>> = (0..=K).map(|k| {
-        let a = std::f64::consts::TAU * k as f64 / K as f64;
-        vec![a.cos(), a.sin()]
-    }).collect();
+    let pts: Vec<Vec<f64>> = (0..=K)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / K as f64;
+            vec![a.cos(), a.sin()]
+        })
+        .collect();
     let refs: Vec<&[f64]> = pts.iter().map(|p| p.as_slice()).collect();
     let p1 = partition_bound(&refs, 0.0);
     assert!((p1 - std::f64::consts::TAU).abs() < 1e-4, "{p1}");

@@ -38,7 +38,9 @@ fn example_sweep_reproduces_the_committed_latex_table() {
     let r = driver::sweep::SweepResult::read(&out.join("sweep.json")).unwrap();
     let col = |n: &str| r.columns.iter().position(|c| c.name == n).unwrap();
     for p in &r.points {
-        if let (driver::sweep::Cell::Num(theta), driver::sweep::Cell::Num(rate)) = (&p.cells[col("theta")], &p.cells[col("measured_rate")]) {
+        if let (driver::sweep::Cell::Num(theta), driver::sweep::Cell::Num(rate)) =
+            (&p.cells[col("theta")], &p.cells[col("measured_rate")])
+        {
             assert!(theta >= rate, "point {}: theta {theta} below the measured exponent {rate}", p.index);
         }
     }
@@ -74,7 +76,13 @@ fn shards_from_the_cli_merge_to_the_unsharded_table() {
     let oshards = tmp.path().join("oshards");
     assert!(moreau(&["sweep", s(&other), "--out", s(&oshards), "--shard", "1/2", "-q"]).status.success());
     let bad = tmp.path().join("bad");
-    let o = moreau(&["merge", s(&shards.join("sweep-shard-0-of-2.json")), s(&oshards.join("sweep-shard-1-of-2.json")), "--out", s(&bad)]);
+    let o = moreau(&[
+        "merge",
+        s(&shards.join("sweep-shard-0-of-2.json")),
+        s(&oshards.join("sweep-shard-1-of-2.json")),
+        "--out",
+        s(&bad),
+    ]);
     assert_one_line_error(&o, "shards of different specs");
     assert!(!bad.exists());
 }
@@ -124,7 +132,9 @@ fn figures_are_written_as_svg_and_png_with_text() {
         let o = moreau(&["figure", kind, "examples/worked-example.toml", "--out", s(&out)]);
         assert!(o.status.success(), "{kind}: {}", String::from_utf8_lossy(&o.stderr));
     }
-    for (stem, text) in [("fig-psi1", "ψ(γ)"), ("fig-loop", "η_T"), ("trajectory-yz", "y = C x"), ("trajectory-x", "x1")] {
+    for (stem, text) in
+        [("fig-psi1", "ψ(γ)"), ("fig-loop", "η_T"), ("trajectory-yz", "y = C x"), ("trajectory-x", "x1")]
+    {
         let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
         assert!(svg.contains("<text") && svg.contains(text), "{stem}.svg lacks `{text}`");
         let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();

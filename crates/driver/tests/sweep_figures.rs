@@ -54,7 +54,12 @@ fn two_axis_result() -> SweepResult {
     let (a, b) = (vec![1.0, 2.0, 3.0], vec![10.0, 20.0]);
     for (i, x) in a.iter().enumerate() {
         for (j, y) in b.iter().enumerate() {
-            points.push(PointRecord { index: 2 * i + j, params: vec![*x, *y], cells: vec![Cell::Num(x * y), Cell::Num(-x), Cell::Flag(true)], status: "ok".into() });
+            points.push(PointRecord {
+                index: 2 * i + j,
+                params: vec![*x, *y],
+                cells: vec![Cell::Num(x * y), Cell::Num(-x), Cell::Flag(true)],
+                status: "ok".into(),
+            });
         }
     }
     SweepResult {
@@ -62,8 +67,15 @@ fn two_axis_result() -> SweepResult {
         spec_hash: "0".into(),
         model: "m".into(),
         evaluator: "e".into(),
-        axes: vec![AxisInfo { name: "input.amplitude".into(), label: "$a$".into(), values: a }, AxisInfo { name: "input.omega".into(), label: "$w$".into(), values: b }],
-        columns: vec![Column::number("theta", "t"), Column::number("measured_rate", "m"), Column::flag("theta_verified", "v")],
+        axes: vec![
+            AxisInfo { name: "input.amplitude".into(), label: "$a$".into(), values: a },
+            AxisInfo { name: "input.omega".into(), label: "$w$".into(), values: b },
+        ],
+        columns: vec![
+            Column::number("theta", "t"),
+            Column::number("measured_rate", "m"),
+            Column::flag("theta_verified", "v"),
+        ],
         total_points: 6,
         shard: None,
         table: Default::default(),
@@ -84,5 +96,8 @@ fn sweep_figure_has_one_curve_per_column_and_group() {
     let f = sweep_figure(&r, Some("input.omega"), &["theta"]).unwrap();
     assert_eq!(f.elements.iter().filter(|e| matches!(e, Element::Line { .. })).count(), 3);
     assert!(matches!(sweep_figure(&r, Some("plant.A[0][0]"), &["theta"]), Err(FigureError::UnknownAxis { .. })));
-    assert!(matches!(sweep_figure(&r, None, &["theta_verified"]), Err(FigureError::UnknownColumn { .. })), "flags are not plotted");
+    assert!(
+        matches!(sweep_figure(&r, None, &["theta_verified"]), Err(FigureError::UnknownColumn { .. })),
+        "flags are not plotted"
+    );
 }

@@ -1,7 +1,9 @@
 //! The sweep machinery (specs, axes, tables, resume, shards, merge, bad input) driven by a cheap
 //! stand-in evaluator: these tests check the machinery, not the science (the theta evaluator
 //! is exercised in `sweep_cli.rs`).
-use driver::sweep::{self, Cell, Column, FnEvaluator, PointError, RunOptions, Shard, SweepError, SweepResult, SweepSpec};
+use driver::sweep::{
+    self, Cell, Column, FnEvaluator, PointError, RunOptions, Shard, SweepError, SweepResult, SweepSpec,
+};
 use model::{Input, System};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -13,7 +15,11 @@ fn worked_example() -> PathBuf {
 /// A spec file in `dir` with the given `[[axis]]` blocks (TOML text).
 fn spec_in(dir: &Path, axes: &str, extra: &str) -> PathBuf {
     let p = dir.join("spec.toml");
-    std::fs::write(&p, format!("name = \"stand-in sweep\"\nmodel = {:?}\n{axes}\n{extra}", worked_example().display().to_string())).unwrap();
+    std::fs::write(
+        &p,
+        format!("name = \"stand-in sweep\"\nmodel = {:?}\n{axes}\n{extra}", worked_example().display().to_string()),
+    )
+    .unwrap();
     p
 }
 
@@ -28,7 +34,14 @@ fn amplitude(s: &System) -> f64 {
 fn stand_in(calls: &AtomicUsize) -> FnEvaluator<impl Fn(&System) -> Result<Vec<Cell>, PointError> + Sync + '_> {
     FnEvaluator {
         fingerprint: "stand-in v1".into(),
-        columns: vec![Column::number("mu", "$\\mu$"), Column::number("amp", "$a$"), Column::number("a10", "$A_{21}$"), Column::number("R", "$R$"), Column::flag("stable", "stable"), Column::text("note", "note")],
+        columns: vec![
+            Column::number("mu", "$\\mu$"),
+            Column::number("amp", "$a$"),
+            Column::number("a10", "$A_{21}$"),
+            Column::number("R", "$R$"),
+            Column::flag("stable", "stable"),
+            Column::text("note", "note"),
+        ],
         f: move |s: &System| -> Result<Vec<Cell>, PointError> {
             calls.fetch_add(1, Ordering::SeqCst);
             let a = amplitude(s);
@@ -37,7 +50,14 @@ fn stand_in(calls: &AtomicUsize) -> FnEvaluator<impl Fn(&System) -> Result<Vec<C
             }
             use geometry::ConvexSet;
             let mu = s.mu();
-            Ok(vec![Cell::Num(mu), Cell::Num(a), Cell::Num(s.A[(1, 0)]), Cell::Num(s.theta.strong_convexity().upper()), Cell::Flag(mu < 0.0), Cell::Text(format!("a={a}, x"))])
+            Ok(vec![
+                Cell::Num(mu),
+                Cell::Num(a),
+                Cell::Num(s.A[(1, 0)]),
+                Cell::Num(s.theta.strong_convexity().upper()),
+                Cell::Flag(mu < 0.0),
+                Cell::Text(format!("a={a}, x")),
+            ])
         },
     }
 }
@@ -45,7 +65,10 @@ fn stand_in(calls: &AtomicUsize) -> FnEvaluator<impl Fn(&System) -> Result<Vec<C
 const TWO_AXES: &str = "[[axis]]\nparameter = \"input.amplitude\"\nrange = { from = 0.5, to = 5.0, count = 10 }\n[[axis]]\nparameter = \"plant.A[1][0]\"\nvalues = [-2.0, -1.5, -3.0]\n";
 
 fn read_all(dir: &Path, stem: &str) -> Vec<String> {
-    ["json", "csv", "md", "tex"].iter().map(|e| std::fs::read_to_string(dir.join(format!("{stem}.{e}"))).unwrap()).collect()
+    ["json", "csv", "md", "tex"]
+        .iter()
+        .map(|e| std::fs::read_to_string(dir.join(format!("{stem}.{e}"))).unwrap())
+        .collect()
 }
 
 fn opts(out: &Path) -> RunOptions {
@@ -102,17 +125,28 @@ fn tables_do_not_depend_on_the_thread_count() {
     assert!(r.points[3].ok() && !r.points[29].ok() && r.points[29].status.contains("stand-in failure"));
     let csv = std::fs::read_to_string(o1.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 31);
-    assert!(csv.lines().next().unwrap().starts_with("index,input.amplitude,plant.A[1][0],mu,amp,a10,R,stable,note,status"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("index,input.amplitude,plant.A[1][0],mu,amp,a10,R,stable,note,status"));
     assert!(csv.contains("\"a=0.5, x\""), "text with a comma is quoted");
     let tex = std::fs::read_to_string(o1.join("sweep.tex")).unwrap();
-    assert!(tex.contains("\\toprule") && tex.contains("\\midrule") && tex.contains("\\bottomrule") && tex.contains("$A_{21}$"));
+    assert!(
+        tex.contains("\\toprule")
+            && tex.contains("\\midrule")
+            && tex.contains("\\bottomrule")
+            && tex.contains("$A_{21}$")
+    );
     assert_eq!(tex.matches("\\\\\n").count(), 31, "header + 30 rows");
 }
 
 #[test]
 fn digits_option_changes_only_markdown_and_latex() {
     let tmp = tempfile::tempdir().unwrap();
-    let spec = SweepSpec::load(&spec_in(tmp.path(), "[[axis]]\nparameter = \"plant.A[1][0]\"\nvalues = [-2.123456789]\n", "")).unwrap();
+    let spec =
+        SweepSpec::load(&spec_in(tmp.path(), "[[axis]]\nparameter = \"plant.A[1][0]\"\nvalues = [-2.123456789]\n", ""))
+            .unwrap();
     let calls = AtomicUsize::new(0);
     let ev = stand_in(&calls);
     let (o3, o6) = (tmp.path().join("d3"), tmp.path().join("d6"));
@@ -122,7 +156,10 @@ fn digits_option_changes_only_markdown_and_latex() {
     assert_eq!(a[1], b[1], "CSV is exact whatever --digits");
     assert!(a[3].contains("$-2.12$") && b[3].contains("$-2.12346$"));
     assert!(a[2].contains("| -2.12 |") && b[2].contains("| -2.12346 |"));
-    assert!(matches!(sweep::run(&spec, &ev, &RunOptions { digits: Some(0), ..opts(&tmp.path().join("d0")) }), Err(SweepError::BadDigits { digits: 0 })));
+    assert!(matches!(
+        sweep::run(&spec, &ev, &RunOptions { digits: Some(0), ..opts(&tmp.path().join("d0")) }),
+        Err(SweepError::BadDigits { digits: 0 })
+    ));
 }
 
 #[test]
@@ -176,7 +213,8 @@ fn shards_merge_to_the_full_table() {
     let shards = tmp.path().join("shards");
     let mut sizes = vec![];
     for k in 0..4 {
-        let s = sweep::run(&spec, &ev, &RunOptions { shard: Some(Shard::new(k, 4).unwrap()), ..opts(&shards) }).unwrap();
+        let s =
+            sweep::run(&spec, &ev, &RunOptions { shard: Some(Shard::new(k, 4).unwrap()), ..opts(&shards) }).unwrap();
         assert!(s.result.points.iter().all(|p| p.index % 4 == k));
         sizes.push(s.computed);
         assert!(shards.join(format!("sweep-shard-{k}-of-4.json")).exists());
@@ -224,11 +262,20 @@ fn merge_refuses_shards_of_different_specs_and_conflicts() {
     let mut bad = full.clone();
     bad.points[4].cells[0] = Cell::Num(123.0);
     std::fs::write(tmp.path().join("bad.json"), bad.to_json_string()).unwrap();
-    let err = sweep::merge::merge_into(&[good.join("sweep.json"), tmp.path().join("bad.json")], &tmp.path().join("m"), false, None).unwrap_err();
+    let err = sweep::merge::merge_into(
+        &[good.join("sweep.json"), tmp.path().join("bad.json")],
+        &tmp.path().join("m"),
+        false,
+        None,
+    )
+    .unwrap_err();
     assert!(matches!(err, SweepError::MergeConflict { index: 4, .. }), "{err}");
     // not a sweep result
     std::fs::write(tmp.path().join("junk.json"), "{\"a\": 1}").unwrap();
-    assert!(matches!(sweep::merge::merge_into(&[tmp.path().join("junk.json")], &tmp.path().join("m"), false, None), Err(SweepError::BadResultFile { .. })));
+    assert!(matches!(
+        sweep::merge::merge_into(&[tmp.path().join("junk.json")], &tmp.path().join("m"), false, None),
+        Err(SweepError::BadResultFile { .. })
+    ));
 }
 
 #[test]
@@ -240,7 +287,8 @@ fn output_of_another_spec_is_not_overwritten() {
     let out = tmp.path().join("out");
     sweep::run(&s1, &ev, &opts(&out)).unwrap();
     let before = read_all(&out, "sweep");
-    let s2 = SweepSpec::load(&spec_in(tmp.path(), "[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0, 2.0]\n", "")).unwrap();
+    let s2 = SweepSpec::load(&spec_in(tmp.path(), "[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0, 2.0]\n", ""))
+        .unwrap();
     let err = sweep::run(&s2, &ev, &opts(&out)).unwrap_err();
     assert!(matches!(err, SweepError::OtherSpec { .. }), "{err}");
     assert!(err.to_string().contains("--overwrite"));
@@ -288,7 +336,12 @@ fn bad_specs_give_clear_errors() {
 #[test]
 fn unknown_table_column_is_refused_before_any_work() {
     let tmp = tempfile::tempdir().unwrap();
-    let spec = SweepSpec::load(&spec_in(tmp.path(), "[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0]\n", "[table]\ncolumns = [\"mu\", \"nonsense\"]\n")).unwrap();
+    let spec = SweepSpec::load(&spec_in(
+        tmp.path(),
+        "[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0]\n",
+        "[table]\ncolumns = [\"mu\", \"nonsense\"]\n",
+    ))
+    .unwrap();
     let calls = AtomicUsize::new(0);
     let err = sweep::run(&spec, &stand_in(&calls), &opts(&tmp.path().join("o"))).unwrap_err();
     assert!(matches!(&err, SweepError::UnknownColumn { name, .. } if name == "nonsense"), "{err}");

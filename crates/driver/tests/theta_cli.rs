@@ -13,12 +13,26 @@ fn readable_report_and_json() {
     let out = moreau().args(["theta", &example("worked-example.toml"), "--no-measure"]).output().unwrap();
     assert!(out.status.success());
     let s = String::from_utf8(out.stdout).unwrap();
-    for needle in ["(theta)", "(ginf)", "(g1)", "(d),(Xinfsupp)", "(mho),(osc)", "(path1)", "(path2)", "(stat1)", "Verdict: theta = "] {
+    for needle in [
+        "(theta)",
+        "(ginf)",
+        "(g1)",
+        "(d),(Xinfsupp)",
+        "(mho),(osc)",
+        "(path1)",
+        "(path2)",
+        "(stat1)",
+        "Verdict: theta = ",
+    ] {
         assert!(s.contains(needle), "missing {needle} in\n{s}");
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("theta.json");
-    let out = moreau().args(["theta", &example("worked-example.toml"), "--json", "--no-measure", "--out"]).arg(&path).output().unwrap();
+    let out = moreau()
+        .args(["theta", &example("worked-example.toml"), "--json", "--no-measure", "--out"])
+        .arg(&path)
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let f: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
@@ -42,10 +56,14 @@ fn bad_input_one_line_error_nonzero_exit() {
         let out = moreau().arg("theta").arg(&p).output().unwrap();
         assert!(!out.status.success(), "{name}");
         let err = String::from_utf8(out.stderr).unwrap();
-        assert!(err.starts_with("error: ") && err.trim_end().lines().count() == 1 && err.contains(needle), "{name}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.trim_end().lines().count() == 1 && err.contains(needle),
+            "{name}: {err}"
+        );
     }
     // Polytope: an answer exists (theta = psi(0) > 0): exit 0.
-    let out = moreau().args(["theta", &example("polytope-p2.toml"), "--no-measure", "--no-stationary"]).output().unwrap();
+    let out =
+        moreau().args(["theta", &example("polytope-p2.toml"), "--no-measure", "--no-stationary"]).output().unwrap();
     assert!(out.status.success());
     assert!(String::from_utf8(out.stdout).unwrap().contains("not strongly convex"));
 }

@@ -33,7 +33,11 @@ fn config() -> SystemStrategyConfig {
 /// `(name, theta, ci_low, ci_high)` of the verified `theta < 0` cases.
 fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
     let want = wanted();
-    let mut systems = vec![model::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml"))).expect("worked example")];
+    let mut systems = vec![model::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/worked-example.toml"
+    )))
+    .expect("worked example")];
     systems.extend(theorems::strategies::draw(&system_params(&config()), 7, 10 * want).into_iter().map(|c| c.build()));
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let mut out = Vec::new();
@@ -47,7 +51,9 @@ fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
         if !(b.theta < 0.0 && b.theta_verified) {
             continue;
         }
-        let full = assemble(sys, &ThetaSettings { stationary: None, measure: Some(measure.clone()), ..Default::default() }).expect("assembled once already");
+        let full =
+            assemble(sys, &ThetaSettings { stationary: None, measure: Some(measure.clone()), ..Default::default() })
+                .expect("assembled once already");
         let m = full.measured.expect("measured side computed");
         out.push((format!("case {i} (n = {}, mu = {:.3})", sys.n(), full.mu), full.theta, m.ci_low, m.ci_high));
     }
@@ -58,7 +64,10 @@ fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
 fn theta_bounds_measured_exponent_and_control_is_caught() {
     let (cases, tried) = verified_cases();
     for (name, theta, lo, hi) in &cases {
-        eprintln!("{name}: theta = {theta:.5}, measured 95% CI [{lo:.5}, {hi:.5}], slack theta - ci_high = {:.5}", theta - hi);
+        eprintln!(
+            "{name}: theta = {theta:.5}, measured 95% CI [{lo:.5}, {hi:.5}], slack theta - ci_high = {:.5}",
+            theta - hi
+        );
     }
     eprintln!("{} verified theta < 0 cases of {tried} tried", cases.len());
     assert!(cases.len() >= 2, "too few verified theta < 0 cases ({}) to test anything", cases.len());

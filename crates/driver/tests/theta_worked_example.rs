@@ -13,7 +13,12 @@ fn worked_example_theta_is_negative_verified_and_above_the_measured_rate() {
     for (file, expect) in [("worked-example.toml", -0.02), ("worked-example-a5.toml", -0.04)] {
         let sys = load(file);
         let r = assemble(&sys, &ThetaSettings::default()).unwrap();
-        assert!(r.theta < 0.0 && r.theta_verified && r.convergence_guaranteed, "{file}: theta {} verified {}", r.theta, r.theta_verified);
+        assert!(
+            r.theta < 0.0 && r.theta_verified && r.convergence_guaranteed,
+            "{file}: theta {} verified {}",
+            r.theta,
+            r.theta_verified
+        );
         // NOTES.md: an independent computation gives about -0.02 (a = 1) and -0.04 (a = 5).
         assert!((r.theta - expect).abs() < 0.01, "{file}: theta {}", r.theta);
         // Structure of eq. (theta): a convex combination of psi(0) and psi(gamma_inf) > -lambda.
@@ -37,8 +42,25 @@ fn worked_example_theta_is_negative_verified_and_above_the_measured_rate() {
         // JSON has the stable keys.
         let j = r.to_json();
         for k in [
-            "mu", "alpha", "lambda", "beta", "osc", "d", "eta_dot_inf", "d_ftheta", "gamma_1", "gamma_inf", "psi_0", "psi_inf", "theta",
-            "theta_verified", "measured_rate", "path_bound", "path1_bound", "path_measured", "stationary_set_empty",
+            "mu",
+            "alpha",
+            "lambda",
+            "beta",
+            "osc",
+            "d",
+            "eta_dot_inf",
+            "d_ftheta",
+            "gamma_1",
+            "gamma_inf",
+            "psi_0",
+            "psi_inf",
+            "theta",
+            "theta_verified",
+            "measured_rate",
+            "path_bound",
+            "path1_bound",
+            "path_measured",
+            "stationary_set_empty",
         ] {
             assert!(j.get(k).is_some_and(|v| !v.is_null()), "{file}: key {k} missing or null");
         }

@@ -28,7 +28,13 @@ fn reference_p1(sys: &model::System, delta: f64) -> f64 {
             P = expm(&(&F * (k as f64 * h)));
         }
         let v = (&sys.C * &P * &sys.E)[(0, 0)].abs();
-        let w = if k == 0 || k == N { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 };
+        let w = if k == 0 || k == N {
+            1.0
+        } else if k % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
         acc += w * v;
     }
     delta * acc * h / 3.0
@@ -37,7 +43,15 @@ fn reference_p1(sys: &model::System, delta: f64) -> f64 {
 #[test]
 fn xinf_support_encloses_an_independent_quadrature() {
     let sys = load("worked-example.toml");
-    let k = TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Infinite, &TubeSettings { tol_abs: 1e-6, ..Default::default() }).unwrap();
+    let k = TubeKernel::new(
+        &sys.C,
+        &sys.F(),
+        &sys.E,
+        &sys.theta,
+        Horizon::Infinite,
+        &TubeSettings { tol_abs: 1e-6, ..Default::default() },
+    )
+    .unwrap();
     let reference = reference_p1(&sys, 0.1);
     let b = k.support_bounds(&[1.0]);
     assert!(b.lower <= reference + 1e-9 && reference <= b.upper + 1e-9, "{b:?} vs {reference}");
@@ -48,8 +62,10 @@ fn xinf_support_encloses_an_independent_quadrature() {
     let ks = TubeKernel::new(&sys.C, &sys.F(), &sys.E, &small, Horizon::Infinite, &TubeSettings::default()).unwrap();
     assert!(ks.support_upper(&[1.0]) < reference - 1e-4);
     // Finite horizon is below the infinite one and increases with t (0 in Theta).
-    let k5 = TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Finite(5.0), &TubeSettings::default()).unwrap();
-    let k10 = TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Finite(10.0), &TubeSettings::default()).unwrap();
+    let k5 =
+        TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Finite(5.0), &TubeSettings::default()).unwrap();
+    let k10 =
+        TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Finite(10.0), &TubeSettings::default()).unwrap();
     assert!(k5.support_upper(&[1.0]) < k10.support_bounds(&[1.0]).lower);
     assert!(k10.support_upper(&[1.0]) < b.lower);
     assert_eq!(k5.tail_bound(), 0.0);

@@ -15,7 +15,9 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("catching_up");
     g.throughput(Throughput::Elements(STEPS as u64));
     g.sample_size(10);
-    let mut f = FastCatchingUp::<2, 1, Interval>::new(&sys, Interval::symmetric(0.1).unwrap(), &CatchingUpSettings::default()).unwrap();
+    let mut f =
+        FastCatchingUp::<2, 1, Interval>::new(&sys, Interval::symmetric(0.1).unwrap(), &CatchingUpSettings::default())
+            .unwrap();
     g.bench_function("n2_p1_interval", |b| {
         b.iter(|| {
             let mut x = SVector::<f64, 2>::zeros();

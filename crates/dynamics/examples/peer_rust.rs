@@ -9,9 +9,15 @@ use std::time::Instant;
 
 fn main() {
     let a: Vec<usize> = std::env::args().skip(1).map(|s| s.parse().expect("integer arguments")).collect();
-    let (steps, ens, ens_steps) = (a.first().copied().unwrap_or(10_000_000), a.get(1).copied().unwrap_or(1000), a.get(2).copied().unwrap_or(10_000));
+    let (steps, ens, ens_steps) = (
+        a.first().copied().unwrap_or(10_000_000),
+        a.get(1).copied().unwrap_or(1000),
+        a.get(2).copied().unwrap_or(10_000),
+    );
     let sys = model::parse_str(include_str!("../../../examples/worked-example.toml")).unwrap();
-    let mut f = FastCatchingUp::<2, 1, Interval>::new(&sys, Interval::symmetric(0.1).unwrap(), &CatchingUpSettings::default()).unwrap();
+    let mut f =
+        FastCatchingUp::<2, 1, Interval>::new(&sys, Interval::symmetric(0.1).unwrap(), &CatchingUpSettings::default())
+            .unwrap();
     let (mut x, mut z) = (SVector::<f64, 2>::zeros(), SVector::<f64, 1>::zeros());
     let t = Instant::now();
     f.run(0.0, &mut x, &mut z, steps, |_, _, _, _| {});

@@ -32,11 +32,16 @@ pub struct ConvergenceStudy {
 pub fn convergence_study(sys: &model::System, st: &ConvergenceSettings) -> Result<ConvergenceStudy, DynamicsError> {
     crate::error::check_dt(st.h0)?;
     if st.levels < 2 {
-        return Err(DynamicsError::BadSetting { name: "levels", value: st.levels as f64, reason: "needs at least 2 steps to fit an order" });
+        return Err(DynamicsError::BadSetting {
+            name: "levels",
+            value: st.levels as f64,
+            reason: "needs at least 2 steps to fit an order",
+        });
     }
     let n0 = (st.t_end / st.h0).ceil() as usize;
     let h0 = st.t_end / n0 as f64;
-    let (reference, events) = event_driven(sys, &EventDrivenSettings { dt_out: h0, t_end: st.t_end, ..Default::default() })?;
+    let (reference, events) =
+        event_driven(sys, &EventDrivenSettings { dt_out: h0, t_end: st.t_end, ..Default::default() })?;
     let mut hs = Vec::new();
     let mut errs = Vec::new();
     for l in 0..st.levels {
@@ -65,7 +70,9 @@ mod tests {
     #[test]
     fn catching_up_is_first_order_on_the_worked_example() {
         let sys = model::parse_str(include_str!("../../../examples/worked-example.toml")).unwrap();
-        let s = convergence_study(&sys, &ConvergenceSettings { h0: 1e-2, levels: 4, t_end: 4.0 * sys.period().unwrap() }).unwrap();
+        let s =
+            convergence_study(&sys, &ConvergenceSettings { h0: 1e-2, levels: 4, t_end: 4.0 * sys.period().unwrap() })
+                .unwrap();
         assert!(s.order > 0.8 && s.order < 1.3, "{s:?}");
         assert!(s.error.windows(2).all(|w| w[1] < w[0]), "{s:?}");
     }

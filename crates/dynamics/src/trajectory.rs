@@ -69,7 +69,12 @@ impl Trajectory {
 
 /// Simulates `steps` catching-up steps from `(sys.x0, sys.z0)` at `t = 0`, recording every
 /// `record_every`-th state (and the first).
-pub fn simulate_catching_up(sys: &System, settings: &CatchingUpSettings, steps: usize, record_every: usize) -> Result<Trajectory, DynamicsError> {
+pub fn simulate_catching_up(
+    sys: &System,
+    settings: &CatchingUpSettings,
+    steps: usize,
+    record_every: usize,
+) -> Result<Trajectory, DynamicsError> {
     let mut sim = Simulator::new(sys, settings)?;
     let every = record_every.max(1);
     let mut tr = Trajectory::new(sys.n(), sys.m(), sys.p());

@@ -34,12 +34,7 @@ pub trait ConvexSet: std::fmt::Debug + Send + Sync {
     fn dist_to_boundary(&self, x: &[f64]) -> f64 {
         let p = self.dim();
         let lip = self.deviation_from_origin().upper + norm(x);
-        let b = crate::sphere_max(
-            p,
-            |u| -(self.support(u) - dot(u, x)),
-            lip,
-            &crate::SphereMaxSettings::default(),
-        );
+        let b = crate::sphere_max(p, |u| -(self.support(u) - dot(u, x)), lip, &crate::SphereMaxSettings::default());
         (-b.upper).max(0.0)
     }
 

@@ -20,9 +20,8 @@ pub fn dist(a: &[f64], b: &[f64]) -> f64 {
 pub fn solve_small(m: &mut [f64], r: &mut [f64], k: usize, tol: f64) -> bool {
     let scale = m.iter().fold(0.0f64, |a, &b| a.max(b.abs())).max(f64::MIN_POSITIVE);
     for col in 0..k {
-        let (piv, pmax) = (col..k)
-            .map(|i| (i, m[i * k + col].abs()))
-            .fold((col, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+        let (piv, pmax) =
+            (col..k).map(|i| (i, m[i * k + col].abs())).fold((col, -1.0), |a, b| if b.1 > a.1 { b } else { a });
         if pmax <= tol * scale {
             return false;
         }

@@ -123,12 +123,8 @@ pub fn sphere_max(p: usize, mut f: impl FnMut(&[f64]) -> f64, lipschitz: f64, s:
         let half = cell.half / 2.0;
         let h = half * (d as f64).sqrt();
         for m in 0..(1usize << d) {
-            let centre: Vec<f64> = cell
-                .centre
-                .iter()
-                .enumerate()
-                .map(|(j, c)| c + if m >> j & 1 == 1 { half } else { -half })
-                .collect();
+            let centre: Vec<f64> =
+                cell.centre.iter().enumerate().map(|(j, c)| c + if m >> j & 1 == 1 { half } else { -half }).collect();
             let v = eval_cell(cell.face, cell.sign, &centre, &mut u, &mut evals);
             lower = lower.max(v);
             heap.push(Cell { ub: v + lip * h, face: cell.face, sign: cell.sign, centre, half });

@@ -3,7 +3,10 @@ mod common;
 use approx::assert_relative_eq;
 use common::proj;
 use geometry::linalg::{dist, dot, norm};
-use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, LinearImage, MinkowskiSum, Polytope, StrongConvexity, SupportSet};
+use geometry::{
+    Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, LinearImage, MinkowskiSum, Polytope, StrongConvexity,
+    SupportSet,
+};
 use nalgebra::DMatrix;
 use std::sync::Arc;
 
@@ -136,7 +139,8 @@ fn lens_projection_and_r_are_exact() {
     lens.project_normal_cone(&[0.0, 0.8], &[0.0, -1.0], 1e-9, &mut out);
     assert!(dist(&out, &[0.0, -1.0]) < 1e-12, "{out:?}");
     // a redundant big ball does not change R
-    let with_big = BallIntersection::new(vec![vec![-0.6, 0.0], vec![0.6, 0.0], vec![0.0, 0.0]], vec![1.0, 1.0, 5.0]).unwrap();
+    let with_big =
+        BallIntersection::new(vec![vec![-0.6, 0.0], vec![0.6, 0.0], vec![0.0, 0.0]], vec![1.0, 1.0, 5.0]).unwrap();
     assert_eq!(with_big.active(), &[true, true, false]);
     assert_eq!(with_big.strong_convexity(), StrongConvexity::Exact(1.0));
     assert!(BallIntersection::new(vec![vec![-3.0, 0.0], vec![3.0, 0.0]], vec![1.0, 1.0]).is_err());
@@ -146,7 +150,8 @@ fn lens_projection_and_r_are_exact() {
 fn ball_intersection_projection_exact_in_3d_corner() {
     // three unit balls whose spheres meet: project a far point onto the "tip"
     let s = 0.5;
-    let centres = vec![vec![s, 0.0, 0.0], vec![-s / 2.0, s * 0.75f64.sqrt(), 0.0], vec![-s / 2.0, -s * 0.75f64.sqrt(), 0.0]];
+    let centres =
+        vec![vec![s, 0.0, 0.0], vec![-s / 2.0, s * 0.75f64.sqrt(), 0.0], vec![-s / 2.0, -s * 0.75f64.sqrt(), 0.0]];
     let k = BallIntersection::new(centres.clone(), vec![1.0; 3]).unwrap();
     let tip_z = (1.0 - s * s).sqrt();
     let p = proj(&k, &[0.0, 0.0, 10.0]);
@@ -188,7 +193,9 @@ fn linear_image_and_minkowski_sum_via_support_functions() {
     let pe = proj(&e, &x);
     assert!(dist(&pi, &pe) < 1e-7, "{pi:?} vs {pe:?}");
     match img.strong_convexity() {
-        StrongConvexity::Numerical { value, error } => assert!((value - 8.0).abs() <= error.max(1e-4), "{value} +- {error}"),
+        StrongConvexity::Numerical { value, error } => {
+            assert!((value - 8.0).abs() <= error.max(1e-4), "{value} +- {error}")
+        }
         other => panic!("expected a numerical R, got {other:?}"),
     }
     // B_1 + B_2 = B_3
@@ -199,7 +206,11 @@ fn linear_image_and_minkowski_sum_via_support_functions() {
     // 1-D image: an interval, exact R
     let row = LinearImage::new(DMatrix::from_row_slice(1, 2, &[3.0, 4.0]), b).unwrap();
     assert_eq!(row.strong_convexity(), StrongConvexity::Exact(5.0));
-    assert!(MinkowskiSum::new(vec![Box::new(Ball::centred(2, 1.0).unwrap()), Box::new(Interval::symmetric(1.0).unwrap())]).is_err());
+    assert!(MinkowskiSum::new(vec![
+        Box::new(Ball::centred(2, 1.0).unwrap()),
+        Box::new(Interval::symmetric(1.0).unwrap())
+    ])
+    .is_err());
 }
 
 #[test]

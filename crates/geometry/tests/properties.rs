@@ -40,7 +40,11 @@ fn radial_retraction(e: &Ellipsoid, x: &[f64]) -> Vec<f64> {
     let minv = m.try_inverse().unwrap();
     let d = nalgebra::DVector::from_iterator(p, x.iter().zip(c).map(|(a, b)| a - b));
     let level = (d.transpose() * minv * &d)[(0, 0)].sqrt();
-    if level <= 1.0 { x.to_vec() } else { (0..p).map(|i| c[i] + d[i] / level).collect() }
+    if level <= 1.0 {
+        x.to_vec()
+    } else {
+        (0..p).map(|i| c[i] + d[i] / level).collect()
+    }
 }
 
 fn pp_holds(px: &[f64], py: &[f64], x: &[f64], y: &[f64]) -> Result<(), TestCaseError> {
@@ -58,7 +62,9 @@ fn vi_holds(s: &Shape, x: &[f64], px: &[f64]) -> Result<(), TestCaseError> {
     let mut sp = vec![0.0; p];
     let dirs = 24;
     for k in 0..dirs {
-        let u: Vec<f64> = (0..p).map(|i| ((k * (i + 3) + 7 * i) as f64 * 0.7853).sin() + if i == k % p { 0.5 } else { 0.0 }).collect();
+        let u: Vec<f64> = (0..p)
+            .map(|i| ((k * (i + 3) + 7 * i) as f64 * 0.7853).sin() + if i == k % p { 0.5 } else { 0.0 })
+            .collect();
         s.support_point(&u, &mut sp);
         let v = dot(&r, &sp) - dot(&r, px);
         prop_assert!(v <= 1e-10 * (1.0 + norm(&r)), "VI violated: (x-Px).(s-Px) = {v:e} for s = {sp:?}");
@@ -67,7 +73,10 @@ fn vi_holds(s: &Shape, x: &[f64], px: &[f64]) -> Result<(), TestCaseError> {
     if norm(&r) > 0.0 {
         s.support_point(&r, &mut sp);
         let v = dot(&r, &sp) - dot(&r, px);
-        prop_assert!(v <= 1e-9 * (1.0 + norm(&r)) * (1.0 + norm(&sp)), "VI violated at the support point of x - Px: {v:e}");
+        prop_assert!(
+            v <= 1e-9 * (1.0 + norm(&r)) * (1.0 + norm(&sp)),
+            "VI violated at the support point of x - Px: {v:e}"
+        );
     }
     Ok(())
 }

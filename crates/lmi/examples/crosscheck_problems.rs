@@ -64,8 +64,14 @@ fn main() {
             "lambda_verified": cb.certificate.lambda, "iterations": sol.iterations,
             "rust_solve_s": t_solve, "rust_certified_s": t_cert,
         }));
-        println!("seed {:4} n={n} p={p} beta={:.10e} b_hat={:.10e} solve {:.3} ms certified {:.3} ms",
-            1000 + seed, sol.beta, cb.certificate.b_hat, t_solve * 1e3, t_cert * 1e3);
+        println!(
+            "seed {:4} n={n} p={p} beta={:.10e} b_hat={:.10e} solve {:.3} ms certified {:.3} ms",
+            1000 + seed,
+            sol.beta,
+            cb.certificate.b_hat,
+            t_solve * 1e3,
+            t_cert * 1e3
+        );
     }
     std::fs::create_dir_all(&out).expect("create --out dir");
     let path = out.join("problems.json");

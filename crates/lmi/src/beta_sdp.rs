@@ -42,7 +42,7 @@
 //!   solution reports it (`trace_bound_active`) and `beta` is the minimum over the bounded
 //!   set, still a valid bound.
 use crate::error::{LmiError, Result};
-use crate::psd_triangle::{symmetric_basis, sym_from_entries, triangular_number};
+use crate::psd_triangle::{sym_from_entries, symmetric_basis, triangular_number};
 use crate::sdp::{LmiBuilder, SdpSettings, SdpStatus};
 use crate::spectral_abscissa::{check_lambda, check_system, hurwitz_mu};
 use crate::verify::{certify, Certificate, VerifySettings};
@@ -219,11 +219,8 @@ pub(crate) fn solve_checked(
         .collect();
     bld.add_psd(&(&I_n * -delta), &Mk);
     // trace_max - trace(Pi) >= 0 (a 1 x 1 cone)
-    let Mk: Vec<Option<DMatrix<f64>>> = basis
-        .iter()
-        .map(|B| Some(DMatrix::from_element(1, 1, -B.trace())))
-        .chain(std::iter::once(None))
-        .collect();
+    let Mk: Vec<Option<DMatrix<f64>>> =
+        basis.iter().map(|B| Some(DMatrix::from_element(1, 1, -B.trace()))).chain(std::iter::once(None)).collect();
     bld.add_psd(&DMatrix::from_element(1, 1, trace_max), &Mk);
     // [[Pi, H], [H^T, b I]] >= 0 with H = (Pi E - F^T C^T)/2, eq. (bet)
     let G = F.transpose() * C.transpose();
@@ -369,7 +366,9 @@ mod tests {
         assert!(matches!(solve_beta_sdp(&F, &E, &C, -0.1, &s), Err(LmiError::LambdaOutOfRange { .. })));
         assert!(matches!(solve_beta_sdp(&F, &E, &C, f64::NAN, &s), Err(LmiError::NonFinite { what: "lambda", .. })));
         let Fu = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, 0.6]);
-        assert!(matches!(solve_beta_sdp(&Fu, &E, &C, 0.1, &s), Err(LmiError::NotHurwitz { mu }) if (mu - 0.3).abs() < 1e-12));
+        assert!(
+            matches!(solve_beta_sdp(&Fu, &E, &C, 0.1, &s), Err(LmiError::NotHurwitz { mu }) if (mu - 0.3).abs() < 1e-12)
+        );
         let Cbad = DMatrix::zeros(2, 2);
         assert!(matches!(
             solve_beta_sdp(&F, &E, &Cbad, 0.1, &s),
@@ -377,11 +376,17 @@ mod tests {
         ));
         let mut En = E.clone();
         En[(1, 0)] = f64::INFINITY;
-        assert!(matches!(solve_beta_sdp(&F, &En, &C, 0.1, &s), Err(LmiError::NonFinite { what: "E", row: 1, col: 0, .. })));
+        assert!(matches!(
+            solve_beta_sdp(&F, &En, &C, 0.1, &s),
+            Err(LmiError::NonFinite { what: "E", row: 1, col: 0, .. })
+        ));
         let it = BetaSdpSettings { sdp: SdpSettings { max_iter: 2, ..Default::default() }, ..Default::default() };
         assert!(matches!(solve_beta_sdp(&F, &E, &C, 0.1, &it), Err(LmiError::IterationLimit { max_iter: 2, .. })));
         let bad = BetaSdpSettings { max_pi_rel: 0.5, ..Default::default() };
-        assert!(matches!(solve_beta_sdp(&F, &E, &C, 0.1, &bad), Err(LmiError::InvalidSetting { name: "max_pi_rel", .. })));
+        assert!(matches!(
+            solve_beta_sdp(&F, &E, &C, 0.1, &bad),
+            Err(LmiError::InvalidSetting { name: "max_pi_rel", .. })
+        ));
     }
 
     /// Degenerate C = 0: beta = lambda_max(E^T Pi E)/4 -> 0 as Pi -> 0; the (ALI) margin

@@ -12,7 +12,7 @@
 //! a verified lower bound of the true one (up to the condition-number bound).
 
 use crate::error::{LmiError, Result};
-use crate::psd_triangle::{symmetric_basis, sym_from_entries, triangular_number};
+use crate::psd_triangle::{sym_from_entries, symmetric_basis, triangular_number};
 use crate::sdp::{LmiBuilder, SdpSettings, SdpStatus};
 use crate::spectral_abscissa::{check_F, check_scalar, hurwitz_mu};
 use crate::verify::{lyapunov_matrix, psd_margin, symmetrize_upper, Margin};
@@ -71,7 +71,11 @@ pub struct LyapunovFeasibility {
 
 /// Solve the feasibility SDP (module docs) at `lambda >= 0` (any finite `lambda >= 0`;
 /// `F` need not be Hurwitz, then nothing is feasible).
-pub fn lyapunov_feasibility(F: &DMatrix<f64>, lambda: f64, settings: &FeasibilitySettings) -> Result<LyapunovFeasibility> {
+pub fn lyapunov_feasibility(
+    F: &DMatrix<f64>,
+    lambda: f64,
+    settings: &FeasibilitySettings,
+) -> Result<LyapunovFeasibility> {
     settings.validate()?;
     check_F(F)?;
     check_scalar("lambda", lambda)?;
@@ -212,6 +216,8 @@ mod tests {
     #[test]
     fn not_hurwitz_is_error() {
         let F = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 1.0, 0.0]);
-        assert!(matches!(sup_feasible_lambda(&F, &FeasibilitySettings::default()), Err(LmiError::NotHurwitz { mu }) if (mu - 1.0).abs() < 1e-12));
+        assert!(
+            matches!(sup_feasible_lambda(&F, &FeasibilitySettings::default()), Err(LmiError::NotHurwitz { mu }) if (mu - 1.0).abs() < 1e-12)
+        );
     }
 }

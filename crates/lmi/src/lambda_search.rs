@@ -225,7 +225,14 @@ mod tests {
     fn failures_become_gaps_not_panics() {
         let (F, E, C) = paper_example();
         // theta returning NaN on part of the interval creates gaps; the search still works.
-        let res = optimise_lambda(&F, &E, &C, |l, b| if l > 0.2 { f64::NAN } else { b - l }, &LambdaSearchSettings::default()).unwrap();
+        let res = optimise_lambda(
+            &F,
+            &E,
+            &C,
+            |l, b| if l > 0.2 { f64::NAN } else { b - l },
+            &LambdaSearchSettings::default(),
+        )
+        .unwrap();
         assert!(!res.gaps.is_empty());
         assert!(res.gaps.iter().all(|(l, e)| *l > 0.2 && matches!(e, LmiError::ThetaNaN { .. })));
         assert!(res.optimum.value.lambda <= 0.2);

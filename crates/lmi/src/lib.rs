@@ -28,7 +28,9 @@ pub mod verify;
 
 pub use beta_sdp::{certified_beta, pi_scale, solve_beta_sdp, BetaSdpSettings, BetaSdpSolution, CertifiedBeta};
 pub use error::{LmiError, Result};
-pub use feasibility::{lyapunov_feasibility, sup_feasible_lambda, FeasibilitySettings, LambdaSupremum, LyapunovFeasibility};
+pub use feasibility::{
+    lyapunov_feasibility, sup_feasible_lambda, FeasibilitySettings, LambdaSupremum, LyapunovFeasibility,
+};
 pub use lambda_search::{optimise_lambda, CurvePoint, CurveValue, LambdaOptimum, LambdaSearch, LambdaSearchSettings};
 pub use sdp::{SdpSettings, SdpStatus};
 pub use spectral_abscissa::{hurwitz_mu, spectral_abscissa};

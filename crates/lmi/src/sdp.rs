@@ -36,11 +36,9 @@ impl Default for SdpSettings {
 impl SdpSettings {
     /// Check that tolerances are positive and finite and `max_iter >= 1`.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("tol_gap_abs", self.tol_gap_abs),
-            ("tol_gap_rel", self.tol_gap_rel),
-            ("tol_feas", self.tol_feas),
-        ] {
+        for (name, v) in
+            [("tol_gap_abs", self.tol_gap_abs), ("tol_gap_rel", self.tol_gap_rel), ("tol_feas", self.tol_feas)]
+        {
             if !(v.is_finite() && v > 0.0) {
                 return Err(LmiError::InvalidSetting { name, value: v });
             }
@@ -91,9 +89,7 @@ impl From<SolverStatus> for SdpStatus {
         match s {
             SolverStatus::Solved => SdpStatus::Solved,
             SolverStatus::AlmostSolved => SdpStatus::AlmostSolved,
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                SdpStatus::PrimalInfeasible
-            }
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => SdpStatus::PrimalInfeasible,
             SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => SdpStatus::DualInfeasible,
             SolverStatus::MaxIterations => SdpStatus::MaxIterations,
             SolverStatus::MaxTime => SdpStatus::MaxTime,
@@ -168,11 +164,9 @@ impl LmiBuilder {
         let sol = &solver.solution;
         let status = SdpStatus::from(sol.status);
         match status {
-            SdpStatus::Solved | SdpStatus::AlmostSolved => Ok(SdpSolution {
-                x: sol.x.clone(),
-                status,
-                iterations: sol.iterations,
-            }),
+            SdpStatus::Solved | SdpStatus::AlmostSolved => {
+                Ok(SdpSolution { x: sol.x.clone(), status, iterations: sol.iterations })
+            }
             SdpStatus::PrimalInfeasible => Err(LmiError::Infeasible { lambda, status }),
             SdpStatus::DualInfeasible => Err(LmiError::Unbounded { lambda, status }),
             SdpStatus::MaxIterations => Err(LmiError::IterationLimit { lambda, max_iter: settings.max_iter }),

@@ -38,8 +38,7 @@ pub(crate) fn check_F(F: &DMatrix<f64>) -> Result<usize> {
         return Err(LmiError::Empty { what: "F", shape: F.shape() });
     }
     check_shape("F", F, (n, n))?;
-    check_finite("F", F)
-        .map(|_| n)
+    check_finite("F", F).map(|_| n)
 }
 
 /// Validate `(F, E, C)`: `F` is `n x n`, `E` is `n x p`, `C` is `p x n`, all finite,
@@ -125,7 +124,9 @@ mod tests {
             Err(LmiError::DimensionMismatch { what: "E", expected: (2, 1), found: (3, 1) })
         ));
         assert!(matches!(check_lambda(0.0, -1.0), Err(LmiError::LambdaOutOfRange { .. })));
-        assert!(matches!(check_lambda(1.0, -1.0), Err(LmiError::LambdaOutOfRange { lambda, mu }) if lambda == 1.0 && mu == -1.0));
+        assert!(
+            matches!(check_lambda(1.0, -1.0), Err(LmiError::LambdaOutOfRange { lambda, mu }) if lambda == 1.0 && mu == -1.0)
+        );
         assert!(check_lambda(0.5, -1.0).is_ok());
     }
 }

@@ -341,7 +341,14 @@ pub struct Certificate {
     pub Pi: DMatrix<f64>,
 }
 
-fn check_inputs(F: &DMatrix<f64>, E: &DMatrix<f64>, C: &DMatrix<f64>, Pi: &DMatrix<f64>, lambda: f64, b: f64) -> Result<()> {
+fn check_inputs(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    Pi: &DMatrix<f64>,
+    lambda: f64,
+    b: f64,
+) -> Result<()> {
     let (n, _) = check_system(F, E, C)?;
     check_shape("Pi", Pi, (n, n))?;
     crate::spectral_abscissa::check_finite("Pi", Pi)?;

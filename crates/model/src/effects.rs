@@ -71,7 +71,11 @@ fn nonneg(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
 fn state_index(t: &Table, prefix: &str, n: usize) -> Result<usize, ModelError> {
     let v = f64_at(t, prefix, "state")?;
     if v < 0.0 || v.fract() != 0.0 || v as usize >= n {
-        return Err(ModelError::OutOfRange { key: key(prefix, "state"), value: v, reason: "must be a state index 0..n-1" });
+        return Err(ModelError::OutOfRange {
+            key: key(prefix, "state"),
+            value: v,
+            reason: "must be a state index 0..n-1",
+        });
     }
     Ok(v as usize)
 }
@@ -81,7 +85,11 @@ impl Effects {
     pub(crate) fn parse(v: Option<&Value>, n: usize, p: usize) -> Result<Self, ModelError> {
         let Some(v) = v else { return Ok(Self::default()) };
         let Value::Array(items) = v else {
-            return Err(ModelError::WrongType { key: "effects".into(), expected: "an array of tables ([[effects]])", found: describe(v) });
+            return Err(ModelError::WrongType {
+                key: "effects".into(),
+                expected: "an array of tables ([[effects]])",
+                found: describe(v),
+            });
         };
         let mut list = Vec::new();
         for (i, it) in items.iter().enumerate() {
@@ -166,7 +174,10 @@ impl Effects {
                 match e {
                     Effect::Backlash { width, location } => {
                         t.insert("width".into(), Value::Float(*width));
-                        t.insert("location".into(), Value::String(if *location == PlayLocation::Loop { "loop" } else { "input" }.into()));
+                        t.insert(
+                            "location".into(),
+                            Value::String(if *location == PlayLocation::Loop { "loop" } else { "input" }.into()),
+                        );
                     }
                     Effect::GapWidth { relative_change } => {
                         t.insert("relative_change".into(), Value::Float(*relative_change));

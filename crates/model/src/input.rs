@@ -96,7 +96,10 @@ impl Input {
         let headers = rdr.headers().map_err(|e| ModelError::Csv { path: ps.clone(), reason: e.to_string() })?.clone();
         let names: Vec<String> = headers.iter().map(|h| h.to_string()).collect();
         if names.len() < 2 || names[0] != "t" || !names[1..].iter().all(|h| h.starts_with('w')) {
-            return Err(ModelError::Csv { path: ps, reason: format!("header must be `t,w` or `t,w1,...,wm`, found `{}`", names.join(",")) });
+            return Err(ModelError::Csv {
+                path: ps,
+                reason: format!("header must be `t,w` or `t,w1,...,wm`, found `{}`", names.join(",")),
+            });
         }
         let mut t = Vec::new();
         let mut w = Vec::new();
@@ -104,13 +107,23 @@ impl Input {
             let row = i + 2; // 1-based, after the header
             let rec = rec.map_err(|e| ModelError::Csv { path: ps.clone(), reason: format!("row {row}: {e}") })?;
             if rec.len() != names.len() {
-                return Err(ModelError::Csv { path: ps, reason: format!("row {row} has {} fields, header has {}", rec.len(), names.len()) });
+                return Err(ModelError::Csv {
+                    path: ps,
+                    reason: format!("row {row} has {} fields, header has {}", rec.len(), names.len()),
+                });
             }
             let mut vals = Vec::with_capacity(names.len());
             for (j, cell) in rec.iter().enumerate() {
                 match cell.parse::<f64>() {
                     Ok(x) if x.is_finite() => vals.push(x),
-                    _ => return Err(ModelError::CsvValue { path: ps, row, column: names[j].clone(), value: cell.to_string() }),
+                    _ => {
+                        return Err(ModelError::CsvValue {
+                            path: ps,
+                            row,
+                            column: names[j].clone(),
+                            value: cell.to_string(),
+                        })
+                    }
                 }
             }
             if let Some(&prev) = t.last() {
@@ -144,7 +157,12 @@ mod tests {
 
     #[test]
     fn samples_interpolate_linearly_and_hold_outside() {
-        let s = Input::Samples { path: String::new(), t: vec![0.0, 1.0, 3.0], w: vec![vec![0.0], vec![2.0], vec![0.0]], period: None };
+        let s = Input::Samples {
+            path: String::new(),
+            t: vec![0.0, 1.0, 3.0],
+            w: vec![vec![0.0], vec![2.0], vec![0.0]],
+            period: None,
+        };
         assert_eq!(s.at(0.5), vec![1.0]);
         assert_eq!(s.at(2.0), vec![1.0]);
         assert_eq!(s.at(-1.0), vec![0.0]);

@@ -37,7 +37,8 @@ use toml::{Table, Value};
 
 /// Reads and validates a model file.
 pub fn load(path: &Path) -> Result<System, ModelError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io { path: path.display().to_string(), source })?;
+    let text =
+        std::fs::read_to_string(path).map_err(|source| ModelError::Io { path: path.display().to_string(), source })?;
     parse_str_with(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 
@@ -55,24 +56,40 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
     let Some(t) = t else { return Ok(Shape::origin(p)) };
     let pre = "theta";
     let shape = str_at(t, pre, "shape")?;
-    let centre = |t: &Table| -> Result<Vec<f64>, ModelError> { if t.contains_key("centre") { vec_at(t, pre, "centre") } else { Ok(vec![0.0; p]) } };
+    let centre = |t: &Table| -> Result<Vec<f64>, ModelError> {
+        if t.contains_key("centre") {
+            vec_at(t, pre, "centre")
+        } else {
+            Ok(vec![0.0; p])
+        }
+    };
     Ok(match shape {
         "interval" => {
             check_keys(t, pre, "shape, half_width, lo, hi")?;
             if let Some(d) = opt_f64(t, pre, "half_width")? {
                 if d < 0.0 {
-                    return Err(ModelError::OutOfRange { key: "theta.half_width".into(), value: d, reason: "must be non-negative" });
+                    return Err(ModelError::OutOfRange {
+                        key: "theta.half_width".into(),
+                        value: d,
+                        reason: "must be non-negative",
+                    });
                 }
                 Shape::Interval(Interval::symmetric(d).map_err(geo("theta.half_width"))?)
             } else {
-                Shape::Interval(Interval::new(f64_at(t, pre, "lo")?, f64_at(t, pre, "hi")?).map_err(geo("theta.lo/hi"))?)
+                Shape::Interval(
+                    Interval::new(f64_at(t, pre, "lo")?, f64_at(t, pre, "hi")?).map_err(geo("theta.lo/hi"))?,
+                )
             }
         }
         "ball" => {
             check_keys(t, pre, "shape, centre, radius")?;
             let r = f64_at(t, pre, "radius")?;
             if r < 0.0 {
-                return Err(ModelError::OutOfRange { key: "theta.radius".into(), value: r, reason: "must be non-negative" });
+                return Err(ModelError::OutOfRange {
+                    key: "theta.radius".into(),
+                    value: r,
+                    reason: "must be non-negative",
+                });
             }
             Shape::Ball(Ball::new(centre(t)?, r).map_err(geo("theta.radius"))?)
         }
@@ -86,10 +103,18 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
             if t.contains_key("semi_axes") {
                 let a = vec_at(t, pre, "semi_axes")?;
                 if let Some(&bad) = a.iter().find(|&&x| x <= 0.0) {
-                    return Err(ModelError::OutOfRange { key: "theta.semi_axes".into(), value: bad, reason: "semi-axes must be positive" });
+                    return Err(ModelError::OutOfRange {
+                        key: "theta.semi_axes".into(),
+                        value: bad,
+                        reason: "semi-axes must be positive",
+                    });
                 }
                 if a.len() != c.len() {
-                    return Err(ModelError::Dimension { key: "theta.semi_axes".into(), expected: format!("length {}", c.len()), got: format!("length {}", a.len()) });
+                    return Err(ModelError::Dimension {
+                        key: "theta.semi_axes".into(),
+                        expected: format!("length {}", c.len()),
+                        got: format!("length {}", a.len()),
+                    });
                 }
                 Shape::Ellipsoid(Ellipsoid::axis_aligned(c, &a).map_err(geo("theta.semi_axes"))?)
             } else {
@@ -111,7 +136,9 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
         }
         "box" => {
             check_keys(t, pre, "shape, lower, upper")?;
-            Shape::Polytope(Polytope::from_box(&vec_at(t, pre, "lower")?, &vec_at(t, pre, "upper")?).map_err(geo("theta"))?)
+            Shape::Polytope(
+                Polytope::from_box(&vec_at(t, pre, "lower")?, &vec_at(t, pre, "upper")?).map_err(geo("theta"))?,
+            )
         }
         other => return Err(ModelError::UnknownShape { value: other.to_string() }),
     })
@@ -124,7 +151,11 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
     let omega_phase = |t: &Table| -> Result<(f64, f64), ModelError> {
         let omega = f64_at(t, pre, "omega")?;
         if omega <= 0.0 {
-            return Err(ModelError::OutOfRange { key: "input.omega".into(), value: omega, reason: "angular frequency must be positive" });
+            return Err(ModelError::OutOfRange {
+                key: "input.omega".into(),
+                value: omega,
+                reason: "angular frequency must be positive",
+            });
         }
         Ok((omega, opt_f64(t, pre, "phase")?.unwrap_or(0.0)))
     };
@@ -137,7 +168,11 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
             check_keys(t, pre, "kind, amplitudes, omega, phase")?;
             let amplitudes = vec_at(t, pre, "amplitudes")?;
             let (omega, phase) = omega_phase(t)?;
-            if kind == "sine" { Input::Sine { amplitudes, omega, phase } } else { Input::Square { amplitudes, omega, phase } }
+            if kind == "sine" {
+                Input::Sine { amplitudes, omega, phase }
+            } else {
+                Input::Square { amplitudes, omega, phase }
+            }
         }
         "csv" => {
             check_keys(t, pre, "kind, file, period")?;
@@ -145,7 +180,11 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
             let period = opt_f64(t, pre, "period")?;
             if let Some(per) = period {
                 if per <= 0.0 {
-                    return Err(ModelError::OutOfRange { key: "input.period".into(), value: per, reason: "must be positive" });
+                    return Err(ModelError::OutOfRange {
+                        key: "input.period".into(),
+                        value: per,
+                        reason: "must be positive",
+                    });
                 }
             }
             Input::from_csv(&dir.join(file), period)?
@@ -155,11 +194,16 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
 }
 
 fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
-    let root: Table = text.parse::<Table>().map_err(|e| ModelError::Syntax { path: origin.to_string(), message: e.to_string().lines().next().unwrap_or("").to_string() })?;
+    let root: Table = text.parse::<Table>().map_err(|e| ModelError::Syntax {
+        path: origin.to_string(),
+        message: e.to_string().lines().next().unwrap_or("").to_string(),
+    })?;
     check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects")?;
     let name = match root.get("name") {
         Some(Value::String(s)) => s.clone(),
-        Some(other) => return Err(ModelError::WrongType { key: "name".into(), expected: "a string", found: describe(other) }),
+        Some(other) => {
+            return Err(ModelError::WrongType { key: "name".into(), expected: "a string", found: describe(other) })
+        }
         None => origin.to_string(),
     };
     let plant = table_at(&root, "", "plant")?;
@@ -183,7 +227,8 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
         None => (DVector::zeros(n), DVector::zeros(p)),
         Some(t) => {
             check_keys(t, "initial", "x0, z0")?;
-            let x0 = if t.contains_key("x0") { DVector::from_vec(vec_at(t, "initial", "x0")?) } else { DVector::zeros(n) };
+            let x0 =
+                if t.contains_key("x0") { DVector::from_vec(vec_at(t, "initial", "x0")?) } else { DVector::zeros(n) };
             let z0 = if t.contains_key("z0") {
                 DVector::from_vec(vec_at(t, "initial", "z0")?)
             } else if C.ncols() == x0.len() {
@@ -202,7 +247,11 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
         }
         if let Some(per) = opt_f64(t, "simulation", "periods")? {
             if per < 1.0 || per.fract() != 0.0 {
-                return Err(ModelError::OutOfRange { key: "simulation.periods".into(), value: per, reason: "must be a positive integer" });
+                return Err(ModelError::OutOfRange {
+                    key: "simulation.periods".into(),
+                    value: per,
+                    reason: "must be a positive integer",
+                });
             }
             sim.periods = per as usize;
         }

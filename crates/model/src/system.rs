@@ -80,22 +80,41 @@ impl System {
             }
         }
         if theta.dim() != p {
-            return Err(ModelError::Dimension { key: "theta".into(), expected: format!("a set in R^{p} (p = rows of C)"), got: format!("a set in R^{}", theta.dim()) });
+            return Err(ModelError::Dimension {
+                key: "theta".into(),
+                expected: format!("a set in R^{p} (p = rows of C)"),
+                got: format!("a set in R^{}", theta.dim()),
+            });
         }
         if input.m() != B.ncols() {
-            return Err(ModelError::Dimension { key: "input".into(), expected: format!("m = {} components (columns of B)", B.ncols()), got: format!("{}", input.m()) });
+            return Err(ModelError::Dimension {
+                key: "input".into(),
+                expected: format!("m = {} components (columns of B)", B.ncols()),
+                got: format!("{}", input.m()),
+            });
         }
         if x0.len() != n {
-            return Err(ModelError::Dimension { key: "initial.x0".into(), expected: format!("length n = {n}"), got: format!("length {}", x0.len()) });
+            return Err(ModelError::Dimension {
+                key: "initial.x0".into(),
+                expected: format!("length n = {n}"),
+                got: format!("length {}", x0.len()),
+            });
         }
         if z0.len() != p {
-            return Err(ModelError::Dimension { key: "initial.z0".into(), expected: format!("length p = {p}"), got: format!("length {}", z0.len()) });
+            return Err(ModelError::Dimension {
+                key: "initial.z0".into(),
+                expected: format!("length p = {p}"),
+                got: format!("length {}", z0.len()),
+            });
         }
         let scale = 1.0 + theta.deviation_from_origin().upper;
         let zero = vec![0.0; p];
         if !theta.contains(&zero, 1e-12 * scale) {
             let proj = geometry::convex_set::project_vec(&theta, &zero);
-            return Err(ModelError::ThetaMissesOrigin { distance: geometry::linalg::norm(&proj), theta: theta.describe() });
+            return Err(ModelError::ThetaMissesOrigin {
+                distance: geometry::linalg::norm(&proj),
+                theta: theta.describe(),
+            });
         }
         let q0: Vec<f64> = (&z0 - &C * &x0).iter().copied().collect();
         let tol = 1e-9 * (scale + geometry::linalg::norm(&q0));
@@ -104,10 +123,18 @@ impl System {
             return Err(ModelError::InitialOutsideTheta { distance: geometry::linalg::dist(&q0, &proj), q0 });
         }
         if !(sim.dt > 0.0 && sim.dt.is_finite()) {
-            return Err(ModelError::OutOfRange { key: "simulation.dt".into(), value: sim.dt, reason: "must be positive and finite" });
+            return Err(ModelError::OutOfRange {
+                key: "simulation.dt".into(),
+                value: sim.dt,
+                reason: "must be positive and finite",
+            });
         }
         if sim.periods == 0 {
-            return Err(ModelError::OutOfRange { key: "simulation.periods".into(), value: 0.0, reason: "must be at least 1" });
+            return Err(ModelError::OutOfRange {
+                key: "simulation.periods".into(),
+                value: 0.0,
+                reason: "must be at least 1",
+            });
         }
         Ok(Self { name: name.into(), A, B, C, E, theta, input, x0, z0, sim, effects })
     }

@@ -16,7 +16,11 @@ pub(crate) fn describe(v: &Value) -> String {
 }
 
 pub(crate) fn key(prefix: &str, k: &str) -> String {
-    if prefix.is_empty() { k.to_string() } else { format!("{prefix}.{k}") }
+    if prefix.is_empty() {
+        k.to_string()
+    } else {
+        format!("{prefix}.{k}")
+    }
 }
 
 pub(crate) fn number(v: &Value, key: &str) -> Result<f64, ModelError> {
@@ -62,7 +66,9 @@ pub(crate) fn vector(v: &Value, key: &str) -> Result<Vec<f64>, ModelError> {
         Value::Array(a) => a.iter().enumerate().map(|(i, x)| number(x, &format!("{key}[{i}]"))).collect(),
         // a bare number is accepted as a vector of length one
         Value::Float(_) | Value::Integer(_) => Ok(vec![number(v, key)?]),
-        other => Err(ModelError::WrongType { key: key.into(), expected: "an array of numbers", found: describe(other) }),
+        other => {
+            Err(ModelError::WrongType { key: key.into(), expected: "an array of numbers", found: describe(other) })
+        }
     }
 }
 
@@ -75,10 +81,16 @@ pub(crate) fn vec_at(t: &Table, prefix: &str, k: &str) -> Result<Vec<f64>, Model
 pub(crate) fn matrix(v: &Value, key: &str, column_if_flat: bool) -> Result<DMatrix<f64>, ModelError> {
     let rows = match v {
         Value::Array(a) => a,
-        other => return Err(ModelError::WrongType { key: key.into(), expected: "an array of rows", found: describe(other) }),
+        other => {
+            return Err(ModelError::WrongType { key: key.into(), expected: "an array of rows", found: describe(other) })
+        }
     };
     if rows.is_empty() {
-        return Err(ModelError::Dimension { key: key.into(), expected: "at least one row".into(), got: "an empty array".into() });
+        return Err(ModelError::Dimension {
+            key: key.into(),
+            expected: "at least one row".into(),
+            got: "an empty array".into(),
+        });
     }
     if rows.iter().all(|r| !matches!(r, Value::Array(_))) {
         let flat = vector(v, key)?;
@@ -90,7 +102,13 @@ pub(crate) fn matrix(v: &Value, key: &str, column_if_flat: bool) -> Result<DMatr
         let row_key = format!("{key}[{i}]");
         match r {
             Value::Array(_) => data.push(vector(r, &row_key)?),
-            other => return Err(ModelError::WrongType { key: row_key, expected: "a row (array of numbers)", found: describe(other) }),
+            other => {
+                return Err(ModelError::WrongType {
+                    key: row_key,
+                    expected: "a row (array of numbers)",
+                    found: describe(other),
+                })
+            }
         }
     }
     let ncols = data[0].len();

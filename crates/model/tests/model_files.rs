@@ -87,7 +87,12 @@ fn nan_and_strings_where_numbers_belong() {
 
 #[test]
 fn bad_sets_are_rejected_with_key_and_value() {
-    let ell = |m: &str| GOOD.replace("C = [[1.0, 0.0]]", "C = [[1.0, 0.0], [0.0, 1.0]]").replace("E = [[0.0], [1.0]]", "E = [[0.0, 0.0], [1.0, 0.0]]").replace("shape = \"interval\"\nhalf_width = 0.1", &format!("shape = \"ellipsoid\"\nmatrix = {m}")).replace("z0 = [0.0]", "z0 = [0.05, 0.0]");
+    let ell = |m: &str| {
+        GOOD.replace("C = [[1.0, 0.0]]", "C = [[1.0, 0.0], [0.0, 1.0]]")
+            .replace("E = [[0.0], [1.0]]", "E = [[0.0, 0.0], [1.0, 0.0]]")
+            .replace("shape = \"interval\"\nhalf_width = 0.1", &format!("shape = \"ellipsoid\"\nmatrix = {m}"))
+            .replace("z0 = [0.0]", "z0 = [0.05, 0.0]")
+    };
     assert!(parse_str(&ell("[[0.01, 0.0], [0.0, 0.02]]")).is_ok());
     let e = err(&ell("[[0.01, 0.0], [0.0, -0.02]]"));
     assert!(e.contains("theta.matrix") && e.contains("positive definite") && e.contains("-2e-2"), "{e}");
@@ -118,7 +123,8 @@ fn missing_file_and_bad_csv_inputs() {
     let dir = tempfile::tempdir().unwrap();
     let write = |name: &str, csv: &str| {
         std::fs::write(dir.path().join(name), csv).unwrap();
-        let text = with("kind = \"sine\"\namplitudes = [1.0]\nomega = 1.0", &format!("kind = \"csv\"\nfile = \"{name}\""));
+        let text =
+            with("kind = \"sine\"\namplitudes = [1.0]\nomega = 1.0", &format!("kind = \"csv\"\nfile = \"{name}\""));
         std::fs::write(dir.path().join("m.toml"), text).unwrap();
         model::load(&dir.path().join("m.toml"))
     };

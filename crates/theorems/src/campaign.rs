@@ -84,7 +84,8 @@ pub fn select(all: Vec<Box<dyn Property>>, only: Option<&str>) -> Result<Vec<Box
         .into_iter()
         .filter(|p| {
             let i = p.info();
-            i.name.eq_ignore_ascii_case(&w) || i.label.trim_start_matches('(').trim_end_matches(')').eq_ignore_ascii_case(&w)
+            i.name.eq_ignore_ascii_case(&w)
+                || i.label.trim_start_matches('(').trim_end_matches(')').eq_ignore_ascii_case(&w)
         })
         .collect();
     if sel.is_empty() {
@@ -123,7 +124,11 @@ pub fn chunk_size(cases: u64) -> u64 {
 
 /// Runs one property; `progress(k)` is called with the number of cases finished since the
 /// previous call (from several threads).
-pub fn run_property(prop: &dyn Property, settings: &CampaignSettings, progress: &(dyn Fn(u64) + Sync)) -> Result<PropertyReport, CampaignError> {
+pub fn run_property(
+    prop: &dyn Property,
+    settings: &CampaignSettings,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<PropertyReport, CampaignError> {
     let info = prop.info();
     let cases = settings.cases.unwrap_or(info.default_cases);
     if cases == 0 {
@@ -170,7 +175,10 @@ pub fn run_property(prop: &dyn Property, settings: &CampaignSettings, progress: 
 }
 
 /// Runs the selected properties in order.
-pub fn run(settings: &CampaignSettings, progress: &(dyn Fn(&str, u64) + Sync)) -> Result<Vec<PropertyReport>, CampaignError> {
+pub fn run(
+    settings: &CampaignSettings,
+    progress: &(dyn Fn(&str, u64) + Sync),
+) -> Result<Vec<PropertyReport>, CampaignError> {
     let props = select(registry(), settings.only.as_deref())?;
     props.iter().map(|p| run_property(p.as_ref(), settings, &|d| progress(p.info().name, d))).collect()
 }

@@ -27,7 +27,11 @@ fn holds(e: Eval) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-fn negative_control<C: std::fmt::Debug + Clone>(strategy: BoxedStrategy<C>, eval: fn(&C, Variant) -> Eval, cases: u32) -> C {
+fn negative_control<C: std::fmt::Debug + Clone>(
+    strategy: BoxedStrategy<C>,
+    eval: fn(&C, Variant) -> Eval,
+    cases: u32,
+) -> C {
     let mut runner = TestRunner::new(Config { cases, ..config() });
     match runner.run(&strategy, |c| holds(eval(&c, Variant::NegativeControl))) {
         Err(TestError::Fail(_, minimal)) => {
@@ -58,10 +62,12 @@ proptest! {
 fn theorem2_ball_intersections() {
     let strat = theorems::strategies::systems::system_params(&theorem2::config_ball_intersection());
     let mut runner = TestRunner::new(config());
-    runner.run(&strat, |c| {
-        holds(theorem2::eval_path(&c, Variant::Claim))?;
-        holds(theorem2::eval_zinf(&c, Variant::Claim))
-    }).unwrap();
+    runner
+        .run(&strat, |c| {
+            holds(theorem2::eval_path(&c, Variant::Claim))?;
+            holds(theorem2::eval_zinf(&c, Variant::Claim))
+        })
+        .unwrap();
 }
 
 #[test]
@@ -85,7 +91,10 @@ fn theorem1_rest_set_campaign() {
     let prop = theorems::properties::theorem1::property();
     let settings = theorems::CampaignSettings { cases: Some(cases), ..Default::default() };
     let rep = theorems::run_property(&prop, &settings, &|_| {}).unwrap();
-    eprintln!("theorem1: {} cases, {} skipped, min slack {:e}, {:.2} s", rep.cases, rep.skipped, rep.min_slack, rep.seconds);
+    eprintln!(
+        "theorem1: {} cases, {} skipped, min slack {:e}, {:.2} s",
+        rep.cases, rep.skipped, rep.min_slack, rep.seconds
+    );
     assert_eq!(rep.violations, 0, "{:?}", rep.counterexample.map(|c| c.summary));
     assert!(rep.skipped * 2 < rep.cases, "too many skipped: {} of {}", rep.skipped, rep.cases);
     let neg = theorems::CampaignSettings { cases: Some(200), variant: Variant::NegativeControl, ..Default::default() };
@@ -122,7 +131,10 @@ fn lemma2_tube_campaign() {
     let prop = theorems::properties::lemma2::property();
     let settings = theorems::CampaignSettings { cases: Some(cases), ..Default::default() };
     let rep = theorems::run_property(&prop, &settings, &|_| {}).unwrap();
-    eprintln!("lemma2: {} cases, {} skipped, min slack {:e}, {:.2} s", rep.cases, rep.skipped, rep.min_slack, rep.seconds);
+    eprintln!(
+        "lemma2: {} cases, {} skipped, min slack {:e}, {:.2} s",
+        rep.cases, rep.skipped, rep.min_slack, rep.seconds
+    );
     assert_eq!(rep.violations, 0, "{:?}", rep.counterexample.map(|c| c.summary));
     assert_eq!(rep.skipped, 0);
     let neg = theorems::CampaignSettings { cases: Some(200), variant: Variant::NegativeControl, ..Default::default() };

@@ -13,7 +13,13 @@ fn simpson(sys: &model::System, T: f64, N: usize, kernel: impl Fn(f64) -> DMatri
     for i in 0..=2 * N {
         let s = i as f64 * h;
         sys.input.eval(s, w.as_mut_slice());
-        let c = if i == 0 || i == 2 * N { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+        let c = if i == 0 || i == 2 * N {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
         acc += kernel(s) * (&sys.B * &w) * c;
     }
     acc * (h / 3.0)

@@ -26,7 +26,17 @@ use rand_chacha::ChaCha8Rng;
 use std::f64::consts::{PI, TAU};
 
 /// The classes of concealed effects.
-pub const CLASSES: [&str; 9] = ["none", "backlash", "gap_width", "coulomb_friction", "constant_force", "backlash_inertia", "input_delay", "input_saturation", "sensor_offset"];
+pub const CLASSES: [&str; 9] = [
+    "none",
+    "backlash",
+    "gap_width",
+    "coulomb_friction",
+    "constant_force",
+    "backlash_inertia",
+    "input_delay",
+    "input_saturation",
+    "sensor_offset",
+];
 
 /// The continuous input signal of a case.
 #[derive(Debug, Clone)]
@@ -43,7 +53,9 @@ impl Signal {
     pub fn eval(&self, t: f64) -> f64 {
         let t = t.max(0.0);
         match self {
-            Signal::Multisine { a, omega, phi } => a.iter().zip(omega).zip(phi).map(|((a, w), p)| a * (w * t + p).sin()).sum(),
+            Signal::Multisine { a, omega, phi } => {
+                a.iter().zip(omega).zip(phi).map(|((a, w), p)| a * (w * t + p).sin()).sum()
+            }
             Signal::Knots { dt_knot, v } => {
                 let s = t / dt_knot;
                 let i = (s.floor() as usize).min(v.len() - 2);
@@ -94,7 +106,8 @@ fn random_plant(rng: &mut ChaCha8Rng, n: usize) -> Plant {
     let k = w0 * w0;
     let c = 2.0 * zeta * w0;
     let kappa: f64 = rng.random_range(0.2..0.6);
-    let (mut A, mut B, mut C, mut E) = (DMatrix::zeros(n, n), DMatrix::zeros(n, 1), DMatrix::zeros(1, n), DMatrix::zeros(n, 1));
+    let (mut A, mut B, mut C, mut E) =
+        (DMatrix::zeros(n, n), DMatrix::zeros(n, 1), DMatrix::zeros(1, n), DMatrix::zeros(n, 1));
     A[(0, 1)] = 1.0;
     A[(1, 0)] = -k * (1.0 - kappa);
     A[(1, 1)] = -c;
@@ -148,7 +161,14 @@ fn random_signal(rng: &mut ChaCha8Rng, w0: f64, duration: f64) -> (Signal, &'sta
         _ => {
             let seg = 8.0 * TAU / w0;
             let ns = (duration / seg) as usize + 2;
-            (Signal::Segments { seg, a: (0..ns).map(|_| rng.random_range(0.4..1.2)).collect(), omega: (0..ns).map(|_| w0 * rng.random_range(0.2..1.3)).collect() }, "sine segments")
+            (
+                Signal::Segments {
+                    seg,
+                    a: (0..ns).map(|_| rng.random_range(0.4..1.2)).collect(),
+                    omega: (0..ns).map(|_| w0 * rng.random_range(0.2..1.3)).collect(),
+                },
+                "sine segments",
+            )
         }
     }
 }
@@ -177,7 +197,10 @@ fn fit_percent(a: &[f64], b: &[f64]) -> f64 {
 
 /// Generates case number `index` of `class` from `seed`.
 pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (CLASSES.iter().position(|c| *c == class).unwrap_or(0) as u64) << 40);
+    let mut rng = ChaCha8Rng::seed_from_u64(
+        seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1))
+            ^ (CLASSES.iter().position(|c| *c == class).unwrap_or(0) as u64) << 40,
+    );
     let n = rng.random_range(2..=4);
     let plant = random_plant(&mut rng, n);
     let tau_slow = {
@@ -212,7 +235,9 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
     };
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let noise: Vec<f64> = (0..ns).map(|_| gauss(&mut rng) * noise_std).collect();
-    let measure = |eff: Option<&Effect>| -> Vec<f64> { plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns).iter().zip(&noise).map(|(a, b)| a + b).collect() };
+    let measure = |eff: Option<&Effect>| -> Vec<f64> {
+        plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns).iter().zip(&noise).map(|(a, b)| a + b).collect()
+    };
     let fit_at = |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel).as_ref()), &clean_nom);
     let truth_a = if class == "none" {
         0.0
@@ -246,7 +271,11 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
     let truth = effect_at(class, truth_a, sign, wmax, plant.vel);
     let y = measure(truth.as_ref());
     let nominal_fit = fit_percent(&y, &clean_nom);
-    let theta = if nominal_has_play { geometry::Shape::Interval(geometry::Interval::symmetric(plant.half_width).expect("positive half-width")) } else { geometry::Shape::origin(1) };
+    let theta = if nominal_has_play {
+        geometry::Shape::Interval(geometry::Interval::symmetric(plant.half_width).expect("positive half-width"))
+    } else {
+        geometry::Shape::origin(1)
+    };
     let x0v = DVector::from_column_slice(&x0);
     let z0 = &plant.C * &x0v;
     let nominal = System::new(
@@ -263,8 +292,17 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
         Effects::default(),
     )
     .expect("generated plant is valid");
-    let recording = Recording::from_samples(&format!("bench-{class}-{index}"), &t, w.iter().map(|v| vec![*v]).collect(), y.iter().map(|v| vec![*v]).collect(), None);
-    let description = format!("n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, nominal fit {nominal_fit:.1} %", plant.omega0, plant.zeta);
+    let recording = Recording::from_samples(
+        &format!("bench-{class}-{index}"),
+        &t,
+        w.iter().map(|v| vec![*v]).collect(),
+        y.iter().map(|v| vec![*v]).collect(),
+        None,
+    );
+    let description = format!(
+        "n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, nominal fit {nominal_fit:.1} %",
+        plant.omega0, plant.zeta
+    );
     Case { class, nominal, truth, recording, nominal_fit, description }
 }
 

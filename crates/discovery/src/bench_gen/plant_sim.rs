@@ -58,7 +58,12 @@ pub fn simulate(pl: &Plant, hw: f64, eff: Option<&Effect>, sig: &Signal, x0: &[f
             if fric > 0.0 {
                 let v_free = x[pl.vel];
                 let dv = fric * h;
-                x[pl.vel] = if v_free.abs() <= dv && (v_old.abs() <= dv || v_old * v_free <= 0.0 || v_free.abs() <= dv) { 0.0 } else { v_free - dv * v_free.signum() };
+                x[pl.vel] = if v_free.abs() <= dv && (v_old.abs() <= dv || v_old * v_free <= 0.0 || v_free.abs() <= dv)
+                {
+                    0.0
+                } else {
+                    v_free - dv * v_free.signum()
+                };
             }
             let y = cy(&x);
             if hw > 0.0 {

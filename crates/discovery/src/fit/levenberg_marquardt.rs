@@ -104,7 +104,13 @@ fn jacobian(vars: &Vars, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DM
 }
 
 /// Runs LM from `v`, at most `iters` iterations. Returns (v, r, cost, converged).
-fn lm(vars: &Vars, mut v: Vec<f64>, iters: usize, s: &FitSettings, evals: &mut usize) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
+fn lm(
+    vars: &Vars,
+    mut v: Vec<f64>,
+    iters: usize,
+    s: &FitSettings,
+    evals: &mut usize,
+) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
     let mut r = vars.res(&v, evals)?;
     let mut cost = sse(&r);
     let mut lambda = 1e-2;
@@ -194,7 +200,15 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         }
     }
     let Some(b) = best else {
-        return FitResult { theta: lo, std: vec![f64::NAN; k], x0: x0_init.to_vec(), sse: f64::INFINITY, n_res: 0, status: FitStatus::Failed, evaluations: evals };
+        return FitResult {
+            theta: lo,
+            std: vec![f64::NAN; k],
+            x0: x0_init.to_vec(),
+            sse: f64::INFINITY,
+            n_res: 0,
+            status: FitStatus::Failed,
+            evaluations: evals,
+        };
     };
     let (v, r, cost, conv) = lm(&vars, b.0.clone(), s.max_iter, s, &mut evals).unwrap_or(b);
     // Gauss-Newton covariance of the effect parameters.
@@ -208,5 +222,13 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         None => vec![f64::NAN; k],
     };
     let (theta, x0) = vars.split(&v);
-    FitResult { theta, std, x0, sse: cost, n_res: nres, status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations }, evaluations: evals }
+    FitResult {
+        theta,
+        std,
+        x0,
+        sse: cost,
+        n_res: nres,
+        status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations },
+        evaluations: evals,
+    }
 }

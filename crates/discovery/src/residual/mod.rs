@@ -68,7 +68,8 @@ fn centred(a: &[f64]) -> Vec<f64> {
 /// Runs the tests on residual `e` and inputs `u[j]` (each a series of the same length),
 /// decimated by `lag_step` (averaging blocks), with `lags` lags.
 pub fn test(e: &[f64], u: &[Vec<f64>], lags: usize, lag_step: usize) -> ResidualTests {
-    let dec = |a: &[f64]| -> Vec<f64> { a.chunks(lag_step.max(1)).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect() };
+    let dec =
+        |a: &[f64]| -> Vec<f64> { a.chunks(lag_step.max(1)).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect() };
     let raw = dec(e);
     let n = raw.len();
     let mean = raw.iter().sum::<f64>() / n as f64;
@@ -99,7 +100,23 @@ pub fn test(e: &[f64], u: &[Vec<f64>], lags: usize, lag_step: usize) -> Residual
     let q_cross_threshold = chi2_quantile(2 * m + 1, 2.326);
     let white = q_auto <= q_auto_threshold;
     let uncorrelated = q_cross.iter().all(|&q| q <= q_cross_threshold);
-    ResidualTests { lags: m, lag_step, autocorr: r_e[1..].to_vec(), autocorr_bound: z99 / nf.sqrt(), q_auto, q_auto_threshold, crosscorr, crosscorr_bound: bounds, q_cross, q_cross_threshold, white, uncorrelated, mean, mean_bound, zero_mean: mean.abs() <= mean_bound }
+    ResidualTests {
+        lags: m,
+        lag_step,
+        autocorr: r_e[1..].to_vec(),
+        autocorr_bound: z99 / nf.sqrt(),
+        q_auto,
+        q_auto_threshold,
+        crosscorr,
+        crosscorr_bound: bounds,
+        q_cross,
+        q_cross_threshold,
+        white,
+        uncorrelated,
+        mean,
+        mean_bound,
+        zero_mean: mean.abs() <= mean_bound,
+    }
 }
 
 #[cfg(test)]

@@ -120,7 +120,11 @@ impl ExtendedModel {
             match e {
                 Effect::Backlash { width, location } => {
                     if !(*width >= 0.0 && width.is_finite()) {
-                        return Err(DiscoveryError::BadEffect { kind: "backlash", reason: "width must be finite and non-negative", value: *width });
+                        return Err(DiscoveryError::BadEffect {
+                            kind: "backlash",
+                            reason: "width must be finite and non-negative",
+                            value: *width,
+                        });
                     }
                     match location {
                         PlayLocation::Loop => loop_width += width,
@@ -129,25 +133,43 @@ impl ExtendedModel {
                 }
                 Effect::GapWidth { relative_change } => {
                     if *relative_change <= -1.0 {
-                        return Err(DiscoveryError::BadEffect { kind: "gap_width", reason: "relative_change must exceed -1", value: *relative_change });
+                        return Err(DiscoveryError::BadEffect {
+                            kind: "gap_width",
+                            reason: "relative_change must exceed -1",
+                            value: *relative_change,
+                        });
                     }
                     scale *= 1.0 + relative_change;
                 }
                 Effect::CoulombFriction { state, level } => {
                     if *state >= n {
-                        return Err(DiscoveryError::BadEffect { kind: "coulomb_friction", reason: "state index out of range", value: *state as f64 });
+                        return Err(DiscoveryError::BadEffect {
+                            kind: "coulomb_friction",
+                            reason: "state index out of range",
+                            value: *state as f64,
+                        });
                     }
                     me.coulomb.push((*state, level.abs()));
                 }
                 Effect::ConstantForce { state, force } => {
                     if *state >= n {
-                        return Err(DiscoveryError::BadEffect { kind: "constant_force", reason: "state index out of range", value: *state as f64 });
+                        return Err(DiscoveryError::BadEffect {
+                            kind: "constant_force",
+                            reason: "state index out of range",
+                            value: *state as f64,
+                        });
                     }
                     me.force[*state] += force;
                     me.has_force = true;
                 }
                 Effect::BacklashInertia { mass, damping } => {
-                    me.inertia_tau = if *mass <= 0.0 { 0.0 } else if *damping <= 0.0 { f64::INFINITY } else { mass / damping };
+                    me.inertia_tau = if *mass <= 0.0 {
+                        0.0
+                    } else if *damping <= 0.0 {
+                        f64::INFINITY
+                    } else {
+                        mass / damping
+                    };
                 }
                 Effect::InputDelay { delay } => me.delay += delay.max(0.0),
                 Effect::InputSaturation { limit } => me.saturation = Some(limit.abs()),
@@ -174,7 +196,11 @@ impl ExtendedModel {
             }
             (shape, false) => {
                 if loop_width > 0.0 {
-                    return Err(DiscoveryError::BadEffect { kind: "backlash", reason: "a loop play can only be added to a 1-D nominal play or where the nominal has none", value: loop_width });
+                    return Err(DiscoveryError::BadEffect {
+                        kind: "backlash",
+                        reason: "a loop play can only be added to a 1-D nominal play or where the nominal has none",
+                        value: loop_width,
+                    });
                 }
                 Play::Scaled { shape: shape.clone(), s: scale }
             }
@@ -295,8 +321,17 @@ impl ExtendedModel {
         let has_play = self.has_play();
         let sub = self.substeps;
         let h = mp.h;
-        let decay = if self.inertia_tau > 0.0 && self.inertia_tau.is_finite() { (-h / self.inertia_tau).exp() } else { 1.0 };
-        let coast = if self.inertia_tau > 0.0 { if self.inertia_tau.is_finite() { self.inertia_tau * (1.0 - decay) } else { h } } else { 0.0 };
+        let decay =
+            if self.inertia_tau > 0.0 && self.inertia_tau.is_finite() { (-h / self.inertia_tau).exp() } else { 1.0 };
+        let coast = if self.inertia_tau > 0.0 {
+            if self.inertia_tau.is_finite() {
+                self.inertia_tau * (1.0 - decay)
+            } else {
+                h
+            }
+        } else {
+            0.0
+        };
         // Constant-force contribution per substep: Psi b.
         let fb: Vec<f64> = (0..n).map(|i| (0..n).map(|j| mp.Psi[i * n + j] * self.force[j]).sum()).collect();
         let mut w0 = vec![0.0; m];

@@ -46,7 +46,15 @@ impl StepMaps {
         let Phi = X.view((0, 0), (n, n)).into_owned();
         let Psi = X.view((0, n), (n, n)).into_owned();
         let Psi1 = X.view((0, 2 * n), (n, n)).into_owned();
-        Self { h, n, Phi: row_major(&Phi), PsiB: row_major(&(&Psi * B)), Psi1B: row_major(&(&Psi1 * B)), PsiE: row_major(&(&Psi * E)), Psi: row_major(&Psi) }
+        Self {
+            h,
+            n,
+            Phi: row_major(&Phi),
+            PsiB: row_major(&(&Psi * B)),
+            Psi1B: row_major(&(&Psi1 * B)),
+            PsiE: row_major(&(&Psi * E)),
+            Psi: row_major(&Psi),
+        }
     }
 }
 
@@ -59,7 +67,12 @@ mod tests {
         // x' = -a x + w with w linear in time: closed forms of Phi, Psi, Psi1.
         let a = 2.0;
         let h = 0.3;
-        let s = StepMaps::new(&DMatrix::from_element(1, 1, -a), &DMatrix::from_element(1, 1, 1.0), &DMatrix::from_element(1, 1, 0.0), h);
+        let s = StepMaps::new(
+            &DMatrix::from_element(1, 1, -a),
+            &DMatrix::from_element(1, 1, 1.0),
+            &DMatrix::from_element(1, 1, 0.0),
+            h,
+        );
         let phi = (-a * h).exp();
         let psi = (1.0 - phi) / a;
         // int_0^h e^{-a(h-s)} s/h ds = (a h - 1 + e^{-a h}) / (a^2 h)
@@ -68,7 +81,12 @@ mod tests {
         assert!((s.Psi[0] - psi).abs() < 1e-14);
         assert!((s.Psi1B[0] - psi1).abs() < 1e-14);
         // Negative control: a different step must not match.
-        let t = StepMaps::new(&DMatrix::from_element(1, 1, -a), &DMatrix::from_element(1, 1, 1.0), &DMatrix::from_element(1, 1, 0.0), 0.31);
+        let t = StepMaps::new(
+            &DMatrix::from_element(1, 1, -a),
+            &DMatrix::from_element(1, 1, 1.0),
+            &DMatrix::from_element(1, 1, 0.0),
+            0.31,
+        );
         assert!((t.Psi1B[0] - psi1).abs() > 1e-4);
     }
 }

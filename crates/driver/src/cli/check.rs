@@ -37,7 +37,11 @@ pub struct Args {
 }
 
 fn fmt_slack(s: f64) -> String {
-    if s.is_infinite() { "-".into() } else { format!("{s:+.3e}") }
+    if s.is_infinite() {
+        "-".into()
+    } else {
+        format!("{s:+.3e}")
+    }
 }
 
 fn report_json(r: &PropertyReport, file: Option<&PathBuf>) -> serde_json::Value {
@@ -65,7 +69,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let settings = CampaignSettings { cases: a.cases, seed: a.seed, only: a.only.clone(), variant };
     let props = theorems::campaign::select(theorems::registry(), a.only.as_deref())?;
     let total: u64 = props.iter().map(|p| a.cases.unwrap_or(p.info().default_cases)).sum();
-    let bar = if a.json { ProgressBar::hidden() } else { ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr()) };
+    let bar = if a.json {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    };
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} cases {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -85,7 +93,8 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             Some(c) => {
                 let suffix = if a.negative_control { "-negative-control" } else { "" };
                 let path = a.out.join(format!("{}{}.{}", r.name, suffix, c.extension));
-                crate::output::write_atomic(&path, c.text.as_bytes()).with_context(|| format!("writing counterexample {}", path.display()))?;
+                crate::output::write_atomic(&path, c.text.as_bytes())
+                    .with_context(|| format!("writing counterexample {}", path.display()))?;
                 files.push(Some(path));
             }
             None => files.push(None),
@@ -94,7 +103,12 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
 
     if a.json {
         let v: Vec<serde_json::Value> = reports.iter().zip(&files).map(|(r, f)| report_json(r, f.as_ref())).collect();
-        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "seed": a.seed, "variant": if a.negative_control { "negative_control" } else { "claim" }, "results": v }))?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(
+                &serde_json::json!({ "seed": a.seed, "variant": if a.negative_control { "negative_control" } else { "claim" }, "results": v })
+            )?
+        );
     } else {
         println!(
             "{:<10} {:<10} {:>9} {:>8} {:>12} {:>10} {:>8}",
@@ -121,7 +135,10 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             println!("(negative controls: every property must show violations)");
         }
     }
-    let bad = if a.negative_control { reports.iter().any(|r| r.violations == 0) } else { reports.iter().any(|r| r.violations > 0) };
+    let bad = if a.negative_control {
+        reports.iter().any(|r| r.violations == 0)
+    } else {
+        reports.iter().any(|r| r.violations > 0)
+    };
     Ok(if bad { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
-

@@ -52,7 +52,10 @@ pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
     out.push((
         "residual",
         LinePlot {
-            title: format!("Residual y - yhat (output 1); shaded: located windows; validation from t = {:.3}", r.validation_segment[0]),
+            title: format!(
+                "Residual y - yhat (output 1); shaded: located windows; validation from t = {:.3}",
+                r.validation_segment[0]
+            ),
             x_label: "t (s)".into(),
             y_label: "residual".into(),
             series: vec![mk("nominal", &en), mk("fitted", &ef)],
@@ -66,7 +69,11 @@ pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
             title: format!("Measured vs nominal vs fitted (output 1): {}", r.selected()),
             x_label: "t (s)".into(),
             y_label: "y".into(),
-            series: vec![mk("measured", &y0), mk("nominal", &col(&s.yhat_nominal, 0)), mk("fitted", &col(&s.yhat_fitted, 0))],
+            series: vec![
+                mk("measured", &y0),
+                mk("nominal", &col(&s.yhat_nominal, 0)),
+                mk("fitted", &col(&s.yhat_fitted, 0)),
+            ],
             windows: vec![(r.validation_segment[0], r.validation_segment[1])],
             size: (1200, 500),
         },
@@ -99,13 +106,21 @@ pub fn write_outputs(r: &Report, out: &std::path::Path) -> anyhow::Result<()> {
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let sys = model::load(&a.model).with_context(|| format!("model {}", a.model.display()))?;
     let rec = Recording::load(&a.data)?;
-    let settings = DiagnoseSettings { estimation_fraction: a.estimation_fraction, max_effects: a.max_effects, ..Default::default() };
+    let settings = DiagnoseSettings {
+        estimation_fraction: a.estimation_fraction,
+        max_effects: a.max_effects,
+        ..Default::default()
+    };
     let start = std::time::Instant::now();
     let r = discovery::diagnose(&sys, &rec, &settings)?;
     let secs = start.elapsed().as_secs_f64();
     write_outputs(&r, &a.out)?;
     println!("{}", r.verdict);
-    println!("validation fit % (nominal -> fitted): {:?} -> {:?}", r.fit_before.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>(), r.fit_after.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>());
+    println!(
+        "validation fit % (nominal -> fitted): {:?} -> {:?}",
+        r.fit_before.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>(),
+        r.fit_after.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>()
+    );
     for e in &r.effects {
         println!("  {}: {:?}", e.label, e.params);
     }

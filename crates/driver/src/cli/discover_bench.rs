@@ -42,11 +42,19 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let r = discovery::bench::run(a.cases, a.seed, &Default::default(), |c| {
-        eprintln!("{:>18} #{:<3} -> {:<34} {} ({:.1} s)", c.class, c.index, c.selected, c.error.as_deref().unwrap_or(""), c.seconds);
+        eprintln!(
+            "{:>18} #{:<3} -> {:<34} {} ({:.1} s)",
+            c.class,
+            c.index,
+            c.selected,
+            c.error.as_deref().unwrap_or(""),
+            c.seconds
+        );
     });
     println!("{}", r.to_text());
     if let Some(p) = &a.json {
-        crate::output::write_atomic(p, serde_json::to_string_pretty(&r)?.as_bytes()).with_context(|| format!("writing {}", p.display()))?;
+        crate::output::write_atomic(p, serde_json::to_string_pretty(&r)?.as_bytes())
+            .with_context(|| format!("writing {}", p.display()))?;
     }
     Ok(ExitCode::SUCCESS)
 }

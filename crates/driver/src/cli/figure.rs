@@ -59,12 +59,22 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             let sys = model::load(&a.input).with_context(|| a.input.display().to_string())?;
             match a.kind {
                 Kind::Trajectory => {
-                    let (yz, x) = figures::trajectory::trajectory_figures(&sys, &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() })?;
+                    let (yz, x) = figures::trajectory::trajectory_figures(
+                        &sys,
+                        &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() },
+                    )?;
                     vec![("trajectory-yz".into(), yz), ("trajectory-x".into(), x)]
                 }
                 Kind::Psi => {
                     let r = crate::theta::assemble(&sys, &crate::theta::ThetaSettings::bound_only())?;
-                    eprintln!("theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}", r.theta, if r.theta_verified { "verified" } else { "not verified" }, r.psi_0, r.psi_inf, -r.lambda);
+                    eprintln!(
+                        "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
+                        r.theta,
+                        if r.theta_verified { "verified" } else { "not verified" },
+                        r.psi_0,
+                        r.psi_inf,
+                        -r.lambda
+                    );
                     vec![("fig-psi1".into(), figures::psi::from_report(&r))]
                 }
                 Kind::Tube => {

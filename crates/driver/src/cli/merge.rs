@@ -21,7 +21,14 @@ pub struct Args {
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let (m, files) = crate::sweep::merge::merge_into(&a.inputs, &a.out, a.partial, a.digits)?;
     let failed = m.points.iter().filter(|p| !p.ok()).count();
-    eprintln!("merged `{}`: {} of {} points, {} failed; spec hash {}", m.name, m.points.len(), m.total_points, failed, m.spec_hash);
+    eprintln!(
+        "merged `{}`: {} of {} points, {} failed; spec hash {}",
+        m.name,
+        m.points.len(),
+        m.total_points,
+        failed,
+        m.spec_hash
+    );
     for f in &files {
         println!("{}", f.display());
     }

@@ -6,14 +6,14 @@ pub mod check;
 pub mod convergence;
 pub mod diagnose;
 pub mod discover_bench;
+pub mod figure;
+pub mod merge;
 pub mod periodic;
+pub mod play_width;
 pub mod simulate;
 pub mod sweep;
-pub mod merge;
-pub mod figure;
 pub mod theta;
 pub mod validate;
-pub mod play_width;
 
 /// Convergence to periodic regimes with a strongly convex backlash: simulate, certify, check.
 #[derive(Debug, Parser)]

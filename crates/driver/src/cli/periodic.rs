@@ -37,13 +37,21 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         bail!("--periods must be at least 1, got 0");
     }
     if sys.period().is_none() {
-        bail!("`{}` has a non-periodic input (`{}`): the periodic regime needs a T-periodic w", a.file.display(), sys.input.kind());
+        bail!(
+            "`{}` has a non-periodic input (`{}`): the periodic regime needs a T-periodic w",
+            a.file.display(),
+            sys.input.kind()
+        );
     }
     let reg = periodic_regime(&sys, &PoincareSettings { dt, ..Default::default() })?;
     let lin = linearised_periodic(&sys, &LinearisedSettings::default())?;
     let loc = check_localisation(&sys, lin.xi0(), &reg.x0, &reg.z0, &LocalisationSettings::default());
     let transient = (a.periods / 6).max(1).min(10);
-    let rate = measure_rate(&sys, &RateSettings { dt, periods: a.periods, transient_periods: transient, pairs: a.pairs, ..Default::default() }, None)?;
+    let rate = measure_rate(
+        &sys,
+        &RateSettings { dt, periods: a.periods, transient_periods: transient, pairs: a.pairs, ..Default::default() },
+        None,
+    )?;
     if a.json {
         let v = serde_json::json!({
             "name": sys.name, "period": reg.period, "h": reg.h,
@@ -58,11 +66,36 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         println!("{}", sys.name);
         println!("  period T = {:.9}, step h = {:e} ({} steps per period)", reg.period, reg.h, reg.steps_per_period);
         println!("  periodic regime: x(0) = [{}], z(0) = [{}]", f(&reg.x0), f(&reg.z0));
-        println!("    fixed-point iteration: {:?} after {} periods, residual |P(s) - s|_inf = {:.3e}", reg.status, reg.iterations, reg.residual);
-        println!("    (loc): {} (worst margin {:.3e} over {} directions, q in Theta: {})", if loc.inside { "inside" } else { "OUTSIDE" }, loc.worst_margin, loc.directions, loc.q_in_theta);
-        println!("  linearised: xi_T(0) = [{}], osc(eta_T) >= {:.6}, max sampled |eta_T'| = {:.6}", f(lin.xi0()), lin.osc_lower(), lin.deta_inf_sampled());
-        println!("  measured exponent (1/2) limsup (1/t) ln V: {:.5}  95% CI [{:.5}, {:.5}]  ({} pairs, periods {}..{})", rate.exponent, rate.ci_low, rate.ci_high, rate.pairs.len(), rate.transient_periods, rate.periods);
-        println!("  path length of z per period (min after transient): {:.6};  limsup |z'|: {:.6}", rate.path_length_per_period, rate.limsup_z_speed);
+        println!(
+            "    fixed-point iteration: {:?} after {} periods, residual |P(s) - s|_inf = {:.3e}",
+            reg.status, reg.iterations, reg.residual
+        );
+        println!(
+            "    (loc): {} (worst margin {:.3e} over {} directions, q in Theta: {})",
+            if loc.inside { "inside" } else { "OUTSIDE" },
+            loc.worst_margin,
+            loc.directions,
+            loc.q_in_theta
+        );
+        println!(
+            "  linearised: xi_T(0) = [{}], osc(eta_T) >= {:.6}, max sampled |eta_T'| = {:.6}",
+            f(lin.xi0()),
+            lin.osc_lower(),
+            lin.deta_inf_sampled()
+        );
+        println!(
+            "  measured exponent (1/2) limsup (1/t) ln V: {:.5}  95% CI [{:.5}, {:.5}]  ({} pairs, periods {}..{})",
+            rate.exponent,
+            rate.ci_low,
+            rate.ci_high,
+            rate.pairs.len(),
+            rate.transient_periods,
+            rate.periods
+        );
+        println!(
+            "  path length of z per period (min after transient): {:.6};  limsup |z'|: {:.6}",
+            rate.path_length_per_period, rate.limsup_z_speed
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

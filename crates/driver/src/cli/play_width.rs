@@ -32,9 +32,18 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let text = std::fs::read_to_string(&a.data).with_context(|| format!("cannot read {}", a.data.display()))?;
     let cfg_text = std::fs::read_to_string(&a.config).with_context(|| format!("cannot read {}", a.config.display()))?;
     let cfg = robonine::StandConfig::from_json_str(&cfg_text).with_context(|| a.config.display().to_string())?;
-    let s = PlayWidthSettings { min_segment_samples: a.min_segment_samples, skip_samples: a.skip_samples, resolution: 1.0, ..Default::default() };
+    let s = PlayWidthSettings {
+        min_segment_samples: a.min_segment_samples,
+        skip_samples: a.skip_samples,
+        resolution: 1.0,
+        ..Default::default()
+    };
     let res = robonine::analyse(&text, &a.data.display().to_string(), &cfg, &s)?;
-    println!("play width from {} (1 count = {:.4} deg; +- is one standard uncertainty)", a.data.display(), robonine::COUNT_DEG);
+    println!(
+        "play width from {} (1 count = {:.4} deg; +- is one standard uncertainty)",
+        a.data.display(),
+        robonine::COUNT_DEG
+    );
     println!("{:>6} {:>9} {:>22} {:>16} {:>7}", "servo", "state", "width (counts)", "width (deg)", "cycles");
     for r in &res {
         for (state, e) in [("unloaded", &r.unloaded), ("loaded", &r.loaded)] {

@@ -1,6 +1,6 @@
 //! `moreau simulate FILE [--periods N] [--dt H] [--integrator catching-up|event] --out DIR`
 use crate::output::StagedDir;
-use crate::plot::{write_png, to_svg_string, LinePlot, Series};
+use crate::plot::{to_svg_string, write_png, LinePlot, Series};
 use anyhow::{bail, Context};
 use dynamics::integrators::catching_up::CatchingUpSettings;
 use dynamics::integrators::event_driven::{event_driven, EventDrivenSettings};
@@ -56,7 +56,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         }
         None => {
             if a.periods.is_some() {
-                bail!("--periods needs a periodic input; `{}` has input `{}` (set simulation.t_end instead)", a.file.display(), sys.input.kind());
+                bail!(
+                    "--periods needs a periodic input; `{}` has input `{}` (set simulation.t_end instead)",
+                    a.file.display(),
+                    sys.input.kind()
+                );
             }
             (sys.sim.t_end.unwrap_or(100.0), dt)
         }
@@ -64,28 +68,63 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let steps = (t_end / h).round().max(1.0) as usize;
     let every = steps.div_ceil(a.max_rows).max(1);
     let (tr, what) = match a.integrator {
-        Integrator::CatchingUp => (simulate_catching_up(&sys, &CatchingUpSettings { dt: h, ..Default::default() }, steps, every)?, format!("catching-up, h = {h:e}")),
+        Integrator::CatchingUp => (
+            simulate_catching_up(&sys, &CatchingUpSettings { dt: h, ..Default::default() }, steps, every)?,
+            format!("catching-up, h = {h:e}"),
+        ),
         Integrator::Event => {
-            let (tr, events) = event_driven(&sys, &EventDrivenSettings { dt_out: h * every as f64, t_end: (steps / every) as f64 * every as f64 * h, ..Default::default() })?;
+            let (tr, events) = event_driven(
+                &sys,
+                &EventDrivenSettings {
+                    dt_out: h * every as f64,
+                    t_end: (steps / every) as f64 * every as f64 * h,
+                    ..Default::default()
+                },
+            )?;
             (tr, format!("event-driven, {events} events"))
         }
     };
     let csv = tr.to_csv(&sys.C);
     let mut series = Vec::new();
     for j in 0..sys.m() {
-        series.push(Series { label: format!("w{}", j + 1), x: tr.t.clone(), y: (0..tr.len()).map(|i| tr.w_at(i)[j]).collect() });
+        series.push(Series {
+            label: format!("w{}", j + 1),
+            x: tr.t.clone(),
+            y: (0..tr.len()).map(|i| tr.w_at(i)[j]).collect(),
+        });
     }
     for j in 0..sys.p() {
-        series.push(Series { label: format!("y{}", j + 1), x: tr.t.clone(), y: (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect() });
-        series.push(Series { label: format!("z{}", j + 1), x: tr.t.clone(), y: (0..tr.len()).map(|i| tr.z_at(i)[j]).collect() });
+        series.push(Series {
+            label: format!("y{}", j + 1),
+            x: tr.t.clone(),
+            y: (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect(),
+        });
+        series.push(Series {
+            label: format!("z{}", j + 1),
+            x: tr.t.clone(),
+            y: (0..tr.len()).map(|i| tr.z_at(i)[j]).collect(),
+        });
     }
-    let plot = LinePlot { title: format!("{} ({what})", sys.name), x_label: "t".into(), y_label: "w, y, z".into(), series, windows: vec![], size: (0, 0) };
+    let plot = LinePlot {
+        title: format!("{} ({what})", sys.name),
+        x_label: "t".into(),
+        y_label: "w, y, z".into(),
+        series,
+        windows: vec![],
+        size: (0, 0),
+    };
     let svg = to_svg_string(&plot)?;
     let stage = StagedDir::new(&a.out)?;
     std::fs::write(stage.path("trajectory.csv"), csv)?;
     std::fs::write(stage.path("trajectory.svg"), svg)?;
     write_png(&plot, &stage.path("trajectory.png"))?;
     stage.commit()?;
-    println!("{}: {} samples up to t = {:.6} ({what}) -> {}", sys.name, tr.len(), tr.t.last().copied().unwrap_or(0.0), a.out.display());
+    println!(
+        "{}: {} samples up to t = {:.6} ({what}) -> {}",
+        sys.name,
+        tr.len(),
+        tr.t.last().copied().unwrap_or(0.0),
+        a.out.display()
+    );
     Ok(ExitCode::SUCCESS)
 }

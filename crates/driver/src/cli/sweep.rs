@@ -44,7 +44,16 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let spec = SweepSpec::load(&a.spec).with_context(|| format!("sweep spec {}", a.spec.display()))?;
     let evaluator = ThetaEvaluator::from_table(&spec.evaluate, &spec.path)?;
-    let opts = RunOptions { out: a.out.clone(), shard, threads: a.threads, progress: !a.quiet, overwrite: a.overwrite, fresh: a.fresh, retry_failed: a.retry_failed, digits: a.digits };
+    let opts = RunOptions {
+        out: a.out.clone(),
+        shard,
+        threads: a.threads,
+        progress: !a.quiet,
+        overwrite: a.overwrite,
+        fresh: a.fresh,
+        retry_failed: a.retry_failed,
+        digits: a.digits,
+    };
     let s = crate::sweep::run(&spec, &evaluator, &opts)?;
     eprintln!(
         "sweep `{}`: {} points in scope, {} resumed, {} computed, {} failed; spec hash {}",

@@ -37,7 +37,11 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
     s.push('\n');
     if let Some(st) = &rep.stationary {
         let state = match st.empty {
-            Some(true) => format!("empty (slack s* = {}{})", fmt_value(st.slack), if st.verified { ", proven" } else { ", solver estimate" }),
+            Some(true) => format!(
+                "empty (slack s* = {}{})",
+                fmt_value(st.slack),
+                if st.verified { ", proven" } else { ", solver estimate" }
+            ),
             Some(false) => format!(
                 "nonempty: z0 = {:?} stays at rest over [0, T] (simulated drift {})",
                 st.point.as_deref().unwrap_or(&[]),
@@ -48,7 +52,9 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
         s.push_str(&format!("Stationary set R(T) (Thm 1, (stat1)): {state}\n"));
         match st.phi.first_singular {
             Some(t) => s.push_str(&format!("Phi(t) (eq. (Phi)) becomes singular at t = {t:.6}\n")),
-            None => s.push_str(&format!("Phi(t) (eq. (Phi)) nonsingular on [0, T] (min sigma {:.3e})\n", st.phi.min_sigma)),
+            None => {
+                s.push_str(&format!("Phi(t) (eq. (Phi)) nonsingular on [0, T] (min sigma {:.3e})\n", st.phi.min_sigma))
+            }
         }
     }
     let verdict = if rep.convergence_guaranteed {

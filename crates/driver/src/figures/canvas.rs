@@ -33,7 +33,9 @@ impl Element {
     fn points(&self) -> Vec<(f64, f64)> {
         match self {
             Element::Line { pts, .. } | Element::Polygon { pts, .. } | Element::Markers { pts, .. } => pts.clone(),
-            Element::Band { x, lo, hi, .. } => x.iter().zip(lo).map(|(&a, &b)| (a, b)).chain(x.iter().zip(hi).map(|(&a, &b)| (a, b))).collect(),
+            Element::Band { x, lo, hi, .. } => {
+                x.iter().zip(lo).map(|(&a, &b)| (a, b)).chain(x.iter().zip(hi).map(|(&a, &b)| (a, b))).collect()
+            }
         }
     }
 }
@@ -53,7 +55,14 @@ pub struct Figure {
 
 impl Figure {
     pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
-        Self { title: title.into(), x_label: x_label.into(), y_label: y_label.into(), elements: vec![], equal_aspect: false, size: (900, 600) }
+        Self {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            elements: vec![],
+            equal_aspect: false,
+            size: (900, 600),
+        }
     }
 
     /// Data ranges with 5 % padding; `None` when nothing is finite.
@@ -113,13 +122,31 @@ where
     let fx = move |v: &f64| format!("{:.*}", dx, if v.abs() < 1e-300 { 0.0 } else { *v });
     let fy = move |v: &f64| {
         let s = format!("{:.*}", dy, v);
-        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') { s.trim_start_matches('-').to_string() } else { s }
+        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+            s.trim_start_matches('-').to_string()
+        } else {
+            s
+        }
     };
     let fx = move |v: &f64| {
         let s = fx(v);
-        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') { s.trim_start_matches('-').to_string() } else { s }
+        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+            s.trim_start_matches('-').to_string()
+        } else {
+            s
+        }
     };
-    chart.configure_mesh().x_label_formatter(&fx).y_label_formatter(&fy).x_desc(f.x_label.as_str()).y_desc(f.y_label.as_str()).label_style(("sans-serif", 15)).axis_desc_style(("sans-serif", 17)).light_line_style(RGBColor(235, 235, 235)).draw().map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .x_desc(f.x_label.as_str())
+        .y_desc(f.y_label.as_str())
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 17))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| err(&e))?;
     let mut legend = false;
     for e in &f.elements {
         match e {
@@ -127,18 +154,24 @@ where
                 let mut pts: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
                 pts.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
                 let c = *color;
-                let a = chart.draw_series(std::iter::once(Polygon::new(finite(&pts), c.mix(0.22).filled()))).map_err(|e| err(&e))?;
+                let a = chart
+                    .draw_series(std::iter::once(Polygon::new(finite(&pts), c.mix(0.22).filled())))
+                    .map_err(|e| err(&e))?;
                 if !label.is_empty() {
                     legend = true;
-                    a.label(label.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
+                    a.label(label.clone())
+                        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
                 }
             }
             Element::Polygon { label, pts, color } => {
                 let c = *color;
-                let a = chart.draw_series(std::iter::once(Polygon::new(finite(pts), c.mix(0.12).filled()))).map_err(|e| err(&e))?;
+                let a = chart
+                    .draw_series(std::iter::once(Polygon::new(finite(pts), c.mix(0.12).filled())))
+                    .map_err(|e| err(&e))?;
                 if !label.is_empty() {
                     legend = true;
-                    a.label(label.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
+                    a.label(label.clone())
+                        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
                 }
             }
             Element::Line { label, pts, color, dashed } => {
@@ -151,12 +184,15 @@ where
                 };
                 if !label.is_empty() {
                     legend = true;
-                    a.label(label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                    a.label(label.clone())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
                 }
             }
             Element::Markers { label, pts, text, color } => {
                 let c = *color;
-                let a = chart.draw_series(finite(pts).into_iter().map(|p| Circle::new(p, 5, c.filled()))).map_err(|e| err(&e))?;
+                let a = chart
+                    .draw_series(finite(pts).into_iter().map(|p| Circle::new(p, 5, c.filled())))
+                    .map_err(|e| err(&e))?;
                 if !label.is_empty() {
                     legend = true;
                     a.label(label.clone()).legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
@@ -164,7 +200,8 @@ where
                 for (p, t) in pts.iter().zip(text) {
                     if p.0.is_finite() && p.1.is_finite() && !t.is_empty() {
                         // text set off above right of the marker (pixels), clear of the curves
-                        let label = EmptyElement::at(*p) + Text::new(t.clone(), (6, -22), ("sans-serif", 15).into_font().color(&BLACK));
+                        let label = EmptyElement::at(*p)
+                            + Text::new(t.clone(), (6, -22), ("sans-serif", 15).into_font().color(&BLACK));
                         chart.draw_series(std::iter::once(label)).map_err(|e| err(&e))?;
                     }
                 }
@@ -172,7 +209,14 @@ where
         }
     }
     if legend {
-        chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 15)).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .draw()
+            .map_err(|e| err(&e))?;
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
@@ -198,7 +242,8 @@ pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
 
 /// Writes `stem.svg` and `stem.png` for every `(stem, figure)` into `out`, all or none.
 pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf>, FigureError> {
-    let werr = |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
+    let werr =
+        |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
     let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
     let mut files = vec![];
     for (stem, f) in figs {

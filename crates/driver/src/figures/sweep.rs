@@ -10,14 +10,26 @@ pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Resul
     let names = || r.axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>().join(", ");
     let xi = match x {
         None => 0,
-        Some(n) => r.axes.iter().position(|a| a.name == n).ok_or_else(|| FigureError::UnknownAxis { name: n.into(), known: names() })?,
+        Some(n) => r
+            .axes
+            .iter()
+            .position(|a| a.name == n)
+            .ok_or_else(|| FigureError::UnknownAxis { name: n.into(), known: names() })?,
     };
     let col_idx: Vec<usize> = columns
         .iter()
         .map(|c| {
-            r.columns.iter().position(|k| k.name == *c && k.kind == ColumnKind::Number).ok_or_else(|| FigureError::UnknownColumn {
-                name: c.to_string(),
-                known: r.columns.iter().filter(|k| k.kind == ColumnKind::Number).map(|k| k.name.as_str()).collect::<Vec<_>>().join(", "),
+            r.columns.iter().position(|k| k.name == *c && k.kind == ColumnKind::Number).ok_or_else(|| {
+                FigureError::UnknownColumn {
+                    name: c.to_string(),
+                    known: r
+                        .columns
+                        .iter()
+                        .filter(|k| k.kind == ColumnKind::Number)
+                        .map(|k| k.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                }
             })
         })
         .collect::<Result<_, _>>()?;
@@ -33,15 +45,30 @@ pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Resul
     let mut colour = 0;
     for (key_bits, pts) in &groups {
         let suffix = if multi {
-            let others: Vec<String> = r.axes.iter().enumerate().filter(|(k, _)| *k != xi).zip(key_bits).map(|((_, a), b)| format!("{} = {}", a.name, f64::from_bits(*b))).collect();
+            let others: Vec<String> = r
+                .axes
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != xi)
+                .zip(key_bits)
+                .map(|((_, a), b)| format!("{} = {}", a.name, f64::from_bits(*b)))
+                .collect();
             format!(" ({})", others.join(", "))
         } else {
             String::new()
         };
         for (&c, name) in col_idx.iter().zip(columns) {
-            let mut xy: Vec<(f64, f64)> = pts.iter().filter_map(|p| if let Cell::Num(v) = p.cells[c] { Some((p.params[xi], v)) } else { None }).collect();
+            let mut xy: Vec<(f64, f64)> = pts
+                .iter()
+                .filter_map(|p| if let Cell::Num(v) = p.cells[c] { Some((p.params[xi], v)) } else { None })
+                .collect();
             xy.sort_by(|a, b| a.0.total_cmp(&b.0));
-            f.elements.push(Element::Line { label: format!("{name}{suffix}"), pts: xy.clone(), color: palette(colour), dashed: false });
+            f.elements.push(Element::Line {
+                label: format!("{name}{suffix}"),
+                pts: xy.clone(),
+                color: palette(colour),
+                dashed: false,
+            });
             f.elements.push(Element::Markers { label: String::new(), pts: xy, text: vec![], color: palette(colour) });
             colour += 1;
         }

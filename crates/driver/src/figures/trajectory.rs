@@ -31,18 +31,38 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
     });
     let steps = ((t_end / dt).ceil() as usize).max(1);
     let every = (steps / s.max_points.max(1)).max(1);
-    let tr = dynamics::trajectory::simulate_catching_up(sys, &CatchingUpSettings { dt, ..Default::default() }, steps, every)?;
+    let tr = dynamics::trajectory::simulate_catching_up(
+        sys,
+        &CatchingUpSettings { dt, ..Default::default() },
+        steps,
+        every,
+    )?;
     let mut yz = Figure::new(&format!("Trajectory of `{}`: y = C x and z", sys.name), "t", "y, z");
     let mut xf = Figure::new(&format!("Trajectory of `{}`: state x", sys.name), "t", "x");
     let ys: Vec<Vec<f64>> = (0..tr.len()).map(|i| tr.y_at(&sys.C, i)).collect();
     let p = sys.p();
     for k in 0..p {
         let sub = if p > 1 { format!("{}", k + 1) } else { String::new() };
-        yz.elements.push(Element::Line { label: format!("y{sub}"), pts: tr.t.iter().zip(&ys).map(|(&t, y)| (t, y[k])).collect(), color: palette(2 * k), dashed: false });
-        yz.elements.push(Element::Line { label: format!("z{sub}"), pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.z_at(i)[k])).collect(), color: palette(2 * k + 1), dashed: false });
+        yz.elements.push(Element::Line {
+            label: format!("y{sub}"),
+            pts: tr.t.iter().zip(&ys).map(|(&t, y)| (t, y[k])).collect(),
+            color: palette(2 * k),
+            dashed: false,
+        });
+        yz.elements.push(Element::Line {
+            label: format!("z{sub}"),
+            pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.z_at(i)[k])).collect(),
+            color: palette(2 * k + 1),
+            dashed: false,
+        });
     }
     for k in 0..sys.n() {
-        xf.elements.push(Element::Line { label: format!("x{}", k + 1), pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.x_at(i)[k])).collect(), color: palette(k), dashed: false });
+        xf.elements.push(Element::Line {
+            label: format!("x{}", k + 1),
+            pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.x_at(i)[k])).collect(),
+            color: palette(k),
+            dashed: false,
+        });
     }
     Ok((yz, xf))
 }

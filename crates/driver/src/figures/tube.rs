@@ -32,7 +32,12 @@ pub fn periodic_z(sys: &System, samples: usize) -> Result<PeriodicZ, FigureError
     s.x0 = DVector::from_vec(reg.x0.clone());
     s.z0 = DVector::from_vec(reg.z0.clone());
     let every = (reg.steps_per_period / samples.max(1)).max(1);
-    let tr = dynamics::trajectory::simulate_catching_up(&s, &CatchingUpSettings { dt: reg.h, ..Default::default() }, reg.steps_per_period, every)?;
+    let tr = dynamics::trajectory::simulate_catching_up(
+        &s,
+        &CatchingUpSettings { dt: reg.h, ..Default::default() },
+        reg.steps_per_period,
+        every,
+    )?;
     let t: Vec<f64> = tr.t.iter().map(|t| t.min(T)).collect();
     let z = (0..tr.len()).map(|i| tr.z_at(i).to_vec()).collect();
     let converged = reg.status == dynamics::periodic::poincare::FixedPointStatus::Converged;
@@ -43,7 +48,8 @@ pub fn periodic_z(sys: &System, samples: usize) -> Result<PeriodicZ, FigureError
 /// coordinates of R^p, from `k` directions: vertex `j` is where the support lines of
 /// directions `j` and `j + 1` meet.
 pub fn support_polygon(p: usize, k: usize, h: impl Fn(&[f64]) -> f64) -> Vec<(f64, f64)> {
-    let dirs: Vec<(f64, f64)> = (0..k).map(|j| std::f64::consts::TAU * j as f64 / k as f64).map(|a| (a.cos(), a.sin())).collect();
+    let dirs: Vec<(f64, f64)> =
+        (0..k).map(|j| std::f64::consts::TAU * j as f64 / k as f64).map(|a| (a.cos(), a.sin())).collect();
     let vals: Vec<f64> = dirs
         .iter()
         .map(|&(c, s)| {
@@ -77,9 +83,25 @@ pub fn tube_figure(sys: &System, r: &ThetaReport, z_periodic: &PeriodicZ) -> Fig
         let up: Vec<f64> = orbit.eta.iter().map(|e| e[0] + r.tube_theta_support_upper(&[1.0])).collect();
         let lo: Vec<f64> = orbit.eta.iter().map(|e| e[0] - r.tube_theta_support_upper(&[-1.0])).collect();
         let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "t (one period)", "η_T, z");
-        f.elements.push(Element::Band { label: "tube η_T + C Ξ∞ + Θ".into(), x: orbit.t.clone(), lo, hi: up, color: BLUE });
-        f.elements.push(Element::Line { label: "η_T (linearised orbit)".into(), pts: orbit.t.iter().zip(&orbit.eta).map(|(&t, e)| (t, e[0])).collect(), color: BLUE, dashed: false });
-        f.elements.push(Element::Line { label: z_label.clone(), pts: tz.iter().zip(z).map(|(&t, z)| (t, z[0])).collect(), color: RED, dashed: false });
+        f.elements.push(Element::Band {
+            label: "tube η_T + C Ξ∞ + Θ".into(),
+            x: orbit.t.clone(),
+            lo,
+            hi: up,
+            color: BLUE,
+        });
+        f.elements.push(Element::Line {
+            label: "η_T (linearised orbit)".into(),
+            pts: orbit.t.iter().zip(&orbit.eta).map(|(&t, e)| (t, e[0])).collect(),
+            color: BLUE,
+            dashed: false,
+        });
+        f.elements.push(Element::Line {
+            label: z_label.clone(),
+            pts: tz.iter().zip(z).map(|(&t, z)| (t, z[0])).collect(),
+            color: RED,
+            dashed: false,
+        });
         return f;
     }
     let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "η₁, z₁", "η₂, z₂");
@@ -89,9 +111,23 @@ pub fn tube_figure(sys: &System, r: &ThetaReport, z_periodic: &PeriodicZ) -> Fig
     let count = 40.min(m);
     for (n, i) in (0..count).map(|j| j * (m - 1) / count.max(1)).enumerate() {
         let e = &orbit.eta[i];
-        f.elements.push(Element::Polygon { label: if n == 0 { "cross-sections C Ξ∞ + Θ".into() } else { String::new() }, pts: section.iter().map(|&(x, y)| (x + e[0], y + e[1])).collect(), color: BLUE });
+        f.elements.push(Element::Polygon {
+            label: if n == 0 { "cross-sections C Ξ∞ + Θ".into() } else { String::new() },
+            pts: section.iter().map(|&(x, y)| (x + e[0], y + e[1])).collect(),
+            color: BLUE,
+        });
     }
-    f.elements.push(Element::Line { label: "η_T (linearised orbit)".into(), pts: orbit.eta.iter().map(|e| (e[0], e[1])).collect(), color: BLUE, dashed: false });
-    f.elements.push(Element::Line { label: z_label, pts: z.iter().map(|z| (z[0], z[1])).collect(), color: RED, dashed: false });
+    f.elements.push(Element::Line {
+        label: "η_T (linearised orbit)".into(),
+        pts: orbit.eta.iter().map(|e| (e[0], e[1])).collect(),
+        color: BLUE,
+        dashed: false,
+    });
+    f.elements.push(Element::Line {
+        label: z_label,
+        pts: z.iter().map(|z| (z[0], z[1])).collect(),
+        color: RED,
+        dashed: false,
+    });
     f
 }

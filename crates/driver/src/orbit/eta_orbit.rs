@@ -58,12 +58,19 @@ impl EtaOrbit {
     pub fn new(sys: &System, settings: &OrbitSettings) -> Result<Self, DriverError> {
         let T = sys.period().ok_or(DriverError::NoPeriod { kind: sys.input.kind() })?;
         if settings.samples < 2 {
-            return Err(DriverError::BadSetting { name: "orbit.samples", value: settings.samples as f64, reason: "must be at least 2" });
+            return Err(DriverError::BadSetting {
+                name: "orbit.samples",
+                value: settings.samples as f64,
+                reason: "must be at least 2",
+            });
         }
         match &sys.input {
-            Input::Sine { amplitudes, omega, phase } => Ok(Self::sine(sys, amplitudes, *omega, *phase, T, settings.samples)),
+            Input::Sine { amplitudes, omega, phase } => {
+                Ok(Self::sine(sys, amplitudes, *omega, *phase, T, settings.samples))
+            }
             _ => {
-                let lp = linearised_periodic(sys, &LinearisedSettings { samples: settings.samples, ..Default::default() })?;
+                let lp =
+                    linearised_periodic(sys, &LinearisedSettings { samples: settings.samples, ..Default::default() })?;
                 let osc = lp.osc_lower();
                 let eta_dot_inf = lp.deta_inf_sampled();
                 Ok(Self {
@@ -84,7 +91,8 @@ impl EtaOrbit {
         let n = sys.n();
         let F = sys.F();
         let Ba = &sys.B * DVector::from_column_slice(a);
-        let M: DMatrix<Complex<f64>> = DMatrix::from_fn(n, n, |i, j| Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 }));
+        let M: DMatrix<Complex<f64>> =
+            DMatrix::from_fn(n, n, |i, j| Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 }));
         let rhs: DVector<Complex<f64>> = Ba.map(|x| Complex::new(x, 0.0));
         // Condition number of the complex matrix for the rounding margin.
         let sv = M.clone().singular_values();

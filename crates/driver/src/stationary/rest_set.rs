@@ -97,7 +97,11 @@ fn open_loop(sys: &System, T: f64, K: usize, sub: usize) -> Result<Vec<DVector<f
 pub fn rest_set(sys: &System, settings: &RestSetSettings) -> Result<RestSet, DriverError> {
     let T = sys.period().ok_or(DriverError::NoPeriod { kind: sys.input.kind() })?;
     if settings.grid < 2 || settings.substeps == 0 {
-        return Err(DriverError::BadSetting { name: "stationary.grid", value: settings.grid as f64, reason: "grid >= 2 and substeps >= 1" });
+        return Err(DriverError::BadSetting {
+            name: "stationary.grid",
+            value: settings.grid as f64,
+            reason: "grid >= 2 and substeps >= 1",
+        });
     }
     let K = settings.grid;
     let p = sys.p();
@@ -130,15 +134,33 @@ pub fn rest_set(sys: &System, settings: &RestSetSettings) -> Result<RestSet, Dri
             let gap = lo - hi;
             let margin = settings.margin_rel * (1.0 + lo.abs().min(hi.abs()));
             if impossible || gap > 0.0 {
-                (Some(true), impossible || gap > margin, gap, None, "exact intersection of intervals on the grid (p = 1)")
+                (
+                    Some(true),
+                    impossible || gap > margin,
+                    gap,
+                    None,
+                    "exact intersection of intervals on the grid (p = 1)",
+                )
             } else {
-                (Some(false), false, gap, Some(vec![0.5 * (lo + hi)]), "exact intersection of intervals on the grid (p = 1)")
+                (
+                    Some(false),
+                    false,
+                    gap,
+                    Some(vec![0.5 * (lo + hi)]),
+                    "exact intersection of intervals on the grid (p = 1)",
+                )
             }
         }
         theta => {
             let (s, z) = socp(theta, &Phis, &cs)?;
             if s > 0.0 {
-                (Some(true), false, s, None, "second-order cone program (Clarabel) on the grid; emptiness from the solver's optimum (estimate)")
+                (
+                    Some(true),
+                    false,
+                    s,
+                    None,
+                    "second-order cone program (Clarabel) on the grid; emptiness from the solver's optimum (estimate)",
+                )
             } else {
                 (Some(false), false, s, Some(z), "second-order cone program (Clarabel) on the grid")
             }
@@ -164,7 +186,8 @@ pub fn confirm_at_rest(sys: &System, z: &[f64], dt: f64) -> Result<f64, DriverEr
     let mut s2 = sys.clone();
     s2.z0 = DVector::from_column_slice(z);
     let (N, h) = dynamics::periodic::steps_per_period(T, dt)?;
-    let traj = dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, N, 1)?;
+    let traj =
+        dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, N, 1)?;
     let mut drift = 0.0f64;
     for i in 0..traj.len() {
         drift = drift.max(geometry::linalg::dist(traj.z_at(i), z));
@@ -187,7 +210,14 @@ fn socp(theta: &Shape, Phis: &[DMatrix<f64>], cs: &[DVector<f64>]) -> Result<(f6
     b.push(big);
     cones.push(SupportedConeT::NonnegativeConeT(1));
     // SOC ||W (Phi z - c - centre)|| <= rad + s:  s_cone = [rad + s; W (Phi z - c - centre)]
-    let soc = |W: &DMatrix<f64>, centre: &[f64], rad: f64, P: &DMatrix<f64>, c: &DVector<f64>, rows: &mut Vec<Vec<f64>>, b: &mut Vec<f64>, cones: &mut Vec<SupportedConeT<f64>>| {
+    let soc = |W: &DMatrix<f64>,
+               centre: &[f64],
+               rad: f64,
+               P: &DMatrix<f64>,
+               c: &DVector<f64>,
+               rows: &mut Vec<Vec<f64>>,
+               b: &mut Vec<f64>,
+               cones: &mut Vec<SupportedConeT<f64>>| {
         let mut r = vec![0.0; nv];
         r[p] = -1.0;
         rows.push(r);
@@ -215,7 +245,9 @@ fn socp(theta: &Shape, Phis: &[DMatrix<f64>], cs: &[DVector<f64>]) -> Result<(f6
             }
             Shape::Ellipsoid(el) => {
                 let M = DMatrix::from_row_slice(p, p, el.matrix());
-                let L = M.cholesky().ok_or(DriverError::ConicSolver { what: "ellipsoid matrix is not positive definite" })?;
+                let L = M
+                    .cholesky()
+                    .ok_or(DriverError::ConicSolver { what: "ellipsoid matrix is not positive definite" })?;
                 let W = L.l().try_inverse().ok_or(DriverError::ConicSolver { what: "ellipsoid factor is singular" })?;
                 soc(&W, el.centre(), 1.0, P, c, &mut rows, &mut b, &mut cones);
             }
@@ -266,7 +298,8 @@ fn socp(theta: &Shape, Phis: &[DMatrix<f64>], cs: &[DVector<f64>]) -> Result<(f6
     let mut q = vec![0.0; nv];
     q[p] = 1.0;
     let settings = DefaultSettings { verbose: false, ..DefaultSettings::default() };
-    let mut solver = DefaultSolver::new(&Pm, &q, &A, &b, &cones, settings).map_err(|_| DriverError::ConicSolver { what: "rejected the problem data" })?;
+    let mut solver = DefaultSolver::new(&Pm, &q, &A, &b, &cones, settings)
+        .map_err(|_| DriverError::ConicSolver { what: "rejected the problem data" })?;
     solver.solve();
     match solver.solution.status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => {

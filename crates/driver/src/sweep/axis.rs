@@ -18,9 +18,15 @@ use nalgebra::DMatrix;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Parameter {
     /// Entry `(i, j)` of one of the plant matrices `A, B, C, E`.
-    MatrixEntry { matrix: Matrix, i: usize, j: usize },
+    MatrixEntry {
+        matrix: Matrix,
+        i: usize,
+        j: usize,
+    },
     /// All amplitudes (`None`) or amplitude `k` of a sine / square input.
-    InputAmplitude { component: Option<usize> },
+    InputAmplitude {
+        component: Option<usize>,
+    },
     InputOmega,
     InputPhase,
     /// `Theta -> s Theta`.
@@ -157,7 +163,13 @@ impl Parameter {
                 Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } => {
                     if let Parameter::InputAmplitude { component: Some(k) } = self {
                         if *k >= amplitudes.len() {
-                            return Err(SweepError::IndexOutOfRange { name, i: *k, j: 0, rows: amplitudes.len(), cols: 1 });
+                            return Err(SweepError::IndexOutOfRange {
+                                name,
+                                i: *k,
+                                j: 0,
+                                rows: amplitudes.len(),
+                                cols: 1,
+                            });
                         }
                     }
                 }
@@ -217,7 +229,10 @@ impl Parameter {
             }
             Parameter::ThetaHalfWidth => {
                 self.check_applicable(sys)?;
-                let iv = Interval::symmetric(value).map_err(|_| SweepError::NotApplicable { name: name.clone(), reason: "the half-width must be non-negative" })?;
+                let iv = Interval::symmetric(value).map_err(|_| SweepError::NotApplicable {
+                    name: name.clone(),
+                    reason: "the half-width must be non-negative",
+                })?;
                 let q0 = sys.z0[0] - (sys.C.row(0) * &sys.x0)[0];
                 sys.theta = Shape::Interval(iv);
                 // keep z0 inside y0 + Theta: clamp q0 into the new interval
@@ -247,7 +262,9 @@ fn scale_theta(sys: &mut System, s: f64, name: &str) -> Result<(), SweepError> {
             let m = DMatrix::from_row_slice(p, p, e.matrix()) * (s * s);
             Shape::Ellipsoid(Ellipsoid::new(sc(e.centre()), &m).map_err(geo)?)
         }
-        Shape::BallIntersection(b) => Shape::BallIntersection(BallIntersection::new(b.centres().iter().map(|c| sc(c)).collect(), sc(b.radii())).map_err(geo)?),
+        Shape::BallIntersection(b) => Shape::BallIntersection(
+            BallIntersection::new(b.centres().iter().map(|c| sc(c)).collect(), sc(b.radii())).map_err(geo)?,
+        ),
         Shape::Polytope(p) => Shape::Polytope(Polytope::new(p.normals().to_vec(), sc(p.offsets())).map_err(geo)?),
     };
     let y0 = &sys.C * &sys.x0;
@@ -269,7 +286,8 @@ pub fn apply_all(base: &System, settings: &[(&Parameter, f64)]) -> Result<System
         }
     }
     let (name, value) = settings.last().map(|(p, v)| (p.name(), *v)).unwrap_or_default();
-    System::new(s.name, s.A, s.B, s.C, s.E, s.theta, s.input, s.x0, s.z0, s.sim, s.effects).map_err(|source| SweepError::InvalidPoint { name, value, source })
+    System::new(s.name, s.A, s.B, s.C, s.E, s.theta, s.input, s.x0, s.z0, s.sim, s.effects)
+        .map_err(|source| SweepError::InvalidPoint { name, value, source })
 }
 
 /// Values of one axis: an explicit list or a range.
@@ -277,9 +295,18 @@ pub fn apply_all(base: &System, settings: &[(&Parameter, f64)]) -> Result<System
 pub enum Values {
     List(Vec<f64>),
     /// `count` points from `from` to `to` inclusive, linearly or logarithmically spaced.
-    Count { from: f64, to: f64, count: usize, log: bool },
+    Count {
+        from: f64,
+        to: f64,
+        count: usize,
+        log: bool,
+    },
     /// `from, from + step, ...` up to `to` (inclusive within `1e-9 step`).
-    Step { from: f64, to: f64, step: f64 },
+    Step {
+        from: f64,
+        to: f64,
+        step: f64,
+    },
 }
 
 impl Values {
@@ -300,10 +327,18 @@ impl Values {
                     }
                 }
                 if *count == 0 {
-                    return Err(SweepError::EmptyRange { name: name.into(), from: *from, to: *to, detail: "count = 0".into() });
+                    return Err(SweepError::EmptyRange {
+                        name: name.into(),
+                        from: *from,
+                        to: *to,
+                        detail: "count = 0".into(),
+                    });
                 }
                 if *log && !(*from > 0.0 && *to > 0.0) {
-                    return Err(SweepError::BadRange { name: name.into(), reason: "a log range needs from > 0 and to > 0" });
+                    return Err(SweepError::BadRange {
+                        name: name.into(),
+                        reason: "a log range needs from > 0 and to > 0",
+                    });
                 }
                 if *count == 1 {
                     if from != to {
@@ -336,7 +371,12 @@ impl Values {
                 }
                 let n = (to - from) / step;
                 if n < -1e-9 {
-                    return Err(SweepError::EmptyRange { name: name.into(), from: *from, to: *to, detail: format!("step {step} points away from `to`") });
+                    return Err(SweepError::EmptyRange {
+                        name: name.into(),
+                        from: *from,
+                        to: *to,
+                        detail: format!("step {step} points away from `to`"),
+                    });
                 }
                 let n = (n + 1e-9).floor() as usize;
                 if n > 10_000_000 {
@@ -367,7 +407,17 @@ mod tests {
 
     #[test]
     fn names_round_trip() {
-        for n in ["plant.A[1][0]", "plant.E[0][0]", "input.amplitude", "input.amplitude[1]", "input.omega", "input.phase", "theta.scale", "theta.R", "theta.half_width"] {
+        for n in [
+            "plant.A[1][0]",
+            "plant.E[0][0]",
+            "input.amplitude",
+            "input.amplitude[1]",
+            "input.omega",
+            "input.phase",
+            "theta.scale",
+            "theta.R",
+            "theta.half_width",
+        ] {
             assert_eq!(Parameter::parse(n).unwrap().name(), n);
         }
         for bad in ["plant.F[0][0]", "plant.A[1]", "plant.A[x][0]", "input.gain", "theta", "plant.A[0][0]x", ""] {
@@ -377,13 +427,22 @@ mod tests {
 
     #[test]
     fn ranges() {
-        assert_eq!(Values::Count { from: 1.0, to: 3.0, count: 3, log: false }.expand("a").unwrap(), vec![1.0, 2.0, 3.0]);
+        assert_eq!(
+            Values::Count { from: 1.0, to: 3.0, count: 3, log: false }.expand("a").unwrap(),
+            vec![1.0, 2.0, 3.0]
+        );
         let l = Values::Count { from: 0.1, to: 10.0, count: 3, log: true }.expand("a").unwrap();
         assert!((l[1] - 1.0).abs() < 1e-12 && l[2] == 10.0);
         assert_eq!(Values::Step { from: 0.0, to: 1.0, step: 0.25 }.expand("a").unwrap().len(), 5);
         assert_eq!(Values::Step { from: 1.0, to: 0.0, step: -0.5 }.expand("a").unwrap(), vec![1.0, 0.5, 0.0]);
-        assert!(matches!(Values::Step { from: 1.0, to: 0.0, step: 0.5 }.expand("a"), Err(SweepError::EmptyRange { .. })));
-        assert!(matches!(Values::Count { from: 1.0, to: 2.0, count: 0, log: false }.expand("a"), Err(SweepError::EmptyRange { .. })));
+        assert!(matches!(
+            Values::Step { from: 1.0, to: 0.0, step: 0.5 }.expand("a"),
+            Err(SweepError::EmptyRange { .. })
+        ));
+        assert!(matches!(
+            Values::Count { from: 1.0, to: 2.0, count: 0, log: false }.expand("a"),
+            Err(SweepError::EmptyRange { .. })
+        ));
         assert!(matches!(Values::List(vec![]).expand("a"), Err(SweepError::EmptyValues { .. })));
     }
 }

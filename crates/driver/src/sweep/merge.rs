@@ -15,7 +15,11 @@ pub fn collect_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, SweepError> {
             let rd = std::fs::read_dir(p).map_err(|source| SweepError::Io { path: p.clone(), source })?;
             let mut found: Vec<PathBuf> = rd
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|f| f.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("sweep") && n.ends_with(".json")))
+                .filter(|f| {
+                    f.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.starts_with("sweep") && n.ends_with(".json"))
+                })
                 .collect();
             if found.is_empty() {
                 return Err(SweepError::NothingToMerge { path: p.clone() });
@@ -40,12 +44,19 @@ pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError
         let r = SweepResult::read(f)?;
         if let Some((first, m)) = &merged {
             if m.spec_hash != r.spec_hash {
-                return Err(SweepError::MergeSpecMismatch { a: first.clone(), hash_a: m.spec_hash.clone(), b: f.clone(), hash_b: r.spec_hash });
+                return Err(SweepError::MergeSpecMismatch {
+                    a: first.clone(),
+                    hash_a: m.spec_hash.clone(),
+                    b: f.clone(),
+                    hash_b: r.spec_hash,
+                });
             }
         }
         for p in &r.points {
             match points.get(&p.index) {
-                Some((q, from)) if !same_record(q, p) => return Err(SweepError::MergeConflict { index: p.index, a: from.clone(), b: f.clone() }),
+                Some((q, from)) if !same_record(q, p) => {
+                    return Err(SweepError::MergeConflict { index: p.index, a: from.clone(), b: f.clone() })
+                }
                 Some(_) => {}
                 None => {
                     points.insert(p.index, (p.clone(), f.clone()));
@@ -59,7 +70,8 @@ pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError
     let (_, mut m) = merged.ok_or_else(|| SweepError::NothingToMerge { path: PathBuf::from(".") })?;
     m.shard = None;
     m.points = points.into_values().map(|(p, _)| p).collect();
-    let missing: Vec<usize> = (0..m.total_points).filter(|i| m.points.binary_search_by_key(i, |p| p.index).is_err()).collect();
+    let missing: Vec<usize> =
+        (0..m.total_points).filter(|i| m.points.binary_search_by_key(i, |p| p.index).is_err()).collect();
     if !missing.is_empty() && !partial {
         return Err(SweepError::MergeIncomplete { missing: missing.len(), total: m.total_points, first: missing[0] });
     }
@@ -68,14 +80,26 @@ pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError
 
 /// Equal records (NaN equal to NaN).
 fn same_record(a: &PointRecord, b: &PointRecord) -> bool {
-    a.index == b.index && a.status == b.status && a.params.len() == b.params.len() && a.params.iter().zip(&b.params).all(|(x, y)| x.to_bits() == y.to_bits()) && a.cells.len() == b.cells.len() && a.cells.iter().zip(&b.cells).all(|(x, y)| match (x, y) {
-        (super::eval::Cell::Num(x), super::eval::Cell::Num(y)) => x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
-        _ => x == y,
-    })
+    a.index == b.index
+        && a.status == b.status
+        && a.params.len() == b.params.len()
+        && a.params.iter().zip(&b.params).all(|(x, y)| x.to_bits() == y.to_bits())
+        && a.cells.len() == b.cells.len()
+        && a.cells.iter().zip(&b.cells).all(|(x, y)| match (x, y) {
+            (super::eval::Cell::Num(x), super::eval::Cell::Num(y)) => {
+                x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan())
+            }
+            _ => x == y,
+        })
 }
 
 /// Merges and writes `sweep.{json,csv,md,tex}` into `out` (all or none).
-pub fn merge_into(inputs: &[PathBuf], out: &Path, partial: bool, digits: Option<usize>) -> Result<(SweepResult, Vec<PathBuf>), SweepError> {
+pub fn merge_into(
+    inputs: &[PathBuf],
+    out: &Path,
+    partial: bool,
+    digits: Option<usize>,
+) -> Result<(SweepResult, Vec<PathBuf>), SweepError> {
     let files = collect_inputs(inputs)?;
     let mut m = merge(&files, partial)?;
     let digits = digits.unwrap_or(m.table.digits);

@@ -60,7 +60,8 @@ fn checkpoint_path(out: &Path, stem: &str) -> PathBuf {
 
 /// Writes the four tables `stem.{json,csv,md,tex}` into `out`, all or none.
 pub fn write_tables(result: &SweepResult, out: &Path, stem: &str, digits: usize) -> Result<Vec<PathBuf>, SweepError> {
-    let werr = |path: &Path, e: &dyn std::fmt::Display| SweepError::Write { path: path.to_path_buf(), reason: e.to_string() };
+    let werr =
+        |path: &Path, e: &dyn std::fmt::Display| SweepError::Write { path: path.to_path_buf(), reason: e.to_string() };
     let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
     let files = [
         (format!("{stem}.json"), result.to_json_string()),
@@ -85,7 +86,11 @@ pub fn result_header(spec: &SweepSpec, evaluator: &dyn Evaluator, shard: Option<
         spec_hash: spec.hash(&evaluator.fingerprint()),
         model: spec.model.clone(),
         evaluator: evaluator.fingerprint(),
-        axes: spec.axes.iter().map(|a| AxisInfo { name: a.parameter.name(), label: a.label.clone(), values: a.values.clone() }).collect(),
+        axes: spec
+            .axes
+            .iter()
+            .map(|a| AxisInfo { name: a.parameter.name(), label: a.label.clone(), values: a.values.clone() })
+            .collect(),
         columns: evaluator.columns(),
         total_points: spec.total_points(),
         shard,
@@ -95,7 +100,12 @@ pub fn result_header(spec: &SweepSpec, evaluator: &dyn Evaluator, shard: Option<
 }
 
 /// Points of an earlier run of the same spec in `out` (final file and checkpoint).
-fn previous_points(header: &SweepResult, out: &Path, stem: &str, overwrite: bool) -> Result<BTreeMap<usize, PointRecord>, SweepError> {
+fn previous_points(
+    header: &SweepResult,
+    out: &Path,
+    stem: &str,
+    overwrite: bool,
+) -> Result<BTreeMap<usize, PointRecord>, SweepError> {
     let mut done = BTreeMap::new();
     let final_path = out.join(format!("{stem}.json"));
     if final_path.exists() {
@@ -105,7 +115,13 @@ fn previous_points(header: &SweepResult, out: &Path, stem: &str, overwrite: bool
                     done.insert(p.index, p);
                 }
             }
-            Ok(r) if !overwrite => return Err(SweepError::OtherSpec { path: final_path, found: r.spec_hash, expected: header.spec_hash.clone() }),
+            Ok(r) if !overwrite => {
+                return Err(SweepError::OtherSpec {
+                    path: final_path,
+                    found: r.spec_hash,
+                    expected: header.spec_hash.clone(),
+                })
+            }
             Err(e) if !overwrite => return Err(e),
             _ => {}
         }
@@ -120,14 +136,19 @@ fn previous_points(header: &SweepResult, out: &Path, stem: &str, overwrite: bool
             Some(h) if h == header.spec_hash => {
                 // a line cut short by an interrupted run fails to parse and is recomputed
                 for l in lines.map_while(Result::ok) {
-                    if let Some(p) = serde_json::from_str::<serde_json::Value>(&l).ok().and_then(|v| PointRecord::from_json(&v, &header.columns, header.axes.len())) {
+                    if let Some(p) = serde_json::from_str::<serde_json::Value>(&l)
+                        .ok()
+                        .and_then(|v| PointRecord::from_json(&v, &header.columns, header.axes.len()))
+                    {
                         if p.index < header.total_points {
                             done.insert(p.index, p);
                         }
                     }
                 }
             }
-            Some(h) if !overwrite => return Err(SweepError::OtherSpec { path: cp, found: h, expected: header.spec_hash.clone() }),
+            Some(h) if !overwrite => {
+                return Err(SweepError::OtherSpec { path: cp, found: h, expected: header.spec_hash.clone() })
+            }
             _ => {}
         }
     }
@@ -137,7 +158,8 @@ fn previous_points(header: &SweepResult, out: &Path, stem: &str, overwrite: bool
 /// Evaluates one point, turning errors and panics into a failed record.
 fn evaluate_point(spec: &SweepSpec, evaluator: &dyn Evaluator, index: usize, ncols: usize) -> PointRecord {
     let params = spec.point(index);
-    let failed = |status: String| PointRecord { index, params: params.clone(), cells: vec![Cell::Empty; ncols], status };
+    let failed =
+        |status: String| PointRecord { index, params: params.clone(), cells: vec![Cell::Empty; ncols], status };
     let sys = match spec.system_at(index) {
         Ok(s) => s,
         Err(e) => return failed(format!("error: {e}")),
@@ -147,7 +169,11 @@ fn evaluate_point(spec: &SweepSpec, evaluator: &dyn Evaluator, index: usize, nco
         Ok(Ok(cells)) => failed(format!("error: the evaluator returned {} values for {ncols} columns", cells.len())),
         Ok(Err(e)) => failed(format!("error: {e}")),
         Err(p) => {
-            let msg = p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_default();
+            let msg = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
             failed(format!("error: panic in the evaluator: {msg}"))
         }
     }
@@ -161,7 +187,10 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     }
     let mut header = result_header(spec, evaluator, opts.shard, digits);
     if let Some(name) = header.unknown_table_columns().into_iter().next() {
-        return Err(SweepError::UnknownColumn { name, known: header.columns.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ") });
+        return Err(SweepError::UnknownColumn {
+            name,
+            known: header.columns.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", "),
+        });
     }
     let stem = stem(opts.shard);
     let mut done = previous_points(&header, &opts.out, &stem, opts.overwrite)?;
@@ -177,13 +206,21 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     let resumed = in_scope.len() - todo.len();
 
     // checkpoint: header line, then one line per finished point (flushed)
-    std::fs::create_dir_all(&opts.out).map_err(|e| SweepError::Write { path: opts.out.clone(), reason: e.to_string() })?;
+    std::fs::create_dir_all(&opts.out)
+        .map_err(|e| SweepError::Write { path: opts.out.clone(), reason: e.to_string() })?;
     let cp = checkpoint_path(&opts.out, &stem);
     let mut cp_file = {
         let exists_same = !opts.fresh && cp.exists() && previous_points(&header, &opts.out, &stem, false).is_ok();
-        let mut f = std::fs::OpenOptions::new().create(true).append(exists_same).write(true).truncate(!exists_same).open(&cp).map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(exists_same)
+            .write(true)
+            .truncate(!exists_same)
+            .open(&cp)
+            .map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;
         if !exists_same {
-            writeln!(f, "{}", header.header_json()).map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;
+            writeln!(f, "{}", header.header_json())
+                .map_err(|e| SweepError::Write { path: cp.clone(), reason: e.to_string() })?;
         }
         f
     };
@@ -192,7 +229,11 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
 
     let pb = if opts.progress {
         let pb = indicatif::ProgressBar::new(todo.len() as u64);
-        pb.set_style(indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} points, ETA {eta}").expect("template").progress_chars("=> "));
+        pb.set_style(
+            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} points, ETA {eta}")
+                .expect("template")
+                .progress_chars("=> "),
+        );
         pb
     } else {
         indicatif::ProgressBar::hidden()
@@ -212,7 +253,11 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
             .collect()
     };
     let new = match opts.threads {
-        Some(t) => rayon::ThreadPoolBuilder::new().num_threads(t).build().map_err(|e| SweepError::ThreadPool { threads: t, reason: e.to_string() })?.install(work),
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .map_err(|e| SweepError::ThreadPool { threads: t, reason: e.to_string() })?
+            .install(work),
         None => work(),
     };
     pb.finish_and_clear();

@@ -84,13 +84,15 @@ fn check_keys(path: &Path, t: &Table, pre: &str, allowed: &'static str) -> Resul
 impl SweepSpec {
     /// Reads a spec file; the base model path is relative to the spec file.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
         Self::parse(&text, path)
     }
 
     /// Parses spec text; `path` locates the base model and names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, SweepError> {
-        let root: Table = toml::from_str(text).map_err(|e| SweepError::Toml { path: path.to_path_buf(), source: Box::new(e) })?;
+        let root: Table =
+            toml::from_str(text).map_err(|e| SweepError::Toml { path: path.to_path_buf(), source: Box::new(e) })?;
         check_keys(path, &root, "", "name, model, axis, evaluate, table")?;
         let model_rel = match root.get("model") {
             Some(Value::String(s)) => s.clone(),
@@ -99,7 +101,8 @@ impl SweepSpec {
         };
         let dir = path.parent().unwrap_or(Path::new("."));
         let model_path = dir.join(&model_rel);
-        let model_text = std::fs::read_to_string(&model_path).map_err(|source| SweepError::Io { path: model_path.clone(), source })?;
+        let model_text = std::fs::read_to_string(&model_path)
+            .map_err(|source| SweepError::Io { path: model_path.clone(), source })?;
         let base = model::load(&model_path).map_err(|source| SweepError::Model { path: model_path.clone(), source })?;
         let name = match root.get("name") {
             Some(Value::String(s)) => s.clone(),
@@ -131,17 +134,28 @@ impl SweepSpec {
             }
             let values = match (t.get("values"), t.get("range")) {
                 (Some(_), Some(_)) => return Err(wrong(path, &key("values"), "either `values` or `range`, not both")),
-                (Some(Value::Array(v)), None) => Values::List(v.iter().map(|x| num(x).ok_or_else(|| wrong(path, &key("values"), "an array of numbers"))).collect::<Result<_, _>>()?),
+                (Some(Value::Array(v)), None) => Values::List(
+                    v.iter()
+                        .map(|x| num(x).ok_or_else(|| wrong(path, &key("values"), "an array of numbers")))
+                        .collect::<Result<_, _>>()?,
+                ),
                 (Some(_), None) => return Err(wrong(path, &key("values"), "an array of numbers")),
                 (None, Some(Value::Table(r))) => {
                     check_keys(path, r, &key("range."), "from, to, count, step, spacing")?;
                     let g = |s: &str| -> Result<Option<f64>, SweepError> {
                         match r.get(s) {
                             None => Ok(None),
-                            Some(v) => num(v).map(Some).ok_or_else(|| wrong(path, &key(&format!("range.{s}")), "a number")),
+                            Some(v) => {
+                                num(v).map(Some).ok_or_else(|| wrong(path, &key(&format!("range.{s}")), "a number"))
+                            }
                         }
                     };
-                    let need = |s: &str| -> Result<f64, SweepError> { g(s)?.ok_or_else(|| SweepError::MissingKey { path: path.to_path_buf(), key: key(&format!("range.{s}")) }) };
+                    let need = |s: &str| -> Result<f64, SweepError> {
+                        g(s)?.ok_or_else(|| SweepError::MissingKey {
+                            path: path.to_path_buf(),
+                            key: key(&format!("range.{s}")),
+                        })
+                    };
                     let (from, to) = (need("from")?, need("to")?);
                     let log = match r.get("spacing") {
                         None => false,
@@ -152,19 +166,35 @@ impl SweepSpec {
                     match (r.get("count"), g("step")?) {
                         (Some(Value::Integer(c)), None) => {
                             if *c < 0 {
-                                return Err(SweepError::EmptyRange { name: parameter.name(), from, to, detail: format!("count = {c}") });
+                                return Err(SweepError::EmptyRange {
+                                    name: parameter.name(),
+                                    from,
+                                    to,
+                                    detail: format!("count = {c}"),
+                                });
                             }
                             Values::Count { from, to, count: *c as usize, log }
                         }
                         (Some(_), None) => return Err(wrong(path, &key("range.count"), "a non-negative integer")),
                         (None, Some(step)) if !log => Values::Step { from, to, step },
-                        (None, Some(_)) => return Err(wrong(path, &key("range.step"), "no step with spacing = \"log\" (use count)")),
-                        (Some(_), Some(_)) => return Err(wrong(path, &key("range"), "either `count` or `step`, not both")),
-                        (None, None) => return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("range.count (or range.step)") }),
+                        (None, Some(_)) => {
+                            return Err(wrong(path, &key("range.step"), "no step with spacing = \"log\" (use count)"))
+                        }
+                        (Some(_), Some(_)) => {
+                            return Err(wrong(path, &key("range"), "either `count` or `step`, not both"))
+                        }
+                        (None, None) => {
+                            return Err(SweepError::MissingKey {
+                                path: path.to_path_buf(),
+                                key: key("range.count (or range.step)"),
+                            })
+                        }
                     }
                 }
                 (None, Some(_)) => return Err(wrong(path, &key("range"), "a table { from, to, count | step }")),
-                (None, None) => return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("values (or range)") }),
+                (None, None) => {
+                    return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("values (or range)") })
+                }
             };
             let values = values.expand(&parameter.name())?;
             let label = match t.get("label") {
@@ -189,8 +219,18 @@ impl SweepSpec {
             Some(Value::Table(t)) => {
                 check_keys(path, t, "table.", "columns, digits, caption")?;
                 if let Some(c) = t.get("columns") {
-                    let Value::Array(c) = c else { return Err(wrong(path, "table.columns", "an array of column names")) };
-                    table.columns = Some(c.iter().map(|v| v.as_str().map(String::from).ok_or_else(|| wrong(path, "table.columns", "an array of column names"))).collect::<Result<_, _>>()?);
+                    let Value::Array(c) = c else {
+                        return Err(wrong(path, "table.columns", "an array of column names"));
+                    };
+                    table.columns = Some(
+                        c.iter()
+                            .map(|v| {
+                                v.as_str()
+                                    .map(String::from)
+                                    .ok_or_else(|| wrong(path, "table.columns", "an array of column names"))
+                            })
+                            .collect::<Result<_, _>>()?,
+                    );
                 }
                 if let Some(d) = t.get("digits") {
                     let d = d.as_integer().ok_or_else(|| wrong(path, "table.digits", "an integer"))?;
@@ -200,12 +240,23 @@ impl SweepSpec {
                     table.digits = d as usize;
                 }
                 if let Some(c) = t.get("caption") {
-                    table.caption = Some(c.as_str().ok_or_else(|| wrong(path, "table.caption", "a string"))?.to_string());
+                    table.caption =
+                        Some(c.as_str().ok_or_else(|| wrong(path, "table.caption", "a string"))?.to_string());
                 }
             }
             Some(_) => return Err(wrong(path, "table", "a table")),
         }
-        let spec = Self { path: path.to_path_buf(), name, model: model_rel, model_path, model_text, base, axes, evaluate, table };
+        let spec = Self {
+            path: path.to_path_buf(),
+            name,
+            model: model_rel,
+            model_path,
+            model_text,
+            base,
+            axes,
+            evaluate,
+            table,
+        };
         // every axis value must give a valid model on its own (e.g. no z0 outside Theta)
         for a in &spec.axes {
             for &v in &a.values {

@@ -142,7 +142,9 @@ impl SweepResult {
 
     pub fn to_json_string(&self) -> String {
         let mut h = self.header_json();
-        h.as_object_mut().expect("object").insert("points".into(), Value::Array(self.points.iter().map(|p| p.to_json()).collect()));
+        h.as_object_mut()
+            .expect("object")
+            .insert("points".into(), Value::Array(self.points.iter().map(|p| p.to_json()).collect()));
         let mut s = serde_json::to_string_pretty(&h).expect("serialisable");
         s.push('\n');
         s
@@ -154,7 +156,9 @@ impl SweepResult {
         if o.get("format").and_then(Value::as_str) != Some(FORMAT) {
             return Err(bad(path, &format!("missing or unknown `format` (expected {FORMAT})")));
         }
-        let s = |k: &str| o.get(k).and_then(Value::as_str).map(String::from).ok_or_else(|| bad(path, &format!("missing `{k}`")));
+        let s = |k: &str| {
+            o.get(k).and_then(Value::as_str).map(String::from).ok_or_else(|| bad(path, &format!("missing `{k}`")))
+        };
         let axes = o
             .get("axes")
             .and_then(Value::as_array)
@@ -174,10 +178,17 @@ impl SweepResult {
             .and_then(Value::as_array)
             .ok_or_else(|| bad(path, "missing `columns`"))?
             .iter()
-            .map(|c| Some(Column { name: c.get("name")?.as_str()?.into(), latex: c.get("latex")?.as_str()?.into(), kind: ColumnKind::parse(c.get("kind")?.as_str()?)? }))
+            .map(|c| {
+                Some(Column {
+                    name: c.get("name")?.as_str()?.into(),
+                    latex: c.get("latex")?.as_str()?.into(),
+                    kind: ColumnKind::parse(c.get("kind")?.as_str()?)?,
+                })
+            })
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| bad(path, "malformed `columns`"))?;
-        let total_points = o.get("total_points").and_then(Value::as_u64).ok_or_else(|| bad(path, "missing `total_points`"))? as usize;
+        let total_points =
+            o.get("total_points").and_then(Value::as_u64).ok_or_else(|| bad(path, "missing `total_points`"))? as usize;
         let shard = match o.get("shard") {
             None | Some(Value::Null) => None,
             Some(v) => {
@@ -188,21 +199,42 @@ impl SweepResult {
         };
         let t = o.get("table");
         let table = TableSettings {
-            columns: t.and_then(|t| t.get("columns")).and_then(Value::as_array).map(|a| a.iter().filter_map(|x| x.as_str().map(String::from)).collect()),
-            digits: t.and_then(|t| t.get("digits")).and_then(Value::as_u64).map(|d| d as usize).filter(|d| (1..=17).contains(d)).unwrap_or(4),
+            columns: t
+                .and_then(|t| t.get("columns"))
+                .and_then(Value::as_array)
+                .map(|a| a.iter().filter_map(|x| x.as_str().map(String::from)).collect()),
+            digits: t
+                .and_then(|t| t.get("digits"))
+                .and_then(Value::as_u64)
+                .map(|d| d as usize)
+                .filter(|d| (1..=17).contains(d))
+                .unwrap_or(4),
             caption: t.and_then(|t| t.get("caption")).and_then(Value::as_str).map(String::from),
         };
-        Ok(Self { name: s("name")?, spec_hash: s("spec_hash")?, model: s("model")?, evaluator: s("evaluator")?, axes, columns, total_points, shard, table, points: vec![] })
+        Ok(Self {
+            name: s("name")?,
+            spec_hash: s("spec_hash")?,
+            model: s("model")?,
+            evaluator: s("evaluator")?,
+            axes,
+            columns,
+            total_points,
+            shard,
+            table,
+            points: vec![],
+        })
     }
 
     /// Reads a result file written by [`SweepResult::to_json_string`].
     pub fn read(path: &Path) -> Result<Self, SweepError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(path, &format!("invalid JSON: {e}")))?;
         let mut r = Self::header_from_json(&v, path)?;
         let pts = v.get("points").and_then(Value::as_array).ok_or_else(|| bad(path, "missing `points`"))?;
         for p in pts {
-            let rec = PointRecord::from_json(p, &r.columns, r.axes.len()).ok_or_else(|| bad(path, "malformed point"))?;
+            let rec =
+                PointRecord::from_json(p, &r.columns, r.axes.len()).ok_or_else(|| bad(path, "malformed point"))?;
             if rec.index >= r.total_points {
                 return Err(bad(path, &format!("point index {} >= total_points {}", rec.index, r.total_points)));
             }
@@ -264,7 +296,13 @@ impl SweepResult {
         if failed {
             head.push("status".into());
         }
-        let mut s = format!("<!-- moreau sweep `{}`, spec hash {}, {} of {} points -->\n\n", self.name, self.spec_hash, self.points.len(), self.total_points);
+        let mut s = format!(
+            "<!-- moreau sweep `{}`, spec hash {}, {} of {} points -->\n\n",
+            self.name,
+            self.spec_hash,
+            self.points.len(),
+            self.total_points
+        );
         s.push_str(&format!("| {} |\n", head.join(" | ")));
         s.push_str(&format!("|{}\n", "---:|".repeat(head.len())));
         for p in &self.points {
@@ -295,9 +333,16 @@ impl SweepResult {
             head.push("status".into());
         }
         let caption = self.table.caption.clone().unwrap_or_else(|| latex_escape(&self.name));
-        let label: String = self.name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect();
+        let label: String =
+            self.name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect();
         let mut s = String::new();
-        s.push_str(&format!("% moreau sweep `{}`: spec hash {}, {} of {} points; needs \\usepackage{{booktabs}}\n", self.name, self.spec_hash, self.points.len(), self.total_points));
+        s.push_str(&format!(
+            "% moreau sweep `{}`: spec hash {}, {} of {} points; needs \\usepackage{{booktabs}}\n",
+            self.name,
+            self.spec_hash,
+            self.points.len(),
+            self.total_points
+        ));
         s.push_str("\\begin{table}[ht]\n\\centering\n");
         s.push_str(&format!("\\caption{{{caption}}}\n\\label{{tab:{label}}}\n"));
         s.push_str(&format!("\\begin{{tabular}}{{{}}}\n\\toprule\n", "r".repeat(ncols)));

@@ -34,7 +34,11 @@ impl ThetaEvaluator {
         const ALLOWED: &str = "measure, dt, periods, transient_periods, pairs, seed";
         let mut ev = Self::default();
         let mut rate = ev.settings.measure.clone().unwrap_or_default();
-        let wrong = |key: &str, expected| SweepError::WrongType { path: path.to_path_buf(), key: format!("evaluate.{key}"), expected };
+        let wrong = |key: &str, expected| SweepError::WrongType {
+            path: path.to_path_buf(),
+            key: format!("evaluate.{key}"),
+            expected,
+        };
         let mut measure = true;
         for (k, v) in t {
             match (k.as_str(), v) {
@@ -46,8 +50,16 @@ impl ThetaEvaluator {
                 ("seed", Value::Integer(i)) if *i >= 0 => rate.seed = *i as u64,
                 ("measure", _) => return Err(wrong(k, "true or false")),
                 ("dt", _) => return Err(wrong(k, "a positive number")),
-                ("periods" | "transient_periods" | "pairs" | "seed", _) => return Err(wrong(k, "a non-negative integer (periods, pairs: positive)")),
-                _ => return Err(SweepError::UnknownKey { path: path.to_path_buf(), key: format!("evaluate.{k}"), allowed: ALLOWED }),
+                ("periods" | "transient_periods" | "pairs" | "seed", _) => {
+                    return Err(wrong(k, "a non-negative integer (periods, pairs: positive)"))
+                }
+                _ => {
+                    return Err(SweepError::UnknownKey {
+                        path: path.to_path_buf(),
+                        key: format!("evaluate.{k}"),
+                        allowed: ALLOWED,
+                    })
+                }
             }
         }
         if measure && rate.periods < rate.transient_periods + 3 {
@@ -91,7 +103,10 @@ impl Evaluator for ThetaEvaluator {
     fn fingerprint(&self) -> String {
         let m = match &self.settings.measure {
             None => "measure=false".to_string(),
-            Some(r) => format!("measure=true dt={:?} periods={} transient={} pairs={} seed={}", r.dt, r.periods, r.transient_periods, r.pairs, r.seed),
+            Some(r) => format!(
+                "measure=true dt={:?} periods={} transient={} pairs={} seed={}",
+                r.dt, r.periods, r.transient_periods, r.pairs, r.seed
+            ),
         };
         format!("moreau {} theta::assemble ({m})", env!("CARGO_PKG_VERSION"))
     }

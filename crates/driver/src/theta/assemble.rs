@@ -238,7 +238,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
 
     // gamma_1, gamma_inf, eqs. (g1), (ginf), at the upper bound of R.
     let strongly_convex = R.is_finite() && R > 0.0;
-    let (gamma_1, gamma_inf) = if strongly_convex { ((osc - d).max(0.0) / (T * R), zdot_bound / R) } else { (0.0, 0.0) };
+    let (gamma_1, gamma_inf) =
+        if strongly_convex { ((osc - d).max(0.0) / (T * R), zdot_bound / R) } else { (0.0, 0.0) };
     if !strongly_convex {
         notes.push(format!(
             "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0), and convergence is guaranteed only if psi(0) < 0, i.e. alpha > beta / lambda"
@@ -249,15 +250,26 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
     // alpha, eq. (alpha), and the lambda search (eqs. (ALI), (bet), (theta)).
     let al = alpha(C, E);
     let a_low = al.lower;
-    let search = optimise_lambda(&F, E, C, |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf), &settings.lambda)?;
+    let search = optimise_lambda(
+        &F,
+        E,
+        C,
+        |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf),
+        &settings.lambda,
+    )?;
     let opt = &search.optimum;
     let psi = Psi { alpha: a_low, lambda: opt.value.lambda, beta: opt.value.beta };
     let psi_0 = psi.at_zero();
     let psi_inf = psi.eval(gamma_inf);
     let theta = psi.theta(gamma_1, gamma_inf);
-    let curve: Vec<(f64, f64, f64)> = search.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta, v.theta))).collect();
+    let curve: Vec<(f64, f64, f64)> =
+        search.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta, v.theta))).collect();
     if !search.gaps.is_empty() {
-        notes.push(format!("lambda search: {} of {} evaluations failed (gaps in the curve)", search.gaps.len(), search.curve.len()));
+        notes.push(format!(
+            "lambda search: {} of {} evaluations failed (gaps in the curve)",
+            search.gaps.len(),
+            search.curve.len()
+        ));
     }
     let cert_ok = opt.certificate.verified;
     let d_ok = true; // sphere_max upper bounds with valid Lipschitz constants
@@ -321,7 +333,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, D
         }
     }
 
-    let Pi: Vec<Vec<f64>> = (0..opt.certificate.Pi.nrows()).map(|i| opt.certificate.Pi.row(i).iter().copied().collect()).collect();
+    let Pi: Vec<Vec<f64>> =
+        (0..opt.certificate.Pi.nrows()).map(|i| opt.certificate.Pi.row(i).iter().copied().collect()).collect();
     Ok(ThetaReport {
         name: sys.name.clone(),
         n: sys.n(),
@@ -403,23 +416,151 @@ impl ThetaReport {
             Quantity::new("period", "T", "(xT)", self.period, Exact, true, "period of the input"),
             Quantity::new("mu", "mu", "(stab)", self.mu, Estimate, false, "max Re eig(F), F = A + E C (Schur form)"),
             Quantity::new("r", "R", "(R)", self.R, Upper, r_ok, "strong convexity constant of Theta"),
-            Quantity::new("alpha", "alpha", "(alpha)", self.alpha.lower, Lower, self.alpha.verified, "lambda_min(S(C E)), Rump's test"),
-            Quantity::new("lambda", "lambda", "(lammu),(ALI)", self.lambda, Lower, self.certificate_verified, "verified decay rate of the certificate"),
-            Quantity::new("beta", "beta", "(bet)", self.beta, Upper, self.certificate_verified, "b_hat >= lambda_max(H^T Pi^-1 H), SDP + verification"),
+            Quantity::new(
+                "alpha",
+                "alpha",
+                "(alpha)",
+                self.alpha.lower,
+                Lower,
+                self.alpha.verified,
+                "lambda_min(S(C E)), Rump's test",
+            ),
+            Quantity::new(
+                "lambda",
+                "lambda",
+                "(lammu),(ALI)",
+                self.lambda,
+                Lower,
+                self.certificate_verified,
+                "verified decay rate of the certificate",
+            ),
+            Quantity::new(
+                "beta",
+                "beta",
+                "(bet)",
+                self.beta,
+                Upper,
+                self.certificate_verified,
+                "b_hat >= lambda_max(H^T Pi^-1 H), SDP + verification",
+            ),
             Quantity::new("osc", "osc", "(mho),(osc)", self.osc, Lower, self.orbit_verified, self.orbit_method.clone()),
-            Quantity::new("d", "d", "(d),(Xinfsupp)", self.d, Upper, true, "tube quadrature + tail (DXX), certified sphere max"),
-            Quantity::new("eta_dot_inf", "||eta_T'||_inf", "(zinf)", self.eta_dot_inf, Upper, self.orbit_verified, "max speed of the linearised orbit"),
-            Quantity::new("d_ftheta", "D(C(F Xi_inf + E Theta),{0})", "(zinf)", self.d_ftheta, Upper, true, "tube quadrature + certified sphere max"),
-            Quantity::new("zdot_bound", "limsup |z'| <=", "(zinf)", self.zdot_bound, Upper, self.orbit_verified, "||eta_T'||_inf + D(...)"),
-            Quantity::new("gamma_1", "gamma_1", "(g1)", self.gamma_1, Lower, self.orbit_verified && r_ok, "(osc - d)_+ / (T R), R upper"),
-            Quantity::new("gamma_inf", "gamma_inf", "(ginf)", self.gamma_inf, Upper, self.orbit_verified && r_ok, "(||eta_T'|| + D(...)) / R at R upper (safe for theta)"),
-            Quantity::new("psi_0", "psi(0)", "(psilim)", self.psi_0, Upper, self.alpha.verified && self.certificate_verified, "at (alpha, lambda) lower, beta upper"),
-            Quantity::new("psi_inf", "psi(gamma_inf)", "(phipsi)", self.psi_inf, Upper, self.alpha.verified && self.certificate_verified, "at gamma_inf (R upper)"),
-            Quantity::new("psi_limit", "-lambda", "(psilim)", -self.lambda, Exact, self.certificate_verified, "limit of psi at infinity"),
-            Quantity::new("theta", "theta", "(theta)", self.theta, Upper, self.theta_verified, "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))"),
-            Quantity::new("path_bound", "(osc - d)_+", "(path)", self.path_bound, Lower, self.orbit_verified, "liminf path length of z per period"),
-            Quantity::new("path1_bound", "sup_partitions", "(path1)", self.path1_bound, Lower, self.orbit_verified, format!("dynamic programming over a {}-point grid", self.path1_grid)),
-            Quantity::new("path2_bound", "sup_eps (2eps-d)N_eps", "(path2)", self.path2.value, Lower, self.orbit_verified, format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count)),
+            Quantity::new(
+                "d",
+                "d",
+                "(d),(Xinfsupp)",
+                self.d,
+                Upper,
+                true,
+                "tube quadrature + tail (DXX), certified sphere max",
+            ),
+            Quantity::new(
+                "eta_dot_inf",
+                "||eta_T'||_inf",
+                "(zinf)",
+                self.eta_dot_inf,
+                Upper,
+                self.orbit_verified,
+                "max speed of the linearised orbit",
+            ),
+            Quantity::new(
+                "d_ftheta",
+                "D(C(F Xi_inf + E Theta),{0})",
+                "(zinf)",
+                self.d_ftheta,
+                Upper,
+                true,
+                "tube quadrature + certified sphere max",
+            ),
+            Quantity::new(
+                "zdot_bound",
+                "limsup |z'| <=",
+                "(zinf)",
+                self.zdot_bound,
+                Upper,
+                self.orbit_verified,
+                "||eta_T'||_inf + D(...)",
+            ),
+            Quantity::new(
+                "gamma_1",
+                "gamma_1",
+                "(g1)",
+                self.gamma_1,
+                Lower,
+                self.orbit_verified && r_ok,
+                "(osc - d)_+ / (T R), R upper",
+            ),
+            Quantity::new(
+                "gamma_inf",
+                "gamma_inf",
+                "(ginf)",
+                self.gamma_inf,
+                Upper,
+                self.orbit_verified && r_ok,
+                "(||eta_T'|| + D(...)) / R at R upper (safe for theta)",
+            ),
+            Quantity::new(
+                "psi_0",
+                "psi(0)",
+                "(psilim)",
+                self.psi_0,
+                Upper,
+                self.alpha.verified && self.certificate_verified,
+                "at (alpha, lambda) lower, beta upper",
+            ),
+            Quantity::new(
+                "psi_inf",
+                "psi(gamma_inf)",
+                "(phipsi)",
+                self.psi_inf,
+                Upper,
+                self.alpha.verified && self.certificate_verified,
+                "at gamma_inf (R upper)",
+            ),
+            Quantity::new(
+                "psi_limit",
+                "-lambda",
+                "(psilim)",
+                -self.lambda,
+                Exact,
+                self.certificate_verified,
+                "limit of psi at infinity",
+            ),
+            Quantity::new(
+                "theta",
+                "theta",
+                "(theta)",
+                self.theta,
+                Upper,
+                self.theta_verified,
+                "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))",
+            ),
+            Quantity::new(
+                "path_bound",
+                "(osc - d)_+",
+                "(path)",
+                self.path_bound,
+                Lower,
+                self.orbit_verified,
+                "liminf path length of z per period",
+            ),
+            Quantity::new(
+                "path1_bound",
+                "sup_partitions",
+                "(path1)",
+                self.path1_bound,
+                Lower,
+                self.orbit_verified,
+                format!("dynamic programming over a {}-point grid", self.path1_grid),
+            ),
+            Quantity::new(
+                "path2_bound",
+                "sup_eps (2eps-d)N_eps",
+                "(path2)",
+                self.path2.value,
+                Lower,
+                self.orbit_verified,
+                format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count),
+            ),
         ];
         if let Some(s) = &self.stationary {
             q.push(Quantity::new(
@@ -431,12 +572,52 @@ impl ThetaReport {
                 false,
                 format!("min sigma(Phi) on [0,T] = {:.3e}", s.phi.min_sigma),
             ));
-            q.push(Quantity::new("stationary_slack", "R(T) slack s*", "(stat1)", s.slack, Estimate, s.verified, format!("{} -> {}", s.method, match s.empty { Some(true) => "empty", Some(false) => "nonempty", None => "undecided" })));
+            q.push(Quantity::new(
+                "stationary_slack",
+                "R(T) slack s*",
+                "(stat1)",
+                s.slack,
+                Estimate,
+                s.verified,
+                format!(
+                    "{} -> {}",
+                    s.method,
+                    match s.empty {
+                        Some(true) => "empty",
+                        Some(false) => "nonempty",
+                        None => "undecided",
+                    }
+                ),
+            ));
         }
         if let Some(m) = &self.measured {
-            q.push(Quantity::new("measured_rate", "measured exponent", "(VV)", m.rate, Estimate, false, format!("95% CI [{:.4}, {:.4}], {} periods", m.ci_low, m.ci_high, m.periods)));
-            q.push(Quantity::new("path_measured", "measured path/period", "(path)", m.path_length_per_period, Estimate, false, "min over periods after the transient"));
-            q.push(Quantity::new("zdot_measured", "measured limsup |z'|", "(zinf)", m.limsup_zdot, Estimate, false, "max over periods after the transient"));
+            q.push(Quantity::new(
+                "measured_rate",
+                "measured exponent",
+                "(VV)",
+                m.rate,
+                Estimate,
+                false,
+                format!("95% CI [{:.4}, {:.4}], {} periods", m.ci_low, m.ci_high, m.periods),
+            ));
+            q.push(Quantity::new(
+                "path_measured",
+                "measured path/period",
+                "(path)",
+                m.path_length_per_period,
+                Estimate,
+                false,
+                "min over periods after the transient",
+            ));
+            q.push(Quantity::new(
+                "zdot_measured",
+                "measured limsup |z'|",
+                "(zinf)",
+                m.limsup_zdot,
+                Estimate,
+                false,
+                "max over periods after the transient",
+            ));
         }
         q
     }
@@ -445,7 +626,8 @@ impl ThetaReport {
     pub fn to_json(&self) -> serde_json::Value {
         use serde_json::json;
         let f = |v: f64| if v.is_finite() { json!(v) } else { serde_json::Value::Null };
-        let quantities: Vec<serde_json::Value> = self.quantities().iter().map(|q| serde_json::to_value(q).unwrap_or_default()).collect();
+        let quantities: Vec<serde_json::Value> =
+            self.quantities().iter().map(|q| serde_json::to_value(q).unwrap_or_default()).collect();
         let mut m = serde_json::Map::new();
         m.insert("name".into(), json!(self.name));
         m.insert("n".into(), json!(self.n));

@@ -53,7 +53,12 @@ impl Ord for Arc {
 }
 
 /// `max_{|v| = 1} g(v)` for sublinear `g`; `lipschitz` is used only for `p >= 3`.
-pub fn sublinear_sphere_max(p: usize, mut g: impl FnMut(&[f64]) -> f64, lipschitz: f64, s: &SphereMaxSettings) -> Bounds {
+pub fn sublinear_sphere_max(
+    p: usize,
+    mut g: impl FnMut(&[f64]) -> f64,
+    lipschitz: f64,
+    s: &SphereMaxSettings,
+) -> Bounds {
     match p {
         0 => Bounds::exact(f64::NAN),
         1 => Bounds::exact(g(&[1.0]).max(g(&[-1.0]))),
@@ -67,7 +72,13 @@ pub fn sublinear_sphere_max(p: usize, mut g: impl FnMut(&[f64]) -> f64, lipschit
             let mut heap = BinaryHeap::new();
             for i in 0..n0 {
                 let (g0, g1) = (vals[i], vals[(i + 1) % n0]);
-                heap.push(Arc { ub: arc_bound(g0, g1, angles[i + 1] - angles[i]), a0: angles[i], a1: angles[i + 1], g0, g1 });
+                heap.push(Arc {
+                    ub: arc_bound(g0, g1, angles[i + 1] - angles[i]),
+                    a0: angles[i],
+                    a1: angles[i + 1],
+                    g0,
+                    g1,
+                });
             }
             while let Some(top) = heap.peek() {
                 if top.ub - lower <= s.tol_abs.max(s.tol_rel * lower.abs()) || evals >= s.max_evals {
@@ -206,7 +217,8 @@ mod tests {
             let (x, y) = (c * v[0] + s * v[1], -s * v[0] + c * v[1]);
             (9.0 * x * x + y * y).sqrt()
         };
-        let b = sublinear_sphere_max(2, g, 3.0, &SphereMaxSettings { tol_abs: 1e-12, tol_rel: 1e-10, max_evals: 10_000 });
+        let b =
+            sublinear_sphere_max(2, g, 3.0, &SphereMaxSettings { tol_abs: 1e-12, tol_rel: 1e-10, max_evals: 10_000 });
         assert!(b.lower <= 3.0 + 1e-12 && b.upper >= 3.0 - 1e-12, "{b:?}");
         assert!(b.width() < 1e-9, "{b:?}");
     }
@@ -219,7 +231,8 @@ mod tests {
             let w = R.inverse() * nalgebra::Vector3::new(v[0], v[1], v[2]);
             (w[0] * w[0] + 4.0 * w[1] * w[1] + 0.25 * w[2] * w[2]).sqrt()
         };
-        let b = sublinear_sphere_max(3, g, 2.0, &SphereMaxSettings { tol_abs: 1e-10, tol_rel: 1e-8, max_evals: 20_000 });
+        let b =
+            sublinear_sphere_max(3, g, 2.0, &SphereMaxSettings { tol_abs: 1e-10, tol_rel: 1e-8, max_evals: 20_000 });
         assert!(b.lower <= 2.0 + 1e-12 && b.upper >= 2.0 - 1e-12, "{b:?}");
         assert!(b.width() < 1e-7, "{b:?}");
     }
@@ -232,7 +245,8 @@ mod tests {
             let a = v[1].atan2(v[0]);
             1.0 + 10.0 * (-((a - 0.05) / 1e-3).powi(2)).exp()
         };
-        let b = sublinear_sphere_max(2, bump, 1.0, &SphereMaxSettings { tol_abs: 1e-6, tol_rel: 1e-6, max_evals: 1000 });
+        let b =
+            sublinear_sphere_max(2, bump, 1.0, &SphereMaxSettings { tol_abs: 1e-6, tol_rel: 1e-6, max_evals: 1000 });
         // true maximum 11 at angle 0.05: the "upper bound" misses it
         assert!(b.upper < 10.0, "the harness must be able to see a violated hypothesis: {b:?}");
         // and the arc bound itself is exact at the end points for a linear function

@@ -46,10 +46,18 @@ impl Default for TubeSettings {
 impl TubeSettings {
     pub fn validate(&self) -> Result<(), DriverError> {
         if !(self.tol_abs > 0.0 && self.tol_abs.is_finite()) {
-            return Err(DriverError::BadSetting { name: "tube.tol_abs", value: self.tol_abs, reason: "must be positive and finite" });
+            return Err(DriverError::BadSetting {
+                name: "tube.tol_abs",
+                value: self.tol_abs,
+                reason: "must be positive and finite",
+            });
         }
         if self.max_cells < 16 {
-            return Err(DriverError::BadSetting { name: "tube.max_cells", value: self.max_cells as f64, reason: "must be at least 16" });
+            return Err(DriverError::BadSetting {
+                name: "tube.max_cells",
+                value: self.max_cells as f64,
+                reason: "must be at least 16",
+            });
         }
         Ok(())
     }
@@ -79,7 +87,9 @@ impl ThetaSupport {
                 let centres: Vec<[f64; 2]> = bi.centres().iter().map(|c| [c[0], c[1]]).collect();
                 let radii = bi.radii().to_vec();
                 let inside = |x: &[f64; 2], centres: &[[f64; 2]], radii: &[f64]| {
-                    centres.iter().zip(radii).all(|(c, r)| ((x[0] - c[0]).powi(2) + (x[1] - c[1]).powi(2)).sqrt() <= r * (1.0 + 1e-12) + 1e-15)
+                    centres.iter().zip(radii).all(|(c, r)| {
+                        ((x[0] - c[0]).powi(2) + (x[1] - c[1]).powi(2)).sqrt() <= r * (1.0 + 1e-12) + 1e-15
+                    })
                 };
                 let mut vertices = Vec::new();
                 for i in 0..centres.len() {
@@ -122,7 +132,9 @@ impl ThetaSupport {
                 }
                 for (c, r) in centres.iter().zip(radii) {
                     let x = [c[0] + r * u[0] / nu, c[1] + r * u[1] / nu];
-                    let ok = centres.iter().zip(radii.iter()).all(|(c2, r2)| ((x[0] - c2[0]).powi(2) + (x[1] - c2[1]).powi(2)).sqrt() <= r2 * (1.0 + 1e-12) + 1e-15);
+                    let ok = centres.iter().zip(radii.iter()).all(|(c2, r2)| {
+                        ((x[0] - c2[0]).powi(2) + (x[1] - c2[1]).powi(2)).sqrt() <= r2 * (1.0 + 1e-12) + 1e-15
+                    });
                     if ok {
                         best = best.max(u[0] * x[0] + u[1] * x[1]);
                     }
@@ -202,7 +214,14 @@ pub fn dxx_bound(F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, t: f64) -> R
 
 impl TubeKernel {
     /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
-    pub fn new(L: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, horizon: Horizon, settings: &TubeSettings) -> Result<Self, DriverError> {
+    pub fn new(
+        L: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        horizon: Horizon,
+        settings: &TubeSettings,
+    ) -> Result<Self, DriverError> {
         settings.validate()?;
         let p = E.ncols();
         let r = L.nrows();
@@ -217,7 +236,11 @@ impl TubeKernel {
         let (s_max, tail_unit) = match horizon {
             Horizon::Finite(t) => {
                 if !(t >= 0.0 && t.is_finite()) {
-                    return Err(DriverError::BadSetting { name: "horizon", value: t, reason: "must be finite and >= 0" });
+                    return Err(DriverError::BadSetting {
+                        name: "horizon",
+                        value: t,
+                        reason: "must be finite and >= 0",
+                    });
                 }
                 (t, 0.0)
             }
@@ -246,9 +269,30 @@ impl TubeKernel {
         let h_cap = 1.0 / nF.max(1e-300);
         let mut h0 = (0.05_f64).min(0.5 * h_cap);
         loop {
-            let k = Self::build(L, &LF, &LF2, F, E, theta, s_max, h0, grade, h_cap, d_theta, nF, nE, r, p, settings.max_cells);
+            let k = Self::build(
+                L,
+                &LF,
+                &LF2,
+                F,
+                E,
+                theta,
+                s_max,
+                h0,
+                grade,
+                h_cap,
+                d_theta,
+                nF,
+                nE,
+                r,
+                p,
+                settings.max_cells,
+            );
             let Some(k) = k else {
-                return Err(DriverError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: settings.max_cells });
+                return Err(DriverError::QuadratureBudget {
+                    error_bound: f64::INFINITY,
+                    tol,
+                    nodes: settings.max_cells,
+                });
             };
             if k.remainder <= 0.5 * tol || k.cells() == 0 {
                 return Ok(Self { tail: tail_unit, zero_in_theta, s_max, ..k });
@@ -259,8 +303,22 @@ impl TubeKernel {
 
     #[allow(clippy::too_many_arguments)]
     fn build(
-        L: &DMatrix<f64>, LF: &DMatrix<f64>, LF2: &DMatrix<f64>, F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, s_max: f64,
-        h0: f64, grade: f64, h_cap: f64, d_theta: f64, nF: f64, nE: f64, r: usize, p: usize, max_cells: usize,
+        L: &DMatrix<f64>,
+        LF: &DMatrix<f64>,
+        LF2: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        s_max: f64,
+        h0: f64,
+        grade: f64,
+        h_cap: f64,
+        d_theta: f64,
+        nF: f64,
+        nE: f64,
+        r: usize,
+        p: usize,
+        max_cells: usize,
     ) -> Option<Self> {
         const BLOCK: usize = 32;
         let mut minus = Vec::new();
@@ -357,7 +415,8 @@ impl TubeKernel {
     pub fn support_bounds(&self, v: &[f64]) -> geometry::Bounds {
         let mut buf = vec![0.0; self.p];
         let nv = geometry::linalg::norm(v);
-        let up = self.sum(&self.minus, v, &mut buf) + self.sum(&self.plus, v, &mut buf) + nv * (self.remainder + self.tail);
+        let up =
+            self.sum(&self.minus, v, &mut buf) + self.sum(&self.plus, v, &mut buf) + nv * (self.remainder + self.tail);
         let lo_tail = if self.zero_in_theta { 0.0 } else { nv * self.tail };
         let lo = 2.0 * self.sum(&self.mid, v, &mut buf) - nv * self.remainder - lo_tail;
         geometry::Bounds::new(lo, up.max(lo))
@@ -428,7 +487,11 @@ mod tests {
     #[test]
     fn fast_disc_intersection_support_matches_geometry() {
         let lens = geometry::BallIntersection::new(vec![vec![-0.15, 0.0], vec![0.15, 0.0]], vec![0.2, 0.2]).unwrap();
-        let three = geometry::BallIntersection::new(vec![vec![0.0, 0.0], vec![0.3, 0.1], vec![0.1, -0.25]], vec![0.3, 0.35, 0.4]).unwrap();
+        let three = geometry::BallIntersection::new(
+            vec![vec![0.0, 0.0], vec![0.3, 0.1], vec![0.1, -0.25]],
+            vec![0.3, 0.35, 0.4],
+        )
+        .unwrap();
         for bi in [lens, three] {
             let shape = Shape::BallIntersection(bi);
             let fast = ThetaSupport::new(&shape);
@@ -441,7 +504,9 @@ mod tests {
             }
         }
         // Negative control: dropping the vertices breaks the support at the lens' tips.
-        let shape = Shape::BallIntersection(geometry::BallIntersection::new(vec![vec![-0.15, 0.0], vec![0.15, 0.0]], vec![0.2, 0.2]).unwrap());
+        let shape = Shape::BallIntersection(
+            geometry::BallIntersection::new(vec![vec![-0.15, 0.0], vec![0.15, 0.0]], vec![0.2, 0.2]).unwrap(),
+        );
         if let ThetaSupport::Discs { centres, radii, .. } = ThetaSupport::new(&shape) {
             let broken = ThetaSupport::Discs { centres, radii, vertices: vec![] };
             assert!((broken.support(&[0.0, 1.0]) - shape.support(&[0.0, 1.0])).abs() > 1e-3);

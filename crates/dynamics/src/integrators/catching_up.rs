@@ -87,7 +87,14 @@ impl CatchingUp {
 
     /// Advances `steps` steps from time `t0` (`t_k = t0 + k h`), in place, calling
     /// `obs(k, t_k, x_k, z_k)` after each step `k = 1..=steps`.
-    pub fn run(&mut self, t0: f64, x: &mut [f64], z: &mut [f64], steps: usize, mut obs: impl FnMut(usize, f64, &[f64], &[f64])) {
+    pub fn run(
+        &mut self,
+        t0: f64,
+        x: &mut [f64],
+        z: &mut [f64],
+        steps: usize,
+        mut obs: impl FnMut(usize, f64, &[f64], &[f64]),
+    ) {
         let (n, p, h) = (self.n, self.p, self.map.h);
         let m = self.w0.len();
         let phi = self.map.phi.as_slice();
@@ -184,7 +191,14 @@ enum FastForcing<const N: usize> {
     /// `w = a sin(omega t + phase)`: forcing `ga s_k + gd (s_{k+1} - s_k)`.
     Sine { omega: f64, phase: f64, ga: SVector<f64, N>, gd: SVector<f64, N> },
     /// Any input, evaluated once per step.
-    General { input: Input, g1b: Vec<SVector<f64, N>>, g2b: Vec<SVector<f64, N>>, w0: Vec<f64>, w1: Vec<f64>, linear: bool },
+    General {
+        input: Input,
+        g1b: Vec<SVector<f64, N>>,
+        g2b: Vec<SVector<f64, N>>,
+        w0: Vec<f64>,
+        w1: Vec<f64>,
+        linear: bool,
+    },
 }
 
 /// Fixed-size catching-up integrator (`N = n`, `P = p`); no allocation in the loop.
@@ -218,7 +232,12 @@ impl<const N: usize, const P: usize, S: FastSet<P>> FastCatchingUp<N, P, S> {
             Input::Zero { .. } => FastForcing::Zero,
             Input::Sine { amplitudes, omega, phase } if linear => {
                 let a = nalgebra::DVector::from_column_slice(amplitudes);
-                FastForcing::Sine { omega: *omega, phase: *phase, ga: SVector::<f64, N>::from_column_slice((&map.g1B * &a).as_slice()), gd: SVector::<f64, N>::from_column_slice((&map.g2B * &a).as_slice()) }
+                FastForcing::Sine {
+                    omega: *omega,
+                    phase: *phase,
+                    ga: SVector::<f64, N>::from_column_slice((&map.g1B * &a).as_slice()),
+                    gd: SVector::<f64, N>::from_column_slice((&map.g2B * &a).as_slice()),
+                }
             }
             other => {
                 let m = other.m();
@@ -240,7 +259,14 @@ impl<const N: usize, const P: usize, S: FastSet<P>> FastCatchingUp<N, P, S> {
 
     /// Advances `steps` steps from `t0` in place, calling `obs(k, t_k, x_k, z_k)` after each.
     #[inline]
-    pub fn run<O: FnMut(usize, f64, &SVector<f64, N>, &SVector<f64, P>)>(&mut self, t0: f64, x: &mut SVector<f64, N>, z: &mut SVector<f64, P>, steps: usize, mut obs: O) {
+    pub fn run<O: FnMut(usize, f64, &SVector<f64, N>, &SVector<f64, P>)>(
+        &mut self,
+        t0: f64,
+        x: &mut SVector<f64, N>,
+        z: &mut SVector<f64, P>,
+        steps: usize,
+        mut obs: O,
+    ) {
         let h = self.h;
         match &mut self.forcing {
             FastForcing::Zero => {

@@ -57,9 +57,15 @@ enum Phase {
 }
 
 enum SetKind {
-    Interval { lo: f64, hi: f64 },
+    Interval {
+        lo: f64,
+        hi: f64,
+    },
     /// `{q : (q - c)^T Minv (q - c) <= 1}`.
-    Smooth { c: DVector<f64>, Minv: DMatrix<f64> },
+    Smooth {
+        c: DVector<f64>,
+        Minv: DMatrix<f64>,
+    },
 }
 
 struct Ev<'a> {
@@ -91,10 +97,15 @@ impl<'a> Ev<'a> {
         let (n, p) = (sys.n(), sys.p());
         let set = match &sys.theta {
             Shape::Interval(iv) => SetKind::Interval { lo: iv.lo, hi: iv.hi },
-            Shape::Ball(b) if b.radius > 0.0 => SetKind::Smooth { c: DVector::from_column_slice(&b.centre), Minv: DMatrix::identity(p, p) / (b.radius * b.radius) },
+            Shape::Ball(b) if b.radius > 0.0 => SetKind::Smooth {
+                c: DVector::from_column_slice(&b.centre),
+                Minv: DMatrix::identity(p, p) / (b.radius * b.radius),
+            },
             Shape::Ellipsoid(e) => {
                 let M = DMatrix::from_row_slice(p, p, e.matrix());
-                let Minv = M.clone().try_inverse().ok_or_else(|| DynamicsError::UnsupportedShape { shape: geometry::ConvexSet::describe(&sys.theta) })?;
+                let Minv = M.clone().try_inverse().ok_or_else(|| DynamicsError::UnsupportedShape {
+                    shape: geometry::ConvexSet::describe(&sys.theta),
+                })?;
                 SetKind::Smooth { c: DVector::from_column_slice(e.centre()), Minv }
             }
             other => return Err(DynamicsError::UnsupportedShape { shape: geometry::ConvexSet::describe(other) }),
@@ -161,7 +172,11 @@ impl<'a> Ev<'a> {
         X[n + p + 1] = th.cos();
         X[n + p + 2] = 1.0;
         let k = gen_index(ph);
-        let Xn = if (tau - self.cache_tau).abs() <= 1e-13 * self.cache_tau { &self.cache[k] * X } else { expm(&(&self.G[k] * tau)) * X };
+        let Xn = if (tau - self.cache_tau).abs() <= 1e-13 * self.cache_tau {
+            &self.cache[k] * X
+        } else {
+            expm(&(&self.G[k] * tau)) * X
+        };
         Xn.rows(0, n + p).into_owned()
     }
 
@@ -272,7 +287,11 @@ pub fn event_driven(sys: &System, settings: &EventDrivenSettings) -> Result<(Tra
     check_dt(settings.rk_step)?;
     check_dt(settings.max_step)?;
     if !(settings.t_end > 0.0 && settings.t_end.is_finite()) {
-        return Err(DynamicsError::BadSetting { name: "t_end", value: settings.t_end, reason: "must be positive and finite" });
+        return Err(DynamicsError::BadSetting {
+            name: "t_end",
+            value: settings.t_end,
+            reason: "must be positive and finite",
+        });
     }
     let ev = Ev::new(sys, settings)?;
     let (n, p) = (ev.n, ev.p);
@@ -373,14 +392,18 @@ mod tests {
         let t_end = 20.0 * T;
         let steps = 1_256_600; // h ~ 1e-4, 20 T / h divisible by 100
         let h = t_end / steps as f64;
-        let (ev, events) = event_driven(&sys, &EventDrivenSettings { dt_out: 100.0 * h, t_end, ..Default::default() }).unwrap();
+        let (ev, events) =
+            event_driven(&sys, &EventDrivenSettings { dt_out: 100.0 * h, t_end, ..Default::default() }).unwrap();
         assert!(events >= 40, "backlash must engage and release every half period: {events} events");
-        let cu = simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, steps, 100).unwrap();
+        let cu =
+            simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, steps, 100).unwrap();
         assert_eq!(cu.len(), ev.len());
         let d = max_diff(&ev, &cu, 1);
         assert!(d < 1e-3, "max difference {d}");
         // negative control: a coarse catching-up run (h = 0.05) is further than 1e-3 away
-        let coarse = simulate_catching_up(&sys, &CatchingUpSettings { dt: 100.0 * h, hold: InputHold::Linear }, steps / 100, 1).unwrap();
+        let coarse =
+            simulate_catching_up(&sys, &CatchingUpSettings { dt: 100.0 * h, hold: InputHold::Linear }, steps / 100, 1)
+                .unwrap();
         assert!(max_diff(&ev, &coarse, 1) > 1e-3);
         // invariants of the reference: q in Theta at every sample
         for i in 0..ev.len() {
@@ -394,9 +417,11 @@ mod tests {
         let sys = model::parse_str(include_str!("../../../../examples/ellipse-p2.toml")).unwrap();
         let t_end = 2.0 * sys.period().unwrap();
         let h = t_end / 125_632.0; // 125_632 = 64 * 1963
-        let (ev, events) = event_driven(&sys, &EventDrivenSettings { dt_out: 64.0 * h, t_end, ..Default::default() }).unwrap();
+        let (ev, events) =
+            event_driven(&sys, &EventDrivenSettings { dt_out: 64.0 * h, t_end, ..Default::default() }).unwrap();
         assert!(events >= 2, "{events}");
-        let cu = simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, 125_632, 64).unwrap();
+        let cu =
+            simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, 125_632, 64).unwrap();
         assert_eq!(cu.len(), ev.len());
         let d = max_diff(&ev, &cu, 1);
         assert!(d < 1e-3, "max difference {d}");
@@ -405,10 +430,16 @@ mod tests {
     #[test]
     fn unsupported_shapes_and_inputs_are_errors() {
         let sys = model::parse_str(include_str!("../../../../examples/polytope-p2.toml")).unwrap();
-        assert!(matches!(event_driven(&sys, &EventDrivenSettings::default()), Err(DynamicsError::UnsupportedShape { .. })));
+        assert!(matches!(
+            event_driven(&sys, &EventDrivenSettings::default()),
+            Err(DynamicsError::UnsupportedShape { .. })
+        ));
         let mut sys = model::parse_str(include_str!("../../../../examples/worked-example.toml")).unwrap();
         sys.input = Input::Square { amplitudes: vec![1.0], omega: 1.0, phase: 0.0 };
-        assert!(matches!(event_driven(&sys, &EventDrivenSettings::default()), Err(DynamicsError::UnsupportedInput { .. })));
+        assert!(matches!(
+            event_driven(&sys, &EventDrivenSettings::default()),
+            Err(DynamicsError::UnsupportedInput { .. })
+        ));
     }
     #[test]
     /// The smooth contact machinery on a 1-D ball must reproduce the exact interval solution.
@@ -420,7 +451,11 @@ mod tests {
         let (a, ea) = event_driven(&sys, &st).unwrap();
         let (b, eb) = event_driven(&sb, &st).unwrap();
         let mut d: f64 = 0.0;
-        for i in 0..a.len() { for (u, v) in a.x_at(i).iter().chain(a.z_at(i)).zip(b.x_at(i).iter().chain(b.z_at(i))) { d = d.max((u - v).abs()); } }
+        for i in 0..a.len() {
+            for (u, v) in a.x_at(i).iter().chain(a.z_at(i)).zip(b.x_at(i).iter().chain(b.z_at(i))) {
+                d = d.max((u - v).abs());
+            }
+        }
         assert!(ea > 5 && ea == eb, "{ea} {eb}");
         assert!(d < 1e-8);
     }

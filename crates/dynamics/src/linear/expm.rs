@@ -85,7 +85,13 @@ mod tests {
         let mut q = DMatrix::zeros(2, 2);
         for i in 0..=k {
             let s = t * i as f64 / k as f64;
-            let wgt = if i == 0 || i == k { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            let wgt = if i == 0 || i == k {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             q += expm(&(&A * (t - s))) * (s * wgt * t / (3.0 * k as f64));
         }
         assert_relative_eq!(I.gamma2, q, epsilon = 1e-12);

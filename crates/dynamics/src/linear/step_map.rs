@@ -66,7 +66,13 @@ pub struct SystemStepMap {
 }
 
 impl SystemStepMap {
-    pub fn new(A: &DMatrix<f64>, B: &DMatrix<f64>, E: &DMatrix<f64>, h: f64, hold: InputHold) -> Result<Self, DynamicsError> {
+    pub fn new(
+        A: &DMatrix<f64>,
+        B: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        h: f64,
+        hold: InputHold,
+    ) -> Result<Self, DynamicsError> {
         let s = StepMap::new(A, h)?;
         let g2B = match hold {
             InputHold::Held => DMatrix::zeros(A.nrows(), B.ncols()),

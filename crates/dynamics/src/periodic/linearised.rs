@@ -165,9 +165,18 @@ pub fn linearised_periodic(sys: &System, settings: &LinearisedSettings) -> Resul
 }
 
 /// Closed form for a sine input, for checks: `xi_T(t) = Im[(i omega I - F)^{-1} B a e^{i(omega t + phase)}]`.
-pub fn sine_frequency_response(F: &DMatrix<f64>, B: &DMatrix<f64>, a: &[f64], omega: f64, phase: f64, t: f64) -> Option<DVector<f64>> {
+pub fn sine_frequency_response(
+    F: &DMatrix<f64>,
+    B: &DMatrix<f64>,
+    a: &[f64],
+    omega: f64,
+    phase: f64,
+    t: f64,
+) -> Option<DVector<f64>> {
     let n = F.nrows();
-    let M: DMatrix<Complex<f64>> = DMatrix::from_fn(n, n, |i, j| Complex::new(if i == j { 0.0 } else { 0.0 }, if i == j { omega } else { 0.0 }) - Complex::new(F[(i, j)], 0.0));
+    let M: DMatrix<Complex<f64>> = DMatrix::from_fn(n, n, |i, j| {
+        Complex::new(if i == j { 0.0 } else { 0.0 }, if i == j { omega } else { 0.0 }) - Complex::new(F[(i, j)], 0.0)
+    });
     let Ba = B * DVector::from_column_slice(a);
     let rhs: DVector<Complex<f64>> = Ba.map(|v| Complex::new(v, 0.0) * Complex::new(0.0, omega * t + phase).exp());
     let sol = M.lu().solve(&rhs)?;
@@ -194,7 +203,9 @@ mod tests {
             assert_relative_eq!(L.xi[k][1], xf[1], epsilon = 1e-12);
             // derivative of the closed form by central differences
             let e = 1e-6;
-            let d = (sine_frequency_response(&F, &sys.B, &[1.0], 1.0, 0.0, L.t[k] + e).unwrap() - sine_frequency_response(&F, &sys.B, &[1.0], 1.0, 0.0, L.t[k] - e).unwrap()) / (2.0 * e);
+            let d = (sine_frequency_response(&F, &sys.B, &[1.0], 1.0, 0.0, L.t[k] + e).unwrap()
+                - sine_frequency_response(&F, &sys.B, &[1.0], 1.0, 0.0, L.t[k] - e).unwrap())
+                / (2.0 * e);
             assert_relative_eq!(L.dxi[k][0], d[0], epsilon = 1e-8);
             assert_relative_eq!(L.deta[k][0], d[0], epsilon = 1e-8);
         }

@@ -83,7 +83,13 @@ impl<'a> XiInfSupport<'a> {
 }
 
 /// Checks (loc) for the periodic state `(x, z)` given `xi_T(0)`.
-pub fn check_localisation(sys: &System, xi_T0: &[f64], x: &[f64], z: &[f64], settings: &LocalisationSettings) -> LocalisationCheck {
+pub fn check_localisation(
+    sys: &System,
+    xi_T0: &[f64],
+    x: &[f64],
+    z: &[f64],
+    settings: &LocalisationSettings,
+) -> LocalisationCheck {
     let n = sys.n();
     let sup = XiInfSupport::new(sys, settings.ds, settings.max_time);
     let d: Vec<f64> = x.iter().zip(xi_T0).map(|(a, b)| a - b).collect();
@@ -113,7 +119,13 @@ pub fn check_localisation(sys: &System, xi_T0: &[f64], x: &[f64], z: &[f64], set
     let q: Vec<f64> = (DVector::from_column_slice(z) - &sys.C * DVector::from_column_slice(x)).as_slice().to_vec();
     let q_in = sys.theta.contains(&q, 1e-9);
     let tol = settings.tol_abs * (1.0 + geometry::linalg::norm(x));
-    LocalisationCheck { inside: q_in && worst >= -tol, worst_margin: worst, worst_direction: worst_dir, q_in_theta: q_in, directions: dirs.len() }
+    LocalisationCheck {
+        inside: q_in && worst >= -tol,
+        worst_margin: worst,
+        worst_direction: worst_dir,
+        q_in_theta: q_in,
+        directions: dirs.len(),
+    }
 }
 
 #[cfg(test)]

@@ -67,7 +67,11 @@ pub fn periodic_regime(sys: &System, settings: &PoincareSettings) -> Result<Peri
     let T = period_of(sys)?;
     let (N, h) = steps_per_period(T, settings.dt)?;
     if !(settings.tol_residual > 0.0) {
-        return Err(DynamicsError::BadSetting { name: "tol_residual", value: settings.tol_residual, reason: "must be positive" });
+        return Err(DynamicsError::BadSetting {
+            name: "tol_residual",
+            value: settings.tol_residual,
+            reason: "must be positive",
+        });
     }
     let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, hold: settings.hold })?;
     let (mut x, mut z) = (sys.x0.as_slice().to_vec(), sys.z0.as_slice().to_vec());
@@ -102,7 +106,17 @@ pub fn periodic_regime(sys: &System, settings: &PoincareSettings) -> Result<Peri
     } else {
         f64::NAN
     };
-    Ok(PeriodicRegime { period: T, h, steps_per_period: N, x0: x, z0: z, residual, iterations: it, contraction_per_period: contraction, status })
+    Ok(PeriodicRegime {
+        period: T,
+        h,
+        steps_per_period: N,
+        x0: x,
+        z0: z,
+        residual,
+        iterations: it,
+        contraction_per_period: contraction,
+        status,
+    })
 }
 
 #[cfg(test)]

@@ -46,7 +46,17 @@ pub struct RateSettings {
 
 impl Default for RateSettings {
     fn default() -> Self {
-        Self { dt: 1e-3, hold: InputHold::Linear, periods: 60, transient_periods: 10, pairs: 3, separation: 1e-3, renorm_below: 1e-4, seed: 11, pi: None }
+        Self {
+            dt: 1e-3,
+            hold: InputHold::Linear,
+            periods: 60,
+            transient_periods: 10,
+            pairs: 3,
+            separation: 1e-3,
+            renorm_below: 1e-4,
+            seed: 11,
+            pi: None,
+        }
     }
 }
 
@@ -57,23 +67,39 @@ impl RateSettings {
             return Err(DynamicsError::ZeroPeriods { periods: 0 });
         }
         if self.periods < self.transient_periods + 3 {
-            return Err(DynamicsError::BadSetting { name: "periods", value: self.periods as f64, reason: "needs at least transient_periods + 3 periods for a regression" });
+            return Err(DynamicsError::BadSetting {
+                name: "periods",
+                value: self.periods as f64,
+                reason: "needs at least transient_periods + 3 periods for a regression",
+            });
         }
         if self.pairs == 0 {
             return Err(DynamicsError::BadSetting { name: "pairs", value: 0.0, reason: "must be at least 1" });
         }
         if !(self.separation > 0.0 && self.separation.is_finite()) {
-            return Err(DynamicsError::BadSetting { name: "separation", value: self.separation, reason: "must be positive and finite" });
+            return Err(DynamicsError::BadSetting {
+                name: "separation",
+                value: self.separation,
+                reason: "must be positive and finite",
+            });
         }
         if !(self.renorm_below > 0.0 && self.renorm_below < 1.0) {
-            return Err(DynamicsError::BadSetting { name: "renorm_below", value: self.renorm_below, reason: "must lie in (0, 1)" });
+            return Err(DynamicsError::BadSetting {
+                name: "renorm_below",
+                value: self.renorm_below,
+                reason: "must lie in (0, 1)",
+            });
         }
         if let Some(pi) = &self.pi {
             if pi.nrows() != n || pi.ncols() != n {
                 return Err(DynamicsError::Dimension { what: "Pi", expected: n, got: pi.nrows() });
             }
             if pi.clone().cholesky().is_none() {
-                return Err(DynamicsError::BadSetting { name: "Pi", value: pi.symmetric_eigenvalues().min(), reason: "must be symmetric positive definite" });
+                return Err(DynamicsError::BadSetting {
+                    name: "Pi",
+                    value: pi.symmetric_eigenvalues().min(),
+                    reason: "must be symmetric positive definite",
+                });
             }
         }
         Ok(())
@@ -134,7 +160,11 @@ pub fn t_quantile_975(nu: usize) -> f64 {
     match nu {
         1 => 12.706,
         2 => 4.303,
-        _ => z + (z.powi(3) + z) / (4.0 * v) + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * v * v) + (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / (384.0 * v.powi(3)),
+        _ => {
+            z + (z.powi(3) + z) / (4.0 * v)
+                + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * v * v)
+                + (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / (384.0 * v.powi(3))
+        }
     }
 }
 
@@ -152,7 +182,11 @@ pub fn regression_slope(t: &[f64], y: &[f64]) -> (f64, f64) {
 }
 
 /// Measures the exponent from `(x0, z0)` (default: the system's initial state).
-pub fn measure_rate(sys: &System, settings: &RateSettings, start: Option<(&[f64], &[f64])>) -> Result<MeasuredRate, DynamicsError> {
+pub fn measure_rate(
+    sys: &System,
+    settings: &RateSettings,
+    start: Option<(&[f64], &[f64])>,
+) -> Result<MeasuredRate, DynamicsError> {
     settings.validate(sys.n())?;
     let T = period_of(sys)?;
     let (N, h) = steps_per_period(T, settings.dt)?;
@@ -213,14 +247,30 @@ pub fn measure_rate(sys: &System, settings: &RateSettings, start: Option<(&[f64]
             }
         }
         if collapsed {
-            pairs.push(PairRate { exponent: f64::NEG_INFINITY, ci_low: f64::NEG_INFINITY, ci_high: f64::NEG_INFINITY, std_error: 0.0, renormalisations: renorms, log_v, collapsed });
+            pairs.push(PairRate {
+                exponent: f64::NEG_INFINITY,
+                ci_low: f64::NEG_INFINITY,
+                ci_high: f64::NEG_INFINITY,
+                std_error: 0.0,
+                renormalisations: renorms,
+                log_v,
+                collapsed,
+            });
             continue;
         }
         let ys = &log_v[settings.transient_periods..];
         let (b, se) = regression_slope(&ts, ys);
         let tq = t_quantile_975(ts.len().saturating_sub(2));
         let exponent = 0.5 * b;
-        pairs.push(PairRate { exponent, ci_low: exponent - 0.5 * tq * se, ci_high: exponent + 0.5 * tq * se, std_error: 0.5 * se, renormalisations: renorms, log_v, collapsed });
+        pairs.push(PairRate {
+            exponent,
+            ci_low: exponent - 0.5 * tq * se,
+            ci_high: exponent + 0.5 * tq * se,
+            std_error: 0.5 * se,
+            renormalisations: renorms,
+            log_v,
+            collapsed,
+        });
     }
     let best = pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent)).expect("pairs >= 1");
     let from = settings.transient_periods;
@@ -282,7 +332,14 @@ mod tests {
     fn linear_case_gives_mu_and_survives_underflow() {
         let mut sys = model::parse_str(include_str!("../../../../examples/worked-example.toml")).unwrap();
         sys.theta = geometry::Shape::origin(1);
-        let st = RateSettings { periods: 200, transient_periods: 5, pairs: 1, separation: 1e-3, renorm_below: 1e-6, ..Default::default() };
+        let st = RateSettings {
+            periods: 200,
+            transient_periods: 5,
+            pairs: 1,
+            separation: 1e-3,
+            renorm_below: 1e-6,
+            ..Default::default()
+        };
         let r = measure_rate(&sys, &st, None).unwrap();
         // 200 periods at -0.3: V falls by e^{-0.6 * 1257} ~ 1e-327: would underflow without renorm
         assert!(r.pairs[0].renormalisations > 10, "{}", r.pairs[0].renormalisations);

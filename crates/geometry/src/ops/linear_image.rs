@@ -15,7 +15,11 @@ pub struct LinearImage<S: ConvexSet> {
 impl<S: ConvexSet> LinearImage<S> {
     pub fn new(m: DMatrix<f64>, set: S) -> Result<Self, GeometryError> {
         if m.ncols() != set.dim() {
-            return Err(GeometryError::DimensionMismatch { what: "columns of M vs dimension of S", expected: set.dim(), got: m.ncols() });
+            return Err(GeometryError::DimensionMismatch {
+                what: "columns of M vs dimension of S",
+                expected: set.dim(),
+                got: m.ncols(),
+            });
         }
         if let Some(&value) = m.iter().find(|x| !x.is_finite()) {
             return Err(GeometryError::NotFinite { what: "matrix entry", value });

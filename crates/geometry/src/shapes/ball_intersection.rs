@@ -31,7 +31,11 @@ impl BallIntersection {
             return Err(GeometryError::NoParts { what: "ball" });
         }
         if radii.len() != centres.len() {
-            return Err(GeometryError::DimensionMismatch { what: "number of radii vs centres", expected: centres.len(), got: radii.len() });
+            return Err(GeometryError::DimensionMismatch {
+                what: "number of radii vs centres",
+                expected: centres.len(),
+                got: radii.len(),
+            });
         }
         let p = centres[0].len();
         if p == 0 {
@@ -87,7 +91,8 @@ impl BallIntersection {
         let p = self.dim();
         let c0 = &self.centres[set[0]];
         let r0 = self.radii[set[0]];
-        let rows: Vec<Vec<f64>> = set[1..].iter().map(|&i| (0..p).map(|d| 2.0 * (self.centres[i][d] - c0[d])).collect()).collect();
+        let rows: Vec<Vec<f64>> =
+            set[1..].iter().map(|&i| (0..p).map(|d| 2.0 * (self.centres[i][d] - c0[d])).collect()).collect();
         let rhs: Vec<f64> = set[1..]
             .iter()
             .map(|&i| {
@@ -163,7 +168,9 @@ impl BallIntersection {
     fn farthest_from(&self, a: &[f64], among: &[usize]) -> f64 {
         let mut best = 0.0f64;
         let a2 = a.to_vec();
-        self.for_each_critical(among, &|m| m.iter().zip(&a2).map(|(x, y)| x - y).collect(), &mut |v| best = best.max(dist(v, a)));
+        self.for_each_critical(among, &|m| m.iter().zip(&a2).map(|(x, y)| x - y).collect(), &mut |v| {
+            best = best.max(dist(v, a))
+        });
         best
     }
 
@@ -204,15 +211,27 @@ impl BallIntersection {
         let mut lam = vec![0.0; k];
         let primal = |lam: &[f64]| -> (Vec<f64>, f64) {
             let s = 1.0 + lam.iter().sum::<f64>();
-            let v: Vec<f64> = (0..p).map(|d| (x[d] + set.iter().zip(lam).map(|(&i, l)| l * self.centres[i][d]).sum::<f64>()) / s).collect();
-            let g = dist(&v, x).powi(2) + set.iter().zip(lam).map(|(&i, l)| l * (dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2))).sum::<f64>();
+            let v: Vec<f64> = (0..p)
+                .map(|d| (x[d] + set.iter().zip(lam).map(|(&i, l)| l * self.centres[i][d]).sum::<f64>()) / s)
+                .collect();
+            let g = dist(&v, x).powi(2)
+                + set
+                    .iter()
+                    .zip(lam)
+                    .map(|(&i, l)| l * (dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2)))
+                    .sum::<f64>();
             (v, g)
         };
-        let scale = set.iter().map(|&i| self.radii[i] * self.radii[i] + dot(&self.centres[i], &self.centres[i])).fold(dot(x, x), f64::max).max(1e-300);
+        let scale = set
+            .iter()
+            .map(|&i| self.radii[i] * self.radii[i] + dot(&self.centres[i], &self.centres[i]))
+            .fold(dot(x, x), f64::max)
+            .max(1e-300);
         let (mut v, mut g) = primal(&lam);
         for _ in 0..100 {
             let s = 1.0 + lam.iter().sum::<f64>();
-            let grad: Vec<f64> = set.iter().map(|&i| dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2)).collect();
+            let grad: Vec<f64> =
+                set.iter().map(|&i| dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2)).collect();
             if grad.iter().all(|gr| gr.abs() <= 1e-15 * scale) {
                 break;
             }
@@ -250,7 +269,8 @@ impl BallIntersection {
                 break;
             }
         }
-        let grad_ok = set.iter().all(|&i| (dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2)).abs() <= 1e-10 * scale);
+        let grad_ok =
+            set.iter().all(|&i| (dist(&v, &self.centres[i]).powi(2) - self.radii[i].powi(2)).abs() <= 1e-10 * scale);
         let lam_ok = lam.iter().all(|&l| l >= -1e-12);
         (grad_ok && lam_ok).then_some(v)
     }
@@ -291,7 +311,11 @@ impl ConvexSet for BallIntersection {
                     let y: Vec<f64> = (0..p).map(|d| v[d] + incr[i][d]).collect();
                     let d = dist(&y, &self.centres[i]);
                     let r = self.radii[i];
-                    let pr: Vec<f64> = if d <= r { y.clone() } else { (0..p).map(|j| self.centres[i][j] + r / d * (y[j] - self.centres[i][j])).collect() };
+                    let pr: Vec<f64> = if d <= r {
+                        y.clone()
+                    } else {
+                        (0..p).map(|j| self.centres[i][j] + r / d * (y[j] - self.centres[i][j])).collect()
+                    };
                     incr[i] = (0..p).map(|j| y[j] - pr[j]).collect();
                     v = pr;
                 }
@@ -336,7 +360,8 @@ impl ConvexSet for BallIntersection {
         StrongConvexity::Exact(r)
     }
     fn describe(&self) -> String {
-        let parts: Vec<String> = self.centres.iter().zip(&self.radii).map(|(c, r)| format!("B({}, {r})", fmt_vec(c))).collect();
+        let parts: Vec<String> =
+            self.centres.iter().zip(&self.radii).map(|(c, r)| format!("B({}, {r})", fmt_vec(c))).collect();
         format!("intersection of balls {}", parts.join(" & "))
     }
 }

@@ -73,7 +73,8 @@ impl Ellipsoid {
     /// Axis-aligned ellipsoid with the given semi-axes.
     pub fn axis_aligned(centre: Vec<f64>, semi_axes: &[f64]) -> Result<Self, GeometryError> {
         check_finite("ellipsoid semi-axis", semi_axes)?;
-        let m = DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(semi_axes.len(), semi_axes.iter().map(|a| a * a)));
+        let m =
+            DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(semi_axes.len(), semi_axes.iter().map(|a| a * a)));
         Self::new(centre, &m)
     }
 
@@ -235,10 +236,8 @@ impl ConvexSet for Ellipsoid {
         let mut u = [0.0; MAX_DIM];
         // hard case test: psi restricted to the other axes at t = -lam_min
         let y_min2: f64 = (0..p).filter(|&k| group[k]).map(|k| y[k] * y[k]).sum();
-        let rest: f64 = (0..p)
-            .filter(|&k| !group[k])
-            .map(|k| self.lam[k] * y[k] * y[k] / (self.lam[k] - lmin).powi(2))
-            .sum();
+        let rest: f64 =
+            (0..p).filter(|&k| !group[k]).map(|k| self.lam[k] * y[k] * y[k] / (self.lam[k] - lmin).powi(2)).sum();
         let lo_eff = -lmin * (1.0 - 1e-13);
         if y_min2 <= (1e-13 * lmin).powi(2) && rest <= 1.0 {
             // hard case: u on the other axes from the formula, rest of the unit norm along the

@@ -35,7 +35,11 @@ impl ConvexSet for Interval {
         1
     }
     fn support(&self, u: &[f64]) -> f64 {
-        if u[0] >= 0.0 { u[0] * self.hi } else { u[0] * self.lo }
+        if u[0] >= 0.0 {
+            u[0] * self.hi
+        } else {
+            u[0] * self.lo
+        }
     }
     fn support_point(&self, u: &[f64], out: &mut [f64]) {
         out[0] = if u[0] >= 0.0 { self.hi } else { self.lo };

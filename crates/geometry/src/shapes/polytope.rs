@@ -21,7 +21,11 @@ impl Polytope {
             return Err(GeometryError::NoParts { what: "half-space" });
         }
         if offsets.len() != normals.len() {
-            return Err(GeometryError::DimensionMismatch { what: "number of offsets vs normals", expected: normals.len(), got: offsets.len() });
+            return Err(GeometryError::DimensionMismatch {
+                what: "number of offsets vs normals",
+                expected: normals.len(),
+                got: offsets.len(),
+            });
         }
         let p = normals[0].len();
         if p == 0 {
@@ -29,7 +33,11 @@ impl Polytope {
         }
         for (i, a) in normals.iter().enumerate() {
             if a.len() != p {
-                return Err(GeometryError::DimensionMismatch { what: "polytope normal length", expected: p, got: a.len() });
+                return Err(GeometryError::DimensionMismatch {
+                    what: "polytope normal length",
+                    expected: p,
+                    got: a.len(),
+                });
             }
             check_finite("polytope normal", a)?;
             if norm(a) == 0.0 {
@@ -101,7 +109,11 @@ impl Polytope {
     /// The box `prod_i [lower_i, upper_i]`.
     pub fn from_box(lower: &[f64], upper: &[f64]) -> Result<Self, GeometryError> {
         if lower.len() != upper.len() {
-            return Err(GeometryError::DimensionMismatch { what: "box upper vs lower length", expected: lower.len(), got: upper.len() });
+            return Err(GeometryError::DimensionMismatch {
+                what: "box upper vs lower length",
+                expected: lower.len(),
+                got: upper.len(),
+            });
         }
         let p = lower.len();
         let mut normals = Vec::new();
@@ -194,7 +206,12 @@ impl ConvexSet for Polytope {
         }
     }
     fn dist_to_boundary(&self, x: &[f64]) -> f64 {
-        self.normals.iter().zip(&self.offsets).map(|(a, b)| (b - dot(a, x)) / norm(a)).fold(f64::INFINITY, f64::min).max(0.0)
+        self.normals
+            .iter()
+            .zip(&self.offsets)
+            .map(|(a, b)| (b - dot(a, x)) / norm(a))
+            .fold(f64::INFINITY, f64::min)
+            .max(0.0)
     }
     fn project_normal_cone(&self, q: &[f64], v: &[f64], tol: f64, out: &mut [f64]) {
         let gens: Vec<Vec<f64>> = self

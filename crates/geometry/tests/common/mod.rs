@@ -53,12 +53,15 @@ pub fn interval() -> impl Strategy<Value = Interval> {
 /// Intersection of 2 or 3 balls in R^p that all contain the origin with margin.
 pub fn ball_intersection(p: usize) -> impl Strategy<Value = BallIntersection> {
     prop::collection::vec((prop::collection::vec(-1.0f64..1.0, p), 0.2f64..1.0), 2..=3).prop_map(move |balls| {
-        let centres: Vec<Vec<f64>> = balls.iter().map(|(c, r)| {
-            // scale the centre so that the origin is inside with margin 0.1 r
-            let n = geometry::linalg::norm(c).max(1e-9);
-            let s = (0.9 * r / n).min(1.0);
-            c.iter().map(|x| x * s).collect()
-        }).collect();
+        let centres: Vec<Vec<f64>> = balls
+            .iter()
+            .map(|(c, r)| {
+                // scale the centre so that the origin is inside with margin 0.1 r
+                let n = geometry::linalg::norm(c).max(1e-9);
+                let s = (0.9 * r / n).min(1.0);
+                c.iter().map(|x| x * s).collect()
+            })
+            .collect();
         let radii: Vec<f64> = balls.iter().map(|(_, r)| *r).collect();
         BallIntersection::new(centres, radii).expect("contains the origin")
     })
@@ -135,11 +138,18 @@ pub fn proj<S: ConvexSet + ?Sized>(s: &S, x: &[f64]) -> Vec<f64> {
 
 /// Runs `prop` over `strategy` with a fixed seed and returns whether a counterexample was
 /// found: the negative controls assert `true`.
-pub fn finds_counterexample<S: Strategy>(strategy: S, cases: u32, prop: impl Fn(S::Value) -> Result<(), TestCaseError>) -> bool
+pub fn finds_counterexample<S: Strategy>(
+    strategy: S,
+    cases: u32,
+    prop: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) -> bool
 where
     S::Value: std::fmt::Debug,
 {
     let cfg = ProptestConfig { cases, failure_persistence: None, ..ProptestConfig::default() };
-    let mut runner = proptest::test_runner::TestRunner::new_with_rng(cfg, proptest::test_runner::TestRng::deterministic_rng(proptest::test_runner::RngAlgorithm::ChaCha));
+    let mut runner = proptest::test_runner::TestRunner::new_with_rng(
+        cfg,
+        proptest::test_runner::TestRng::deterministic_rng(proptest::test_runner::RngAlgorithm::ChaCha),
+    );
     runner.run(&strategy, |v| prop(v)).is_err()
 }

@@ -44,7 +44,11 @@ pub struct Lemma2Case {
 }
 
 pub fn config() -> SystemStrategyConfig {
-    SystemStrategyConfig { max_n: 3, input: InputStrategyConfig { amp_exp: (-1.5, 0.5), ..Default::default() }, ..Default::default() }
+    SystemStrategyConfig {
+        max_n: 3,
+        input: InputStrategyConfig { amp_exp: (-1.5, 0.5), ..Default::default() },
+        ..Default::default()
+    }
 }
 
 pub fn strategy() -> BoxedStrategy<Lemma2Case> {
@@ -97,7 +101,9 @@ pub fn eval(case: &Lemma2Case, variant: Variant) -> Eval {
             let allow = eps * g + 1e-3 * (sp + sm).abs() + 1e-12 * (xs[k].norm() + xi[k].norm());
             for (lhs, sig) in [(u.dot(&dx), sp), (-u.dot(&dx), sm)] {
                 let e = Eval::new(lhs, k_shrink * sig, allow);
-                if worst.is_none_or(|w| e.violated() && !w.violated() || (e.violated() == w.violated() && e.slack() < w.slack())) {
+                if worst.is_none_or(|w| {
+                    e.violated() && !w.violated() || (e.violated() == w.violated() && e.slack() < w.slack())
+                }) {
                     worst = Some(e);
                 }
             }
@@ -107,7 +113,12 @@ pub fn eval(case: &Lemma2Case, variant: Variant) -> Eval {
 }
 
 fn export(case: &Lemma2Case, e: &Eval) -> Counterexample {
-    system_counterexample(&case.sys.build(), e, "lemma2", &format!("horizon {}, h = {H}; lhs = u^T (x - xi), rhs = sigma_Xi(t)(u)", case.horizon))
+    system_counterexample(
+        &case.sys.build(),
+        e,
+        "lemma2",
+        &format!("horizon {}, h = {H}; lhs = u^T (x - xi), rhs = sigma_Xi(t)(u)", case.horizon),
+    )
 }
 
 pub fn property() -> Prop<Lemma2Case> {

@@ -51,8 +51,20 @@ impl SpecCase {
 pub fn lambda_max_dense(a: f64, b: f64, g: &DMatrix<f64>) -> f64 {
     let (n, p) = (g.nrows(), g.ncols());
     let m = Mat::<f64>::from_fn(n + p, n + p, |i, j| match (i < n, j < n) {
-        (true, true) => if i == j { a } else { 0.0 },
-        (false, false) => if i == j { b } else { 0.0 },
+        (true, true) => {
+            if i == j {
+                a
+            } else {
+                0.0
+            }
+        }
+        (false, false) => {
+            if i == j {
+                b
+            } else {
+                0.0
+            }
+        }
         (true, false) => g[(i, j - n)],
         (false, true) => g[(j, i - n)],
     });
@@ -89,8 +101,9 @@ pub fn export(case: &SpecCase, e: &Eval) -> Counterexample {
     root.insert("property".into(), toml::Value::String("lemma_b".into()));
     root.insert("a".into(), toml::Value::Float(case.a));
     root.insert("b".into(), toml::Value::Float(case.b));
-    let rows: Vec<toml::Value> =
-        (0..g.nrows()).map(|i| toml::Value::Array((0..g.ncols()).map(|j| toml::Value::Float(g[(i, j)])).collect())).collect();
+    let rows: Vec<toml::Value> = (0..g.nrows())
+        .map(|i| toml::Value::Array((0..g.ncols()).map(|j| toml::Value::Float(g[(i, j)])).collect()))
+        .collect();
     root.insert("g".into(), toml::Value::Array(rows));
     root.insert("abs_error".into(), toml::Value::Float(e.lhs));
     root.insert("tol".into(), toml::Value::Float(e.rhs));

@@ -12,9 +12,9 @@
 use proptest::strategy::{BoxedStrategy, Strategy, ValueTree};
 use proptest::test_runner::{Config, TestRng, TestRunner};
 
+pub mod lemma2;
 pub mod lemma_a1;
 pub mod lemma_a2;
-pub mod lemma2;
 pub mod lemma_b;
 pub mod pp;
 pub mod qzdot;
@@ -62,7 +62,11 @@ impl Eval {
     /// (any value above `-1/2` is within the floating-point allowance).
     pub fn slack(&self) -> f64 {
         let s = (self.rhs - self.lhs) / (self.lhs.abs() + self.rhs.abs() + self.tol + TINY);
-        if s.is_nan() { -1.0 } else { s }
+        if s.is_nan() {
+            -1.0
+        } else {
+            s
+        }
     }
     /// `lhs > rhs + tol`, or NaN on either side.
     pub fn violated(&self) -> bool {
@@ -121,7 +125,12 @@ pub trait Property: Send + Sync {
     /// shrunk counterexample.
     fn check_case(&self, rng: &mut TestRng, variant: Variant) -> CaseOutcome {
         let r = self.run_cases(rng, 1, variant, &mut |_| {});
-        CaseOutcome { slack: r.min_slack, violated: r.violations > 0, skipped: r.skipped > 0, counterexample: r.counterexample }
+        CaseOutcome {
+            slack: r.min_slack,
+            violated: r.violations > 0,
+            skipped: r.skipped > 0,
+            counterexample: r.counterexample,
+        }
     }
     /// Runs `cases` cases from `rng` (strategy built once), calling `progress(k)` every few
     /// cases with the number done since the last call.
@@ -193,7 +202,14 @@ impl<C: Clone + std::fmt::Debug + Send + Sync + 'static> Property for Prop<C> {
     fn run_cases(&self, rng: &mut TestRng, cases: u64, variant: Variant, progress: &mut dyn FnMut(u64)) -> ChunkResult {
         let strat = (self.strategy)();
         let mut runner = runner_with(rng.clone());
-        let mut out = ChunkResult { cases: 0, skipped: 0, min_slack: f64::INFINITY, violations: 0, first_violation: None, counterexample: None };
+        let mut out = ChunkResult {
+            cases: 0,
+            skipped: 0,
+            min_slack: f64::INFINITY,
+            violations: 0,
+            first_violation: None,
+            counterexample: None,
+        };
         let mut pending = 0;
         for k in 0..cases {
             let saved = runner.rng().clone();
@@ -237,7 +253,12 @@ impl<C: Clone + std::fmt::Debug + Send + Sync + 'static> Property for Prop<C> {
 
 /// `toml` text of a geometric counterexample: the set as a model file's `[theta]` table (same
 /// keys, so it can be pasted into a model) and the points as `[points]`.
-pub fn geometric_counterexample(set: &geometry::Shape, points: &[(&str, &[f64])], e: &Eval, property: &str) -> Counterexample {
+pub fn geometric_counterexample(
+    set: &geometry::Shape,
+    points: &[(&str, &[f64])],
+    e: &Eval,
+    property: &str,
+) -> Counterexample {
     let mut root = toml::Table::new();
     root.insert("property".into(), toml::Value::String(property.into()));
     root.insert("lhs".into(), toml::Value::Float(e.lhs));
@@ -255,7 +276,13 @@ pub fn geometric_counterexample(set: &geometry::Shape, points: &[(&str, &[f64])]
     Counterexample {
         extension: "toml",
         text: toml::to_string(&root).unwrap_or_default(),
-        summary: format!("lhs = {:.6e} > rhs = {:.6e} (tol {:.1e}) on {}", e.lhs, e.rhs, e.tol, geometry::ConvexSet::describe(set)),
+        summary: format!(
+            "lhs = {:.6e} > rhs = {:.6e} (tol {:.1e}) on {}",
+            e.lhs,
+            e.rhs,
+            e.tol,
+            geometry::ConvexSet::describe(set)
+        ),
     }
 }
 
@@ -290,12 +317,18 @@ pub fn system_counterexample(sys: &model::System, e: &Eval, property: &str, extr
         e.lhs, e.rhs, e.tol
     );
     text.push_str(&model::to_toml_string(sys));
-    Counterexample { extension: "toml", text, summary: format!("lhs = {:.6e} > rhs = {:.6e} (tol {:.1e}); {extra}", e.lhs, e.rhs, e.tol) }
+    Counterexample {
+        extension: "toml",
+        text,
+        summary: format!("lhs = {:.6e} > rhs = {:.6e} (tol {:.1e}); {extra}", e.lhs, e.rhs, e.tol),
+    }
 }
 
 /// Common imports of the property modules.
 pub(crate) mod sets_prelude {
-    pub use super::{fp_tol, geometric_counterexample, system_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant};
+    pub use super::{
+        fp_tol, geometric_counterexample, system_counterexample, Counterexample, Eval, Prop, PropertyInfo, Variant,
+    };
     pub use crate::strategies::sets::*;
     pub use geometry::linalg::{dist, dot, norm};
     pub use geometry::ConvexSet;

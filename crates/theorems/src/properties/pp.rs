@@ -27,7 +27,9 @@ pub struct PpCase {
 }
 
 pub fn strategy() -> BoxedStrategy<PpCase> {
-    (set_params(&SetStrategyConfig::default()), vector_params(), vector_params()).prop_map(|(set, a, b)| PpCase { set, a, b }).boxed()
+    (set_params(&SetStrategyConfig::default()), vector_params(), vector_params())
+        .prop_map(|(set, a, b)| PpCase { set, a, b })
+        .boxed()
 }
 
 fn point(set: &geometry::Shape, v: &([f64; MAX_P], f64), size: f64) -> Vec<f64> {

@@ -61,7 +61,9 @@ pub fn eval(case: &QzCase, variant: Variant) -> Eval {
     // record z and q of both trajectories
     let mut tr1: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(steps + 1);
     let mut tr2: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(steps + 1);
-    let q_of = |x: &[f64], z: &[f64]| -> Vec<f64> { (0..p).map(|i| z[i] - (0..n).map(|j| sys.C[(i, j)] * x[j]).sum::<f64>()).collect() };
+    let q_of = |x: &[f64], z: &[f64]| -> Vec<f64> {
+        (0..p).map(|i| z[i] - (0..n).map(|j| sys.C[(i, j)] * x[j]).sum::<f64>()).collect()
+    };
     tr1.push((z1.clone(), q_of(&x1, &z1)));
     tr2.push((z2.clone(), q_of(&x2, &z2)));
     if !simulate(&sys, dt, 0.0, &mut x1, &mut z1, steps, |_, x, z| tr1.push((z.to_vec(), q_of(x, z))))

@@ -41,7 +41,11 @@ impl XiNodes {
     /// trapezoid rule on the nodes with `s <= t` (`t = inf`: all nodes, eq. (Xinfsupp)).
     pub fn support(&self, theta: &geometry::Shape, u: &[f64], t: f64) -> f64 {
         let u = DVector::from_column_slice(u);
-        let k = if t.is_finite() { ((t / self.ds).floor().max(0.0) as usize).saturating_add(1).min(self.nodes.len()) } else { self.nodes.len() };
+        let k = if t.is_finite() {
+            ((t / self.ds).floor().max(0.0) as usize).saturating_add(1).min(self.nodes.len())
+        } else {
+            self.nodes.len()
+        };
         let mut s = 0.0;
         for (i, M) in self.nodes[..k].iter().enumerate() {
             let f = theta.support((M * &u).as_slice());
@@ -53,7 +57,15 @@ impl XiNodes {
 
 /// Runs the catching-up scheme from `(x, z)` at time `t0` for `steps` steps of `dt`, calling
 /// `obs(t, x, z)` after every step.
-pub fn simulate(sys: &System, dt: f64, t0: f64, x: &mut [f64], z: &mut [f64], steps: usize, mut obs: impl FnMut(f64, &[f64], &[f64])) -> bool {
+pub fn simulate(
+    sys: &System,
+    dt: f64,
+    t0: f64,
+    x: &mut [f64],
+    z: &mut [f64],
+    steps: usize,
+    mut obs: impl FnMut(f64, &[f64], &[f64]),
+) -> bool {
     let Ok(mut cu) = CatchingUp::new(sys, &CatchingUpSettings { dt, ..Default::default() }) else { return false };
     cu.run(t0, x, z, steps, |_, t, x, z| obs(t, x, z));
     true
@@ -61,7 +73,11 @@ pub fn simulate(sys: &System, dt: f64, t0: f64, x: &mut [f64], z: &mut [f64], st
 
 /// Operator 2-norm.
 pub fn op_norm(M: &DMatrix<f64>) -> f64 {
-    if M.is_empty() { 0.0 } else { M.clone().singular_values().max() }
+    if M.is_empty() {
+        0.0
+    } else {
+        M.clone().singular_values().max()
+    }
 }
 
 /// Exact solution of `x' = M x + B w(t)`, `x(0) = x0`, at `t_k = k h`, `k = 0..=steps`, for a

@@ -62,7 +62,9 @@ pub fn config() -> SystemStrategyConfig {
 }
 
 pub fn strategy() -> BoxedStrategy<Theorem1Case> {
-    (system_params(&config()), 0.05..=1.5f64, 0.0..=1.0f64).prop_map(|(sys, horizon, frac)| Theorem1Case { sys, horizon, frac }).boxed()
+    (system_params(&config()), 0.05..=1.5f64, 0.0..=1.0f64)
+        .prop_map(|(sys, horizon, frac)| Theorem1Case { sys, horizon, frac })
+        .boxed()
 }
 
 /// `R(T)` on the grid and what the check needs.
@@ -85,7 +87,11 @@ pub struct RestSet {
 impl RestSet {
     /// `v(z)`: `<= 0` iff `z in R(T)` (on the grid).
     pub fn violation(&self, z: f64) -> f64 {
-        self.phi.iter().zip(&self.c).map(|(f, c)| (f * z - c - self.hi).max(self.lo + c - f * z)).fold(f64::NEG_INFINITY, f64::max)
+        self.phi
+            .iter()
+            .zip(&self.c)
+            .map(|(f, c)| (f * z - c - self.hi).max(self.lo + c - f * z))
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 }
 
@@ -173,7 +179,11 @@ pub fn eval(case: &Theorem1Case, variant: Variant) -> Eval {
             let b = outside.and_then(|z| run_from(&sys, &rs, z)).map(|(_, path)| Eval::new(1e-9 * width, path, 0.0));
             match (a, b) {
                 (Some(a), Some(b)) => {
-                    if a.violated() || (!b.violated() && a.slack() <= b.slack()) { a } else { b }
+                    if a.violated() || (!b.violated() && a.slack() <= b.slack()) {
+                        a
+                    } else {
+                        b
+                    }
                 }
                 (Some(e), None) | (None, Some(e)) => e,
                 (None, None) => Eval::skipped(),
@@ -188,7 +198,10 @@ fn export(case: &Theorem1Case, e: &Eval) -> Counterexample {
     let extra = match rest_set(&sys, case.horizon) {
         Some(rs) => {
             let (r, o) = points(case, &sys, &rs);
-            format!("T = {}, R(T) = [{:e}, {:e}], rest point {:?}, outside point {:?}, delta {:e}", case.horizon, rs.lower, rs.upper, r, o, rs.delta)
+            format!(
+                "T = {}, R(T) = [{:e}, {:e}], rest point {:?}, outside point {:?}, delta {:e}",
+                case.horizon, rs.lower, rs.upper, r, o, rs.delta
+            )
         }
         None => format!("T = {}", case.horizon),
     };

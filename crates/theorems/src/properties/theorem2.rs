@@ -63,7 +63,12 @@ pub fn info(part: Part) -> PropertyInfo {
 pub fn config() -> SystemStrategyConfig {
     SystemStrategyConfig {
         mu: (-2.0, -1.0),
-        theta: SetStrategyConfig { kinds: THETA_KINDS.to_vec(), max_cond: 5.0, scale_exp: 0.75, ..SetStrategyConfig::default() },
+        theta: SetStrategyConfig {
+            kinds: THETA_KINDS.to_vec(),
+            max_cond: 5.0,
+            scale_exp: 0.75,
+            ..SetStrategyConfig::default()
+        },
         input: InputStrategyConfig { amp_exp: (-1.0, 1.3), ..Default::default() },
         ..Default::default()
     }

@@ -29,7 +29,9 @@ pub struct ZyCase {
 }
 
 pub fn strategy() -> BoxedStrategy<ZyCase> {
-    (set_params(&SetStrategyConfig::default()), point_params(), vector_params()).prop_map(|(set, q, ydot)| ZyCase { set, q, ydot }).boxed()
+    (set_params(&SetStrategyConfig::default()), point_params(), vector_params())
+        .prop_map(|(set, q, ydot)| ZyCase { set, q, ydot })
+        .boxed()
 }
 
 pub fn eval(case: &ZyCase, variant: Variant) -> Eval {

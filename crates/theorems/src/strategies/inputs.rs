@@ -61,6 +61,12 @@ pub fn periodic_input(cfg: &InputStrategyConfig) -> BoxedStrategy<InputParams> {
         cfg.omega.0..=cfg.omega.1,
         0.0..std::f64::consts::TAU,
     )
-        .prop_map(|(waveform, amplitudes, amp_exp, omega, phase)| InputParams { waveform, amplitudes, amp_exp, omega, phase })
+        .prop_map(|(waveform, amplitudes, amp_exp, omega, phase)| InputParams {
+            waveform,
+            amplitudes,
+            amp_exp,
+            omega,
+            phase,
+        })
         .boxed()
 }

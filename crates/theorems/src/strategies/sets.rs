@@ -24,9 +24,11 @@ pub enum SetKind {
 
 impl SetKind {
     /// Strongly convex kinds (finite `R`, eq. (R)).
-    pub const STRONGLY_CONVEX: [SetKind; 4] = [SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid, SetKind::BallIntersection];
+    pub const STRONGLY_CONVEX: [SetKind; 4] =
+        [SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid, SetKind::BallIntersection];
     /// All kinds (polytopes have `R = infinity`).
-    pub const ALL: [SetKind; 5] = [SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid, SetKind::BallIntersection, SetKind::Polytope];
+    pub const ALL: [SetKind; 5] =
+        [SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid, SetKind::BallIntersection, SetKind::Polytope];
 }
 
 /// What kind of sets a strategy draws.
@@ -130,8 +132,9 @@ impl SetParams {
                 let k = self.count.clamp(2, MAX_P);
                 let radii: Vec<f64> = (0..k).map(|i| s * cond.powf(self.shape[i])).collect();
                 // |c_i| <= 0.6 r_i: the origin is inside every ball with margin 0.4 r_i
-                let centres: Vec<Vec<f64>> =
-                    (0..k).map(|i| (0..p).map(|j| 0.6 * radii[i] * self.extra[i][j] / (p as f64).sqrt()).collect()).collect();
+                let centres: Vec<Vec<f64>> = (0..k)
+                    .map(|i| (0..p).map(|j| 0.6 * radii[i] * self.extra[i][j] / (p as f64).sqrt()).collect())
+                    .collect();
                 Shape::BallIntersection(BallIntersection::new(centres, radii).expect("contains the origin"))
             }
             SetKind::Polytope => {
@@ -164,7 +167,11 @@ impl SetParams {
         let g = DMatrix::from_fn(p, p, |i, j| self.rot[i * MAX_P + j] * 2.0 + if i == j { 1.0 } else { 0.0 });
         let qr = g.qr();
         let q = qr.q();
-        if q.iter().all(|x| x.is_finite()) { q } else { DMatrix::identity(p, p) }
+        if q.iter().all(|x| x.is_finite()) {
+            q
+        } else {
+            DMatrix::identity(p, p)
+        }
     }
 }
 
