@@ -126,3 +126,28 @@ fn fitted_model_round_trips_through_the_model_file() {
     }
     assert!(j["effects"][0].get("uncertainty").is_some());
 }
+
+#[test]
+fn backlash_inertia_coasts_as_the_closed_form() {
+    // x' = -x + w, w = 1, y = x, play half-width r = 0.1 not fed back (E = 0): z stays at 0
+    // until y - z = r at t_c = ln(1/0.9), is then pushed with y' = 0.9 and, since y decelerates
+    // faster (rate 1) than the coasting output (rate 1/tau, tau = 1.05), leaves y at once and
+    // coasts: z(t) = 0.9 tau (1 - e^{-(t - t_c)/tau}), always within r of y.
+    let text = "name = \"coast\"\n[plant]\nA = [[-1.0]]\nB = [[1.0]]\nC = [[1.0]]\nE = [[0.0]]\n[theta]\nshape = \"interval\"\nhalf_width = 0.1\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0]\nz0 = [0.0]\n";
+    let sys = model::parse_str(text).unwrap();
+    let (dt, ns, tau) = (0.002, 5000, 1.05);
+    let w = vec![1.0; ns];
+    let tc = (1.0f64 / 0.9).ln();
+    let exact = |t: f64| if t <= tc { 0.0 } else { 0.9 * tau * (1.0 - (-(t - tc) / tau).exp()) };
+    let run = |tau: f64| {
+        let e = [Effect::BacklashInertia { mass: tau, damping: 1.0 }];
+        ExtendedModel::new(&sys, &e, dt, 4).unwrap().simulate(&w, dt, &[0.0]).z
+    };
+    let z = run(tau);
+    let err = (0..ns).map(|k| (z[k] - exact(k as f64 * dt)).abs()).fold(0.0, f64::max);
+    assert!(err < 5e-3, "coasting output off the closed form by {err}");
+    // Negative control: a massless output ends at y - r = 0.9 - e^{-10}, 0.045 below.
+    let z0 = run(0.0);
+    let err0 = (z0[ns - 1] - exact((ns - 1) as f64 * dt)).abs();
+    assert!(err0 > 0.04, "massless output indistinguishable from the coasting one ({err0})");
+}

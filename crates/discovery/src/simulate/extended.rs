@@ -64,6 +64,8 @@ pub struct SimOutput {
     pub y: Vec<f64>,
     /// Whether the play is in contact (`q` on the boundary of Theta) at sample `k`.
     pub contact: Vec<bool>,
+    /// The backlash output `z[k]` flat, `k * p + i` (equal to `C x` without a play).
+    pub z: Vec<f64>,
     /// Whether the state was finite throughout.
     pub finite: bool,
     /// Root mean square of each state over the run (scales for fitting).
@@ -309,8 +311,9 @@ impl ExtendedModel {
         let mut y = vec![0.0; p];
         let mut v = vec![0.0; p];
         let mut scratch = vec![0.0; p];
-        let mut zp = vec![0.0; p];
-        let mut out = SimOutput { y: vec![0.0; ns * p], contact: vec![false; ns], finite: true, x_rms: vec![0.0; n] };
+        let mut qp = vec![0.0; p];
+        let mut out =
+            SimOutput { y: vec![0.0; ns * p], contact: vec![false; ns], z: vec![0.0; ns * p], finite: true, x_rms: vec![0.0; n] };
         let cx = |x: &[f64], y: &mut [f64]| {
             for i in 0..p {
                 y[i] = (0..n).map(|j| self.C[i * n + j] * x[j]).sum();
@@ -339,6 +342,7 @@ impl ExtendedModel {
         for k in 0..ns {
             for i in 0..p {
                 out.y[k * p + i] = y[i] + self.offset[i];
+                out.z[k * p + i] = z[i];
             }
             for i in 0..n {
                 out.x_rms[i] += x[i] * x[i];
@@ -385,12 +389,15 @@ impl ExtendedModel {
                         scratch[i] = z[i] + v[i] * coast;
                         q[i] = scratch[i] - y[i];
                     }
-                    zp.copy_from_slice(&scratch);
+                    // The deviation before projection: the contact is decided on `q` itself
+                    // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
+                    // a contact and slow the coasting decay spuriously).
+                    qp.copy_from_slice(&q);
                     let hit = self.project_q(&mut q, &mut scratch);
                     for i in 0..p {
                         let znew = y[i] + q[i];
                         if self.inertia_tau > 0.0 {
-                            v[i] = if (znew - zp[i]).abs() > 0.0 { (znew - z[i]) / h } else { v[i] * decay };
+                            v[i] = if q[i] != qp[i] { (znew - z[i]) / h } else { v[i] * decay };
                         }
                         z[i] = znew;
                     }
