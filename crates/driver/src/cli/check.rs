@@ -111,12 +111,12 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         );
     } else {
         println!(
-            "{:<10} {:<10} {:>9} {:>8} {:>12} {:>10} {:>8}",
+            "{:<14} {:<10} {:>9} {:>8} {:>12} {:>10} {:>8}",
             "result", "label", "cases", "skipped", "min slack", "violations", "time"
         );
         for r in &reports {
             println!(
-                "{:<10} {:<10} {:>9} {:>8} {:>12} {:>10} {:>7.2}s",
+                "{:<14} {:<10} {:>9} {:>8} {:>12} {:>10} {:>7.2}s",
                 r.name,
                 r.label,
                 r.cases,
