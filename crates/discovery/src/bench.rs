@@ -26,6 +26,8 @@ pub struct CaseResult {
     pub param_error: Option<f64>,
     pub true_param: Option<f64>,
     pub est_param: Option<f64>,
+    /// Reported 1-sigma uncertainty (Gauss-Newton) of the estimate.
+    pub est_std: Option<f64>,
     pub fit_before: f64,
     pub fit_after: f64,
     pub seconds: f64,
@@ -75,6 +77,7 @@ pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettin
         param_error: None,
         true_param: case.truth.as_ref().map(main_param),
         est_param: None,
+        est_std: None,
         fit_before: f64::NAN,
         fit_after: f64::NAN,
         seconds,
@@ -105,6 +108,17 @@ pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettin
                     let (tv, ev) = (main_param(t), main_param(e));
                     out.est_param = Some(ev);
                     out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
+                    let label = match t {
+                        Effect::CoulombFriction { state, .. } | Effect::ConstantForce { state, .. } => {
+                            format!("{}(x{})", t.kind(), state + 1)
+                        }
+                        _ => String::new(),
+                    };
+                    out.est_std = rep
+                        .effects
+                        .iter()
+                        .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))
+                        .and_then(|f| f.uncertainty.first().map(|u| u.1));
                 }
             }
         }
@@ -180,11 +194,25 @@ impl BenchResult {
             let mut e = errs.clone();
             e.sort_by(f64::total_cmp);
             let within = e.iter().filter(|x| **x <= 0.15).count();
+            // Error in units of the reported uncertainty.
+            let mut z: Vec<f64> = self
+                .cases
+                .iter()
+                .filter(|r| &r.class == c)
+                .filter_map(|r| match (r.est_param, r.true_param, r.est_std) {
+                    (Some(e), Some(t), Some(sd)) => Some((e - t).abs() / sd),
+                    _ => None,
+                })
+                .collect();
+            z.sort_by(f64::total_cmp);
+            let within2 = z.iter().filter(|x| **x <= 2.0).count();
             s += &format!(
-                "  {c:>18}: median {:.1} %, max {:.1} %, within 15 %: {within}/{}\n",
+                "  {c:>18}: median {:.1} %, max {:.1} %, within 15 %: {within}/{}; |error| / reported sigma: median {:.1}, within 2 sigma: {within2}/{}\n",
                 100.0 * e[e.len() / 2],
                 100.0 * e[e.len() - 1],
-                e.len()
+                e.len(),
+                z.get(z.len() / 2).copied().unwrap_or(f64::NAN),
+                z.len()
             );
         }
         let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();

@@ -4,7 +4,9 @@
 //!
 //! Bounds (all scale-free, from the data and the model):
 //! - play widths `[0, range(y)/2]` (loop) or `[0, range(w)/2]` (input);
-//! - `gap_width` relative change `[-0.9, 4]`;
+//! - `gap_width` relative change `[-0.9, s_max - 1]` with `s_max = clamp(2 range(y) /
+//!   diam(Theta), 5, 1000)` (a play wider than the output range never moves `z`), fitted
+//!   in the logarithm of the scale `1 + relative_change`;
 //! - force levels (friction, constant force) up to the force whose static deflection of `y`
 //!   equals `range(y)`: `range(y) / |C F^{-1} e_j|` (friction `[0, that]`, force `+-` half of it);
 //! - `backlash_inertia` time constant `mass/damping` in `[0, 2 tau_slow]` (damping fixed to 1:
@@ -88,13 +90,52 @@ pub struct Hypothesis {
     pub kind: Kind,
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,
-    /// Starting points in normalised coordinates `(theta - lower) / (upper - lower)`.
+    /// Starting points in the solver's unit coordinates `u in [0, 1]` (see [`Hypothesis::param_at`]).
     pub starts: Vec<Vec<f64>>,
     /// Parameter names (as in the model file, in the order of the parameter vector).
     pub names: Vec<&'static str>,
+    /// How each parameter is mapped to `[0, 1]`: `None` linearly, `Some(c)` logarithmically
+    /// in `theta + c` (for scale-like parameters whose plausible range spans decades, so
+    /// that a step means the same relative change across the range).
+    pub log_shift: Vec<Option<f64>>,
 }
 
 impl Hypothesis {
+    /// Parameter `i` from unit coordinate `u`: `lower + u (upper - lower)`, or with a log
+    /// shift `c`: `theta + c = (lower + c) ((upper + c) / (lower + c))^u`.
+    pub fn param_at(&self, i: usize, u: f64) -> f64 {
+        let (lo, hi) = (self.lower[i], self.upper[i]);
+        match self.log_shift[i] {
+            None => lo + u * (hi - lo),
+            Some(c) => (lo + c) * ((hi + c) / (lo + c)).powf(u) - c,
+        }
+    }
+    /// Inverse of [`Hypothesis::param_at`], clamped to `[0, 1]`.
+    pub fn unit_of(&self, i: usize, theta: f64) -> f64 {
+        let (lo, hi) = (self.lower[i], self.upper[i]);
+        let u = match self.log_shift[i] {
+            None => (theta - lo) / (hi - lo).max(1e-300),
+            Some(c) => ((theta + c).max(1e-300) / (lo + c)).ln() / ((hi + c) / (lo + c)).ln(),
+        };
+        if u.is_finite() {
+            u.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+    /// `d theta_i / d u` at `u` (maps the solver's covariance to physical units).
+    pub fn slope(&self, i: usize, u: f64) -> f64 {
+        let (lo, hi) = (self.lower[i], self.upper[i]);
+        match self.log_shift[i] {
+            None => hi - lo,
+            Some(c) => (self.param_at(i, u) + c) * ((hi + c) / (lo + c)).ln(),
+        }
+    }
+    /// Sets the starts from physical parameter values (one parameter per hypothesis).
+    fn starts_at(mut self, theta: &[f64]) -> Self {
+        self.starts = theta.iter().map(|t| vec![self.unit_of(0, *t)]).collect();
+        self
+    }
     /// The effect for parameters `theta` (physical units).
     pub fn effect(&self, theta: &[f64], s: &Scales) -> Effect {
         let _ = s;
@@ -157,6 +198,7 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
         upper: vec![hi],
         starts: vec![vec![0.1], vec![0.4], vec![0.8]],
         names: vec![name],
+        log_shift: vec![None],
     };
     let mut out = Vec::new();
     if point && e_nonzero {
@@ -164,9 +206,14 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
     }
     out.push(one(Kind::Backlash { at_input: true }, 0.0, 0.5 * wr, "width"));
     if !point {
-        let mut h = one(Kind::GapWidth, -0.9, 4.0, "relative_change");
-        h.starts = vec![vec![0.1], vec![0.184], vec![0.3], vec![0.6]];
-        out.push(h);
+        // Scale 1 + relative_change from 0.1 up to the scale at which the play is wider than
+        // the whole output range (beyond it z never moves and the scale is not identifiable),
+        // at least 5; fitted in log scale.
+        let diam = geometry::ConvexSet::diameter(&sys.theta).lower;
+        let smax = if diam > 0.0 { (2.0 * yr / diam).clamp(5.0, 1e3) } else { 5.0 };
+        let mut h = one(Kind::GapWidth, -0.9, smax - 1.0, "relative_change");
+        h.log_shift = vec![Some(1.0)];
+        out.push(h.starts_at(&[-0.5, 1e-3, 0.7, 2.5]));
         out.push(one(Kind::BacklashInertia, 0.0, 2.0 * s.tau_slow, "mass"));
     }
     for j in velocity_states(sys) {
@@ -188,6 +235,40 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
         upper: s.y_range.iter().map(|r| 0.5 * r).collect(),
         starts: vec![vec![0.5; p], vec![0.3; p], vec![0.7; p]],
         names: vec!["offset"; p],
+        log_shift: vec![None; p],
     });
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_coordinates_round_trip_and_slope_matches_differences() {
+        let h = Hypothesis {
+            kind: Kind::GapWidth,
+            lower: vec![-0.9, 0.0],
+            upper: vec![29.0, 2.0],
+            starts: vec![],
+            names: vec!["relative_change", "x"],
+            log_shift: vec![Some(1.0), None],
+        };
+        // Log map: u = 0 -> scale 0.1, u = 1 -> scale 30, u = 1/2 -> geometric mean.
+        assert!((h.param_at(0, 0.0) + 0.9).abs() < 1e-12);
+        assert!((h.param_at(0, 1.0) - 29.0).abs() < 1e-9);
+        assert!((h.param_at(0, 0.5) + 1.0 - 3f64.sqrt()).abs() < 1e-12);
+        for (i, t) in [(0, -0.5), (0, 0.0), (0, 7.1), (1, 0.3)] {
+            let u = h.unit_of(i, t);
+            assert!((h.param_at(i, u) - t).abs() < 1e-9 * (1.0 + t.abs()), "{i} {t}");
+            let d = (h.param_at(i, u + 1e-6) - h.param_at(i, u - 1e-6)) / 2e-6;
+            assert!((h.slope(i, u) - d).abs() < 1e-5 * d.abs(), "slope {} vs {d}", h.slope(i, u));
+        }
+        // Out of the box: clamped.
+        assert_eq!(h.unit_of(0, 100.0), 1.0);
+        assert_eq!(h.unit_of(1, -1.0), 0.0);
+        // Negative control: the linear map of the same box does not give the geometric mean.
+        let lin = Hypothesis { log_shift: vec![None, None], ..h.clone() };
+        assert!((lin.param_at(0, 0.5) + 1.0 - 3f64.sqrt()).abs() > 1.0);
+    }
 }

@@ -1,7 +1,8 @@
 //! Bounded Levenberg-Marquardt on the simulation error with several starts.
 //!
-//! Variables: normalised effect parameters `u = (theta - lower) / (upper - lower)` kept in
-//! `[0, 1]` by projection, and `x0 / x_scale`. Jacobian by forward differences (step `tol_fd`
+//! Variables: effect parameters in unit coordinates `u in [0, 1]` (linear
+//! `(theta - lower) / (upper - lower)`, or logarithmic for scale-like parameters, see
+//! [`crate::hypothesis::Hypothesis::param_at`]) kept in the box by projection, and `x0 / x_scale`. Jacobian by forward differences (step `tol_fd`
 //! in normalised units: large enough to see through the kinks of plays and stick-slip).
 //! Step: `(J^T J + lambda diag(J^T J)) d = -J^T r`; accepted when the cost decreases.
 //!
@@ -58,15 +59,13 @@ pub struct FitResult {
 
 struct Vars<'p, 'a> {
     pb: &'p Problem<'a>,
-    lo: Vec<f64>,
-    span: Vec<f64>,
     xs: Vec<f64>,
     k: usize,
 }
 
 impl Vars<'_, '_> {
     fn split(&self, v: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let theta = (0..self.k).map(|i| self.lo[i] + self.span[i] * v[i]).collect();
+        let theta = self.pb.params_at(&v[..self.k]);
         let x0 = (0..self.xs.len()).map(|i| v[self.k + i] * self.xs[i]).collect();
         (theta, x0)
     }
@@ -160,11 +159,9 @@ fn lm(
 /// every part together) and initial state `x0_init`; `x_scale` scales the initial state.
 pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>, s: &FitSettings) -> FitResult {
     let lo = pb.lower();
-    let hi = pb.upper();
     let k = lo.len();
-    let span: Vec<f64> = lo.iter().zip(&hi).map(|(a, b)| (b - a).max(1e-300)).collect();
     let xs: Vec<f64> = x_scale.iter().map(|v| v.max(1e-9)).collect();
-    let vars = Vars { pb, lo: lo.clone(), span: span.clone(), xs: xs.clone(), k };
+    let vars = Vars { pb, xs: xs.clone(), k };
     let mut evals = 0;
     let x0v: Vec<f64> = x0_init.iter().zip(&xs).map(|(a, b)| a / b).collect();
     let nstart = pb.parts.iter().map(|h| h.starts.len()).max().unwrap_or(1).max(1);
@@ -173,7 +170,7 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         // Warm start: the given leading parameters, then the new part's starts.
         let nw = w.len();
         for i in 0..nstart {
-            let mut v: Vec<f64> = w.iter().enumerate().map(|(j, t)| ((t - lo[j]) / span[j]).clamp(0.0, 1.0)).collect();
+            let mut v: Vec<f64> = pb.units_of(w);
             let mut off = 0;
             for h in &pb.parts {
                 if off >= nw {
@@ -217,8 +214,9 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     let dof = (nres as f64 - v.len() as f64).max(1.0);
     let s2 = cost / dof;
     let JtJ = J.transpose() * &J;
+    let slope = pb.slope(&v[..k]);
     let std: Vec<f64> = match JtJ.clone().try_inverse() {
-        Some(inv) => (0..k).map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt() * span[i]).collect(),
+        Some(inv) => (0..k).map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt() * slope[i].abs()).collect(),
         None => vec![f64::NAN; k],
     };
     let (theta, x0) = vars.split(&v);

@@ -49,6 +49,47 @@ impl<'a> Problem<'a> {
     pub fn upper(&self) -> Vec<f64> {
         self.parts.iter().flat_map(|h| h.upper.clone()).collect()
     }
+    /// The hypothesis and its local index for parameter `i` of the concatenated vector.
+    fn part_of(&self, mut i: usize) -> (&Hypothesis, usize) {
+        for h in &self.parts {
+            if i < h.k() {
+                return (h, i);
+            }
+            i -= h.k();
+        }
+        panic!("parameter index {i} beyond the problem's parameters")
+    }
+    /// Physical parameters from unit coordinates (see [`Hypothesis::param_at`]).
+    pub fn params_at(&self, u: &[f64]) -> Vec<f64> {
+        u.iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let (h, j) = self.part_of(i);
+                h.param_at(j, *v)
+            })
+            .collect()
+    }
+    /// Unit coordinates of physical parameters.
+    pub fn units_of(&self, theta: &[f64]) -> Vec<f64> {
+        theta
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let (h, j) = self.part_of(i);
+                h.unit_of(j, *v)
+            })
+            .collect()
+    }
+    /// `d theta_i / d u_i` at `u`.
+    pub fn slope(&self, u: &[f64]) -> Vec<f64> {
+        u.iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let (h, j) = self.part_of(i);
+                h.slope(j, *v)
+            })
+            .collect()
+    }
     /// Simulates with `theta`, `x0` over the first `len` samples (`None`: the whole record).
     pub fn simulate(&self, theta: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
         let ext = ExtendedModel::from_maps(self.sys, &self.effects(theta), self.maps.clone(), self.substeps).ok()?;
