@@ -92,8 +92,8 @@ pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettin
             out.ties = rep.ties.clone();
             out.correct = out.predicted == class;
             out.correct_or_tied = out.correct || rep.ties.iter().any(|t| t.split('(').next() == Some(class));
-            out.fit_before = rep.fit_before.fit_percent[0];
-            out.fit_after = rep.fit_after.fit_percent[0];
+            out.fit_before = rep.fit_before.fit_percent[0].unwrap_or(f64::NAN);
+            out.fit_after = rep.fit_after.fit_percent[0].unwrap_or(f64::NAN);
             if out.correct {
                 // Compare like with like: the same kind and, for forces, the same state (a force
                 // on another state is an observationally equivalent but different parameter).

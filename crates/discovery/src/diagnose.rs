@@ -296,9 +296,10 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
             None => (
                 Fit {
-                    fit_percent: vec![f64::NEG_INFINITY; p],
+                    fit_percent: vec![Some(f64::NEG_INFINITY); p],
                     rmse: vec![f64::INFINITY; p],
-                    velocity_fit_percent: vec![f64::NEG_INFINITY; p],
+                    velocity_fit_percent: vec![Some(f64::NEG_INFINITY); p],
+                    constant_outputs: vec![],
                 },
                 f64::INFINITY,
             ),
@@ -425,16 +426,32 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)"
             .to_string()
     } else if let Some(c) = &chosen {
-        format!(
-            "missing physics: {} (validation fit {} -> {} %)",
-            c.label,
-            fmt_vec(&fit_before.fit_percent),
-            fmt_vec(&fit_after.fit_percent)
-        )
+        if fit_before.constant_outputs.is_empty() {
+            format!(
+                "missing physics: {} (validation fit {} -> {} %)",
+                c.label,
+                fmt_opt(&fit_before.fit_percent),
+                fmt_opt(&fit_after.fit_percent)
+            )
+        } else {
+            format!(
+                "missing physics: {} (validation RMSE {} -> {}; fit % undefined, the validation output is constant)",
+                c.label,
+                fmt_e(&fit_before.rmse),
+                fmt_e(&fit_after.rmse)
+            )
+        }
     } else {
         "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC and validation): the mismatch is outside the library".to_string()
     };
-    if fit_before.fit_percent.iter().any(|f| *f > 97.0) {
+    if !fit_before.constant_outputs.is_empty() {
+        notes.push(format!(
+            "The measured output(s) {} are constant on the validation segment (standard deviation at most {} of the whole record's): fit % is undefined there (null in report.json) and the validation is judged by the RMSE and the validation SSE ratio instead.",
+            fit_before.constant_outputs.iter().map(|i| format!("y{}", i + 1)).collect::<Vec<_>>().join(", "),
+            metrics::TOL_CONSTANT
+        ));
+    }
+    if fit_before.fit_percent.iter().flatten().any(|f| *f > 97.0) {
         notes.push("Plain fit % is above 97 % (a tightly tracking loop saturates it): judge by the RMSE ratio (validation_ratio), the velocity fit and BIC instead.".into());
     }
     if matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset))
@@ -482,6 +499,11 @@ fn fmt_vec(v: &[f64]) -> String {
     v.iter().map(|x| format!("{x:.1}")).collect::<Vec<_>>().join(", ")
 }
 
+/// Fit % values, `undefined` where the measured segment is constant.
+fn fmt_opt(v: &[Option<f64>]) -> String {
+    v.iter().map(|x| x.map_or("undefined (constant output)".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
+}
+
 impl Report {
     /// The label of the selected hypothesis (`"none"` if nothing was added).
     pub fn selected(&self) -> String {
@@ -504,15 +526,15 @@ impl Report {
         s += "## Fit on the validation segment\n\n| | fit % | RMSE | velocity fit % |\n|---|---|---|---|\n";
         s += &format!(
             "| nominal | {} | {} | {} |\n",
-            fmt_vec(&self.fit_before.fit_percent),
+            fmt_opt(&self.fit_before.fit_percent),
             fmt_e(&self.fit_before.rmse),
-            fmt_vec(&self.fit_before.velocity_fit_percent)
+            fmt_opt(&self.fit_before.velocity_fit_percent)
         );
         s += &format!(
             "| fitted | {} | {} | {} |\n\n",
-            fmt_vec(&self.fit_after.fit_percent),
+            fmt_opt(&self.fit_after.fit_percent),
             fmt_e(&self.fit_after.rmse),
-            fmt_vec(&self.fit_after.velocity_fit_percent)
+            fmt_opt(&self.fit_after.velocity_fit_percent)
         );
         s += "## Residual tests (nominal model)\n\n";
         let r = &self.residual_nominal;
@@ -569,7 +591,7 @@ impl Report {
                 r.label,
                 fmt_e(&r.params),
                 r.delta_bic,
-                fmt_vec(&r.validation.fit_percent),
+                fmt_opt(&r.validation.fit_percent),
                 r.validation_ratio,
                 r.beats_nominal
             );

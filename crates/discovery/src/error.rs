@@ -13,6 +13,8 @@ pub enum DiscoveryError {
     RowLength { path: String, row: usize, got: usize, expected: usize },
     #[error("recording {path}: time must increase strictly: row {row} has t = {t} after t = {prev}")]
     NonIncreasingTime { path: String, row: usize, t: f64, prev: f64 },
+    #[error("recording {path}: the sampling gap of {gap} s before row {row} is {ratio:.0} times the median interval {median} s (at most {max_ratio} allowed): resampling would invent data across it; split the recording at the gap")]
+    TimeGap { path: String, row: usize, gap: f64, median: f64, ratio: f64, max_ratio: f64 },
     #[error("recording {path}: input column `{column}` is constant (value {value}); nothing can be identified from a constant input")]
     ConstantInput { path: String, column: String, value: f64 },
     #[error("recording {path}: only {rows} samples; at least {min} are needed")]

@@ -28,6 +28,11 @@ pub struct Recording {
 /// Minimum number of samples of a recording.
 pub const MIN_SAMPLES: usize = 50;
 
+/// Largest sampling interval allowed, in units of the median interval: a longer gap is
+/// rejected rather than bridged by interpolation (which would invent data and could blow the
+/// resampled grid up to an unbounded length).
+pub const MAX_GAP_RATIO: f64 = 20.0;
+
 fn col_names(prefix: &str, header: &[String]) -> Vec<usize> {
     if let Some(i) = header.iter().position(|h| h == prefix) {
         return vec![i];
@@ -137,6 +142,20 @@ impl Recording {
         }
         if t.len() < MIN_SAMPLES {
             return Err(DiscoveryError::TooFewSamples { path, rows: t.len(), min: MIN_SAMPLES });
+        }
+        let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+        d.sort_by(f64::total_cmp);
+        let median = d[d.len() / 2];
+        if let Some(k) = t.windows(2).position(|p| p[1] - p[0] > MAX_GAP_RATIO * median) {
+            let gap = t[k + 1] - t[k];
+            return Err(DiscoveryError::TimeGap {
+                path,
+                row: k + 3, // row of t[k + 1]: 1-based, header is row 1
+                gap,
+                median,
+                ratio: gap / median,
+                max_ratio: MAX_GAP_RATIO,
+            });
         }
         for (j, &i) in iw.iter().enumerate() {
             let v0 = w[0][j];
@@ -251,5 +270,19 @@ mod tests {
         assert!(e.contains("constant"), "{e}");
         let e = Recording::parse_str(&csv(10, |k| format!("{},{},{}", k, k, k)), "x").unwrap_err().to_string();
         assert!(e.contains("only 10 samples"), "{e}");
+        // A gap of 1e9 s after 0.01 s sampling (once resampled to 1e11 rows): rejected.
+        let e = Recording::parse_str(
+            &csv(60, |k| format!("{},{},1", if k < 59 { k as f64 * 0.01 } else { 1e9 }, k)),
+            "x",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("sampling gap") && e.contains("row 61"), "{e}");
+        // Negative control: jitter of a few times the median interval is resampled, not rejected.
+        let ok = Recording::parse_str(
+            &csv(60, |k| format!("{},{},1", k as f64 * 0.01 + if k >= 30 { 0.04 } else { 0.0 }, k)),
+            "x",
+        );
+        assert!(ok.is_ok_and(|r| r.resampled));
     }
 }

@@ -87,7 +87,7 @@ fn bam_xl330_kp100_diagnosis_is_stable() {
         let mut kinds: Vec<&str> = r.effects.iter().map(|e| e.label.as_str()).collect();
         kinds.sort();
         assert_eq!(kinds, ["backlash(input)", "input_saturation"], "{log}");
-        assert!(r.fit_after.fit_percent[0] > r.fit_before.fit_percent[0] + 15.0);
+        assert!(r.fit_after.fit_percent[0].unwrap() > r.fit_before.fit_percent[0].unwrap() + 15.0);
         let w = r.effects.iter().find(|e| e.label == "backlash(input)").unwrap().params[0].1;
         widths.push(w);
     }

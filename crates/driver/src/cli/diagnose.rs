@@ -116,11 +116,19 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let secs = start.elapsed().as_secs_f64();
     write_outputs(&r, &a.out)?;
     println!("{}", r.verdict);
+    let pct = |v: &[Option<f64>]| {
+        v.iter().map(|x| x.map_or("undefined".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
+    };
     println!(
-        "validation fit % (nominal -> fitted): {:?} -> {:?}",
-        r.fit_before.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>(),
-        r.fit_after.fit_percent.iter().map(|v| (v * 10.0).round() / 10.0).collect::<Vec<_>>()
+        "validation fit % (nominal -> fitted): [{}] -> [{}]; RMSE {:?} -> {:?}",
+        pct(&r.fit_before.fit_percent),
+        pct(&r.fit_after.fit_percent),
+        r.fit_before.rmse,
+        r.fit_after.rmse
     );
+    if !r.fit_before.constant_outputs.is_empty() {
+        println!("fit % undefined: the validation output is constant; judge by the RMSE");
+    }
     for e in &r.effects {
         println!("  {}: {:?}", e.label, e.params);
     }
