@@ -501,7 +501,10 @@ fn fmt_vec(v: &[f64]) -> String {
 
 /// Fit % values, `undefined` where the measured segment is constant.
 fn fmt_opt(v: &[Option<f64>]) -> String {
-    v.iter().map(|x| x.map_or("undefined (constant output)".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|x| x.map_or("undefined (constant output)".to_string(), |x| format!("{x:.1}")))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 impl Report {

@@ -271,12 +271,10 @@ mod tests {
         let e = Recording::parse_str(&csv(10, |k| format!("{},{},{}", k, k, k)), "x").unwrap_err().to_string();
         assert!(e.contains("only 10 samples"), "{e}");
         // A gap of 1e9 s after 0.01 s sampling (once resampled to 1e11 rows): rejected.
-        let e = Recording::parse_str(
-            &csv(60, |k| format!("{},{},1", if k < 59 { k as f64 * 0.01 } else { 1e9 }, k)),
-            "x",
-        )
-        .unwrap_err()
-        .to_string();
+        let e =
+            Recording::parse_str(&csv(60, |k| format!("{},{},1", if k < 59 { k as f64 * 0.01 } else { 1e9 }, k)), "x")
+                .unwrap_err()
+                .to_string();
         assert!(e.contains("sampling gap") && e.contains("row 61"), "{e}");
         // Negative control: jitter of a few times the median interval is resampled, not rejected.
         let ok = Recording::parse_str(

@@ -312,8 +312,13 @@ impl ExtendedModel {
         let mut v = vec![0.0; p];
         let mut scratch = vec![0.0; p];
         let mut qp = vec![0.0; p];
-        let mut out =
-            SimOutput { y: vec![0.0; ns * p], contact: vec![false; ns], z: vec![0.0; ns * p], finite: true, x_rms: vec![0.0; n] };
+        let mut out = SimOutput {
+            y: vec![0.0; ns * p],
+            contact: vec![false; ns],
+            z: vec![0.0; ns * p],
+            finite: true,
+            x_rms: vec![0.0; n],
+        };
         let cx = |x: &[f64], y: &mut [f64]| {
             for i in 0..p {
                 y[i] = (0..n).map(|j| self.C[i * n + j] * x[j]).sum();
