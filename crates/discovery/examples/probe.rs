@@ -1,5 +1,6 @@
 //! Development aid: one benchmark case, its ranking, and a profile of the estimation cost
 //! along the true effect's main parameter (initial state refitted at each point).
+//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3`.
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
@@ -8,6 +9,10 @@ use model::effects::Effect;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
+    if a.len() != 4 {
+        eprintln!("usage: cargo run --release -p discovery --example probe CLASS SEED INDEX");
+        std::process::exit(2);
+    }
     let class: &'static str = Box::leak(a[1].clone().into_boxed_str());
     let seed: u64 = a[2].parse().unwrap();
     let idx: usize = a[3].parse().unwrap();

@@ -150,11 +150,24 @@ pub fn solve_beta_sdp(
     lambda: f64,
     settings: &BetaSdpSettings,
 ) -> Result<BetaSdpSolution> {
+    let mu = validate_problem(F, E, C, lambda, settings)?;
+    solve_checked(F, E, C, lambda, mu, settings)
+}
+
+/// Validates settings, dimensions and finiteness, `F` Hurwitz and `lambda in (0, |mu|)`;
+/// returns `mu`.
+fn validate_problem(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    lambda: f64,
+    settings: &BetaSdpSettings,
+) -> Result<f64> {
     settings.validate()?;
     check_system(F, E, C)?;
     let mu = hurwitz_mu(F)?;
     check_lambda(lambda, mu)?;
-    solve_checked(F, E, C, lambda, mu, settings)
+    Ok(mu)
 }
 
 /// [`solve_beta_sdp`] followed by [`certify`]; [`LmiError::NotVerified`] when no proof
@@ -166,10 +179,7 @@ pub fn certified_beta(
     lambda: f64,
     settings: &BetaSdpSettings,
 ) -> Result<CertifiedBeta> {
-    settings.validate()?;
-    check_system(F, E, C)?;
-    let mu = hurwitz_mu(F)?;
-    check_lambda(lambda, mu)?;
+    let mu = validate_problem(F, E, C, lambda, settings)?;
     certified_checked(F, E, C, lambda, mu, settings)
 }
 
