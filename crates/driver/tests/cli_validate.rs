@@ -58,4 +58,28 @@ fn bad_files_give_one_line_errors_and_nonzero_exit() {
     let (code, _, err) = moreau(&["validate", "/no/such/model.toml"]);
     assert_ne!(code, 0);
     assert!(err.contains("/no/such/model.toml") && err.lines().count() == 1, "{err}");
+    // The operating system's reason is said once, not once per error layer.
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+    let (code, _, err) = moreau(&["theta", "/no/such/model.toml"]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+}
+
+#[test]
+fn negative_numeric_options_reach_their_own_check() {
+    // `--dt -1` is a value, not an unknown flag: the error names the option and the value.
+    for (args, needle) in [
+        (
+            &["simulate", "examples/worked-example.toml", "--dt", "-1", "--out", "unused-out"][..],
+            "--dt must be positive",
+        ),
+        (&["periodic", "examples/worked-example.toml", "--dt", "-0.5"][..], "got -0.5"),
+        (&["convergence", "examples/worked-example.toml", "--h0", "-0.1"][..], "--h0 must be positive"),
+    ] {
+        let (code, _, err) = moreau(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(needle) && err.trim_end().lines().count() == 1, "{args:?}: {err}");
+    }
+    let unused = concat!(env!("CARGO_MANIFEST_DIR"), "/../../unused-out");
+    assert!(!std::path::Path::new(unused).exists(), "no output directory after a rejected --dt");
 }

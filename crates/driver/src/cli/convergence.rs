@@ -10,7 +10,7 @@ pub struct Args {
     /// Model file (TOML); Theta an interval, ball or ellipsoid; zero or sine input.
     pub file: PathBuf,
     /// Largest step of the ladder.
-    #[arg(long, default_value_t = 1e-2)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 1e-2)]
     pub h0: f64,
     /// Number of steps in the ladder (each half the previous).
     #[arg(long, default_value_t = 6)]

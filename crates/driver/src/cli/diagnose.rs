@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long)]
     pub out: PathBuf,
     /// Fraction of the record used for estimation (the rest validates). Default 0.7.
-    #[arg(long, default_value_t = 0.7)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.7)]
     pub estimation_fraction: f64,
     /// Greatest number of effects added by forward selection.
     #[arg(long, default_value_t = 2)]

@@ -34,10 +34,10 @@ pub struct Args {
     #[arg(long)]
     pub x: Option<String>,
     /// trajectory: final time (default: the model's periods, or t_end).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub t_end: Option<f64>,
     /// trajectory: time step (default: the model's dt).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
 }
 

@@ -14,7 +14,7 @@ pub struct Args {
     /// Model file (TOML) with a periodic input.
     pub file: PathBuf,
     /// Time step (default: `simulation.dt`).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
     /// Periods simulated for the rate measurement (default 60; the first 10 are transient).
     #[arg(long, default_value_t = 60)]

@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(long)]
     pub periods: Option<usize>,
     /// Time step (default: `simulation.dt`); for periodic inputs `T / ceil(T / dt)` is used.
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
     #[arg(long, value_enum, default_value = "catching-up")]
     pub integrator: Integrator,

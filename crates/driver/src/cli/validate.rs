@@ -41,8 +41,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         match model::load(f).with_context(|| f.display().to_string()) {
             Ok(s) => println!("{}\n  {}", f.display(), summary(&s)),
             Err(e) => {
-                let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-                eprintln!("error: {}", chain.join(": "));
+                eprintln!("error: {}", super::one_line(&e));
                 failed += 1;
             }
         }

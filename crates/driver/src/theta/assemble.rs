@@ -577,7 +577,8 @@ impl ThetaReport {
                 "R(T) slack s*",
                 "(stat1)",
                 s.slack,
-                Estimate,
+                // The grid relaxes (stat1), so its slack bounds the continuous one from below.
+                if s.verified { Lower } else { Estimate },
                 s.verified,
                 format!(
                     "{} -> {}",
