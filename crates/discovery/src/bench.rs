@@ -26,7 +26,7 @@ pub struct CaseResult {
     pub param_error: Option<f64>,
     pub true_param: Option<f64>,
     pub est_param: Option<f64>,
-    /// Reported 1-sigma uncertainty (Gauss-Newton) of the estimate.
+    /// Reported 1-sigma uncertainty of the estimate (Gauss-Newton or coloured-residual sandwich, the larger).
     pub est_std: Option<f64>,
     pub fit_before: f64,
     pub fit_after: f64,

@@ -577,7 +577,7 @@ impl Report {
             s += &format!("- **{}**: {}\n", e.label, e.description);
             for ((n, v), (_, u)) in e.params.iter().zip(&e.uncertainty) {
                 s += &format!(
-                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma, Gauss-Newton; optimistic if residuals are coloured)\n"
+                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma: the larger of Gauss-Newton and a batch-means sandwich for coloured residuals; model error is not included)\n"
                 );
             }
         }

@@ -6,8 +6,10 @@
 //! in normalised units: large enough to see through the kinks of plays and stick-slip).
 //! Step: `(J^T J + lambda diag(J^T J)) d = -J^T r`; accepted when the cost decreases.
 //!
-//! Uncertainty: Gauss-Newton covariance `s^2 (J^T J)^{-1}` with `s^2 = SSE / (N - k)`, mapped
-//! back to physical units. It assumes white residuals and is optimistic when they are not.
+//! Uncertainty: the larger of the Gauss-Newton variance `s^2 (J^T J)^{-1}`, `s^2 = SSE / (N - k)`
+//! (white residuals), and the sandwich `(J^T J)^{-1} S (J^T J)^{-1}` with a batch-means estimate
+//! `S` of the long-run covariance of the score (coloured residuals), mapped back to physical
+//! units. Model error that biases the estimate is not covered by either.
 use crate::fit::Problem;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -100,6 +102,78 @@ fn jacobian(vars: &Vars, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DM
         }
     }
     J
+}
+
+/// Long-run covariance of the score `J^T r` when the residuals are serially correlated
+/// (batch means): the per-sample scores `g_t = sum_j J_(t p + j)^T r_(t p + j)` (residuals are
+/// time-major with `p` outputs) are summed over consecutive blocks of `L` samples and
+/// `S = sum_b G_b G_b^T`. `L` is ten times the lag at which the residual autocorrelation first
+/// falls below `1/e` (block sums of an AR(1) with `rho = 0.9` then carry 90 % of the long-run
+/// variance), at least 1, at most a tenth of the record so that there are >= 10 blocks. For
+/// white residuals `S ~ s^2 J^T J`, the Gauss-Newton value.
+fn long_run_score_covariance(J: &DMatrix<f64>, r: &[f64], p: usize) -> DMatrix<f64> {
+    let nv = J.ncols();
+    let p = p.max(1);
+    let t_len = r.len() / p;
+    let mut S = DMatrix::zeros(nv, nv);
+    if t_len == 0 {
+        return S;
+    }
+    let max_block = (t_len / 10).max(1);
+    let block = 10 * residual_correlation_length(r, p, max_block);
+    let block = block.clamp(1, max_block);
+    let mut g = DVector::zeros(nv);
+    let mut filled = 0;
+    for t in 0..t_len {
+        for j in 0..p {
+            let idx = t * p + j;
+            for c in 0..nv {
+                g[c] += J[(idx, c)] * r[idx];
+            }
+        }
+        filled += 1;
+        if filled == block || t + 1 == t_len {
+            S += &g * g.transpose();
+            g.fill(0.0);
+            filled = 0;
+        }
+    }
+    S
+}
+
+/// First time lag (in samples, at most `max_lag`) at which the autocorrelation of the
+/// residuals, pooled over the `p` outputs, falls below `1/e`: doubling lags bracket the
+/// crossing, bisection locates it (about `2 log2(max_lag)` autocorrelations, not `max_lag`:
+/// a long record with coloured residuals stays cheap).
+fn residual_correlation_length(r: &[f64], p: usize, max_lag: usize) -> usize {
+    let t_len = r.len() / p;
+    let max_lag = max_lag.min(t_len.saturating_sub(1)).max(1);
+    let c0: f64 = r.iter().map(|x| x * x).sum();
+    if c0 <= 0.0 || !c0.is_finite() || t_len < 2 {
+        return 1;
+    }
+    let below = |lag: usize| {
+        let c: f64 = (lag * p..t_len * p).map(|i| r[i] * r[i - lag * p]).sum();
+        c / c0 < (-1.0f64).exp()
+    };
+    let (mut lo, mut hi) = (0, 1);
+    while !below(hi) {
+        if hi >= max_lag {
+            return max_lag;
+        }
+        lo = hi;
+        hi = (2 * hi).min(max_lag);
+    }
+    // Not below at `lo` (or `lo = 0`), below at `hi`.
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if below(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
 }
 
 /// Runs LM from `v`, at most `iters` iterations. Returns (v, r, cost, converged).
@@ -216,7 +290,12 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     let JtJ = J.transpose() * &J;
     let slope = pb.slope(&v[..k]);
     let std: Vec<f64> = match JtJ.clone().try_inverse() {
-        Some(inv) => (0..k).map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt() * slope[i].abs()).collect(),
+        Some(inv) => {
+            // The larger of the white-noise and the coloured-residual (batch-means sandwich)
+            // variances: the report never claims more precision than either supports.
+            let sandwich = &inv * long_run_score_covariance(&J, &r, pb.p) * &inv;
+            (0..k).map(|i| (s2 * inv[(i, i)]).max(sandwich[(i, i)]).max(0.0).sqrt() * slope[i].abs()).collect()
+        }
         None => vec![f64::NAN; k],
     };
     let (theta, x0) = vars.split(&v);
@@ -228,5 +307,70 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         n_res: nres,
         status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations },
         evaluations: evals,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+        let u1: f64 = rng.random::<f64>().max(1e-300);
+        let u2: f64 = rng.random();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+
+    /// Variance of the fitted mean of `r` (one parameter, `J = 1`): sandwich over Gauss-Newton.
+    fn sandwich_over_gauss_newton(r: &[f64]) -> f64 {
+        let n = r.len() as f64;
+        let J = DMatrix::from_element(r.len(), 1, 1.0);
+        let s2 = r.iter().map(|x| x * x).sum::<f64>() / (n - 1.0);
+        let gn = s2 / n;
+        let sandwich = long_run_score_covariance(&J, r, 1)[(0, 0)] / (n * n);
+        sandwich / gn
+    }
+
+    #[test]
+    fn white_residuals_keep_the_gauss_newton_variance() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let r: Vec<f64> = (0..20_000).map(|_| gauss(&mut rng)).collect();
+        let ratio = sandwich_over_gauss_newton(&r);
+        assert!((0.6..1.6).contains(&ratio), "white noise: sandwich / GN = {ratio}");
+    }
+
+    #[test]
+    fn coloured_residuals_widen_the_variance_by_the_long_run_factor() {
+        // AR(1), rho = 0.9: the variance of a mean is (1 + rho) / (1 - rho) = 19 times the
+        // white-noise formula. Gauss-Newton alone (ratio 1) would fail this check.
+        let rho = 0.9;
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut x = 0.0;
+        let r: Vec<f64> = (0..50_000)
+            .map(|_| {
+                x = rho * x + gauss(&mut rng);
+                x
+            })
+            .collect();
+        let ratio = sandwich_over_gauss_newton(&r);
+        assert!((13.0..25.0).contains(&ratio), "AR(1) 0.9: sandwich / GN = {ratio}, expected about 17-19");
+        assert_eq!(residual_correlation_length(&r, 1, 1000), 10, "1/e crossing of 0.9^k is at k = 10");
+    }
+
+    #[test]
+    fn interleaved_outputs_use_time_lags() {
+        // Two outputs, time-major: output 0 is AR(1), output 1 white. The correlation length is
+        // measured in time steps (pooled), not in stacked indices.
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut x = 0.0;
+        let mut r = Vec::new();
+        for _ in 0..20_000 {
+            x = 0.9 * x + gauss(&mut rng);
+            r.push(x);
+            r.push(gauss(&mut rng));
+        }
+        let l = residual_correlation_length(&r, 2, 1000);
+        assert!((3..=10).contains(&l), "pooled correlation length {l}");
     }
 }
