@@ -175,7 +175,8 @@ pub fn sine_frequency_response(
 ) -> Option<DVector<f64>> {
     let n = F.nrows();
     let M: DMatrix<Complex<f64>> = DMatrix::from_fn(n, n, |i, j| {
-        Complex::new(if i == j { 0.0 } else { 0.0 }, if i == j { omega } else { 0.0 }) - Complex::new(F[(i, j)], 0.0)
+        // i omega I - F
+        Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 })
     });
     let Ba = B * DVector::from_column_slice(a);
     let rhs: DVector<Complex<f64>> = Ba.map(|v| Complex::new(v, 0.0) * Complex::new(0.0, omega * t + phase).exp());

@@ -103,7 +103,7 @@ impl Ellipsoid {
         }
     }
     #[inline]
-    fn from_axes(&self, y: &[f64], out: &mut [f64]) {
+    fn to_world(&self, y: &[f64], out: &mut [f64]) {
         let p = self.centre.len();
         for i in 0..p {
             let mut s = self.centre[i];
@@ -206,7 +206,7 @@ impl ConvexSet for Ellipsoid {
         for k in 0..p {
             u[k] = self.lam[k] * y[k] / (self.lam[k] + t);
         }
-        self.from_axes(&u[..p], out);
+        self.to_world(&u[..p], out);
     }
     fn contains(&self, x: &[f64], tol: f64) -> bool {
         let p = self.dim();
