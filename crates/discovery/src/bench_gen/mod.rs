@@ -306,7 +306,8 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
     Case { class, nominal, truth, recording, nominal_fit, description }
 }
 
-fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+/// A standard normal sample (Box-Muller).
+pub(crate) fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let u1: f64 = rng.random::<f64>().max(1e-300);
     let u2: f64 = rng.random();
     (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()

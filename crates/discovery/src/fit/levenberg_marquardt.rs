@@ -120,8 +120,8 @@ fn long_run_score_covariance(J: &DMatrix<f64>, r: &[f64], p: usize) -> DMatrix<f
         return S;
     }
     let max_block = (t_len / 10).max(1);
-    let block = 10 * residual_correlation_length(r, p, max_block);
-    let block = block.clamp(1, max_block);
+    // Lags beyond a tenth of the largest block cannot change it: the search stops there.
+    let block = (10 * residual_correlation_length(r, p, max_block.div_ceil(10))).clamp(1, max_block);
     let mut g = DVector::zeros(nv);
     let mut filled = 0;
     for t in 0..t_len {
@@ -313,14 +313,9 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{Rng, SeedableRng};
+    use crate::bench_gen::gauss;
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn gauss(rng: &mut ChaCha8Rng) -> f64 {
-        let u1: f64 = rng.random::<f64>().max(1e-300);
-        let u2: f64 = rng.random();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
 
     /// Variance of the fitted mean of `r` (one parameter, `J = 1`): sandwich over Gauss-Newton.
     fn sandwich_over_gauss_newton(r: &[f64]) -> f64 {
