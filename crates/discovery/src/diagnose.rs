@@ -13,7 +13,7 @@ use crate::select::{self, SelectSettings};
 use crate::simulate::{ExtendedModel, StepMaps};
 use crate::{DiscoveryError, Recording};
 use model::effects::Effect;
-use model::System;
+use model::{Input, SimDefaults, System};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -53,6 +53,9 @@ impl Default for DiagnoseSettings {
         }
     }
 }
+
+/// File name of the input samples written beside `fitted.toml` (the model's `input.file`).
+pub const FITTED_INPUT_FILE: &str = "fitted-input.csv";
 
 /// One fitted effect in the report.
 #[derive(Debug, Clone, Serialize)]
@@ -396,6 +399,15 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     fitted_sys.x0 = nalgebra::DVector::from_column_slice(&x0_fit);
     fitted_sys.z0 = &sys.C * &fitted_sys.x0;
     fitted_sys.name = format!("{} (fitted by moreau diagnose)", sys.name);
+    // The recording's input (on the uniform grid the fit used, time from 0) and the fit's
+    // step, so that `moreau simulate fitted.toml` reproduces the fitted curve.
+    fitted_sys.input = Input::Samples {
+        path: FITTED_INPUT_FILE.into(),
+        t: (0..n_samp).map(|k| k as f64 * dt).collect(),
+        w: rec.w.clone(),
+        period: None,
+    };
+    fitted_sys.sim = SimDefaults { dt: dt / substeps as f64, periods: 1, t_end: Some((n_samp - 1) as f64 * dt) };
     let effects: Vec<FittedEffect> = match &chosen {
         Some(c) => {
             let mut off = 0;

@@ -27,8 +27,8 @@ pub enum DiscoveryError {
     DimensionMismatch { what: &'static str, model: usize, recording: usize, columns: String },
     #[error("the model is not stable (max Re eig(F) = {mu}); a free-run simulation fit is meaningless")]
     Unstable { mu: f64 },
-    #[error("effect {kind}: {reason} (value {value})")]
-    BadEffect { kind: &'static str, reason: &'static str, value: f64 },
+    #[error("simulation: {0}")]
+    Dynamics(#[from] dynamics::DynamicsError),
     #[error("settings: {field} = {value}: {reason}")]
     BadSetting { field: &'static str, value: f64, reason: &'static str },
 }

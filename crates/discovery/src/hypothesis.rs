@@ -188,7 +188,7 @@ fn static_gain(sys: &System, j: usize) -> Option<f64> {
 
 /// All single-effect hypotheses applicable to `sys`.
 pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
-    let point = crate::simulate::extended::theta_is_point(sys);
+    let point = dynamics::extended::theta_is_point(sys);
     let e_nonzero = sys.E.iter().any(|v| *v != 0.0);
     let yr = s.y_range.iter().copied().fold(0.0, f64::max).max(1e-12);
     let wr = s.w_range.iter().copied().fold(0.0, f64::max).max(1e-12);

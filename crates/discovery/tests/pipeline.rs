@@ -134,8 +134,15 @@ fn fitted_model_round_trips_through_the_model_file() {
     let m = r.fitted_model.as_ref().unwrap();
     assert!(!m.effects.list.is_empty(), "{}", r.verdict);
     let text = model::to_toml_string(m);
-    let back = model::parse_str(&text).unwrap();
+    // The fitted model carries the recording's input as a CSV input beside it.
+    let dir = tempfile::tempdir().unwrap();
+    assert!(text.contains(discovery::diagnose::FITTED_INPUT_FILE), "{text}");
+    std::fs::write(dir.path().join(discovery::diagnose::FITTED_INPUT_FILE), m.input.samples_csv().unwrap()).unwrap();
+    std::fs::write(dir.path().join("fitted.toml"), &text).unwrap();
+    let back = model::load(&dir.path().join("fitted.toml")).unwrap();
     assert_eq!(back.effects, m.effects);
+    assert_eq!(back.input.samples_csv(), m.input.samples_csv());
+    assert_eq!(back.sim, m.sim);
     // The JSON report has the documented keys.
     let j = serde_json::to_value(&r).unwrap();
     for k in ["fit_before", "fit_after", "effects", "windows", "ranking"] {

@@ -23,6 +23,8 @@ pub enum DynamicsError {
     EventLocation { t: f64, what: &'static str },
     #[error("too many events ({count}) before t = {t}: chattering or Zeno behaviour")]
     TooManyEvents { count: usize, t: f64 },
+    #[error("effect {kind}: {reason} (value {value})")]
+    BadEffect { kind: &'static str, reason: &'static str, value: f64 },
     #[error("the state became non-finite at t = {t}")]
     NonFinite { t: f64 },
 }

@@ -19,8 +19,11 @@
 //!   regression over periods with a 95% interval and Benettin renormalisation;
 //!   [`rate::path_length`]: path length of `z` per period and `max |z'|`.
 //! - [`trajectory`]: recorded trajectories and their CSV.
+//! - [`extended`]: the model extended by its `[[effects]]` (friction, backlash inertia, input
+//!   delay and saturation, sensor offset, extra play) and its fixed-step simulator, the one
+//!   used for every model with effects.
 //!
-//! Entry points for the theta driver and the theorem campaign:
+//! Entry points for `bounds`, the theorem campaign and the CLI:
 //! - simulation: `Simulator::new(&sys, &CatchingUpSettings { dt, hold })?` then
 //!   `sim.run(t0, &mut x, &mut z, steps, |k, t, x, z| ..)` (no allocation per step; fast path for
 //!   `(n, p)` in `(2,1) (3,1) (4,1) (4,2) (6,2) (6,3)`, any `Shape`);
@@ -36,6 +39,7 @@
 
 pub mod convergence;
 pub mod error;
+pub mod extended;
 pub mod integrators;
 pub mod linear;
 pub mod periodic;

@@ -13,6 +13,9 @@ pub struct Trajectory {
     pub w: Vec<f64>,
     pub x: Vec<f64>,
     pub z: Vec<f64>,
+    /// Sensor offset added to `C x` in [`Trajectory::y_at`] (empty: none; models with a
+    /// `sensor_offset` effect).
+    pub y_offset: Vec<f64>,
 }
 
 impl Trajectory {
@@ -40,9 +43,13 @@ impl Trajectory {
     pub fn w_at(&self, i: usize) -> &[f64] {
         &self.w[i * self.m..(i + 1) * self.m]
     }
-    /// `y = C x` at sample `i`.
+    /// `y = C x` (plus the sensor offset, if any) at sample `i`.
     pub fn y_at(&self, C: &nalgebra::DMatrix<f64>, i: usize) -> Vec<f64> {
-        (C * nalgebra::DVector::from_column_slice(self.x_at(i))).as_slice().to_vec()
+        let mut y = (C * nalgebra::DVector::from_column_slice(self.x_at(i))).as_slice().to_vec();
+        for (a, o) in y.iter_mut().zip(&self.y_offset) {
+            *a += o;
+        }
+        y
     }
     /// CSV with header `t,w1..,x1..,y1..,z1..,q1..` (`q = z - y`), full precision.
     pub fn to_csv(&self, C: &nalgebra::DMatrix<f64>) -> String {
@@ -67,8 +74,21 @@ impl Trajectory {
     }
 }
 
+/// Simulates `sys` for `steps` steps of `h` from `(sys.x0, sys.z0)`, recording every
+/// `record_every`-th state (and the first and last): the catching-up scheme for a model of the
+/// paper's class, the extended model ([`crate::extended::simulate_trajectory`]) when the model
+/// has `[[effects]]`. The one entry point of every command that simulates a model file.
+pub fn simulate_model(sys: &System, h: f64, steps: usize, record_every: usize) -> Result<Trajectory, DynamicsError> {
+    if sys.effects.list.is_empty() {
+        simulate_catching_up(sys, &CatchingUpSettings { dt: h, ..Default::default() }, steps, record_every)
+    } else {
+        crate::extended::simulate_trajectory(sys, h, steps, record_every)
+    }
+}
+
 /// Simulates `steps` catching-up steps from `(sys.x0, sys.z0)` at `t = 0`, recording every
-/// `record_every`-th state (and the first).
+/// `record_every`-th state (and the first). Ignores `[[effects]]`: use [`simulate_model`] for
+/// model files.
 pub fn simulate_catching_up(
     sys: &System,
     settings: &CatchingUpSettings,

@@ -16,6 +16,8 @@
 //!   ([`MinkowskiSum`]) through support functions.
 //! - [`normal_cone`]: projection onto finitely generated cones (non-smooth boundary points).
 //! - [`sphere_max`]: certified maximisation of a Lipschitz function over the unit sphere.
+//! - [`sublinear_max`]: sharper certified maxima over the unit sphere of sublinear functions
+//!   (sums of support functions, eqs. (d), (zinf)) by conic combination on arcs and triangles.
 //! - [`curvature`]: numerical `R` of planar sets from the support function.
 //!
 //! All points are plain `&[f64]` slices so that hot loops (the catching-up integrator)
@@ -32,6 +34,7 @@ pub mod ops;
 pub mod shapes;
 pub mod sphere_max;
 pub mod strong_convexity;
+pub mod sublinear_max;
 
 pub use bounds::Bounds;
 pub use convex_set::ConvexSet;
@@ -40,3 +43,4 @@ pub use ops::{LinearImage, MinkowskiSum};
 pub use shapes::{Ball, BallIntersection, Ellipsoid, Interval, Polytope, Shape, SupportSet};
 pub use sphere_max::{sphere_max, SphereMaxSettings};
 pub use strong_convexity::StrongConvexity;
+pub use sublinear_max::sublinear_sphere_max;

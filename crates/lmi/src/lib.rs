@@ -3,6 +3,7 @@
 //!
 //! Objects, one module each:
 //! - [`spectral_abscissa`]: `mu = max Re eig(F)`, eq. (stab), input validation;
+//! - [`sdp`]: the conic layer over Clarabel ([`ConicProgram`]), shared with Theorem 1's set;
 //! - [`psd_triangle`]: Clarabel's scaled upper-triangle storage of symmetric matrices;
 //! - [`feasibility`]: (ALI) `S(Pi F) <= -lambda Pi`, `Pi > 0`, and the supremum of `lambda`;
 //! - [`beta_sdp`]: minimal `beta = lambda_max(H^T Pi^{-1} H)`, eq. (bet), for given `lambda`;
@@ -32,6 +33,6 @@ pub use feasibility::{
     lyapunov_feasibility, sup_feasible_lambda, FeasibilitySettings, LambdaSupremum, LyapunovFeasibility,
 };
 pub use lambda_search::{optimise_lambda, CurvePoint, CurveValue, LambdaOptimum, LambdaSearch, LambdaSearchSettings};
-pub use sdp::{SdpSettings, SdpStatus};
+pub use sdp::{ConicOutcome, ConicProgram, SdpSettings, SdpStatus};
 pub use spectral_abscissa::{hurwitz_mu, spectral_abscissa};
 pub use verify::{certify, check_certificate, Certificate, Margin, VerifySettings};

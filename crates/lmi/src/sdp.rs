@@ -1,4 +1,5 @@
-//! Thin layer over Clarabel's PSD cones: linear matrix inequalities
+//! Thin layer over Clarabel ([`ConicProgram`]: orthants, second-order and PSD cones), and
+//! the PSD cones: linear matrix inequalities
 //! `M_0 + sum_k x_k M_k >= 0` written directly as rows of `A x + s = b`,
 //! `s in PSDTriangleCone` (no modelling layer).
 //!
@@ -34,6 +35,18 @@ impl Default for SdpSettings {
 }
 
 impl SdpSettings {
+    /// Clarabel's own default tolerances and iteration limit (looser than [`Default`]).
+    pub fn clarabel_defaults() -> Self {
+        let d = DefaultSettings::<f64>::default();
+        Self {
+            tol_gap_abs: d.tol_gap_abs,
+            tol_gap_rel: d.tol_gap_rel,
+            tol_feas: d.tol_feas,
+            max_iter: d.max_iter,
+            verbose: false,
+        }
+    }
+
     /// Check that tolerances are positive and finite and `max_iter >= 1`.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in
@@ -108,8 +121,29 @@ pub(crate) struct SdpSolution {
     pub iterations: u32,
 }
 
-/// Accumulates PSD constraints `M_0 + sum_k x_k M_k >= 0`.
-pub(crate) struct LmiBuilder {
+/// The result of [`ConicProgram::solve`], whatever the status: callers decide what a status
+/// means for them (the solver status is never dropped).
+#[derive(Debug, Clone)]
+pub struct ConicOutcome {
+    /// Primal variables at termination (meaningful for `Solved` / `AlmostSolved`).
+    pub x: Vec<f64>,
+    pub status: SdpStatus,
+    pub iterations: u32,
+}
+
+impl ConicOutcome {
+    /// `Solved` or `AlmostSolved`.
+    pub fn solved(&self) -> bool {
+        matches!(self.status, SdpStatus::Solved | SdpStatus::AlmostSolved)
+    }
+}
+
+/// A linear conic program `min q^T x  s.t.  A x + s = b,  s in K` in Clarabel's form,
+/// assembled block by block: nonnegative orthants and second-order cones from dense rows
+/// (Theorem 1's set, eq. (stat1)), PSD cones from matrix pencils `M_0 + sum_k x_k M_k`
+/// (eqs. (ALI), (bet)). The only Clarabel wrapper of the workspace.
+#[derive(Debug, Clone)]
+pub struct ConicProgram {
     nvar: usize,
     /// Column-wise nonzeros (row, value) of `A`.
     cols: Vec<Vec<(usize, f64)>>,
@@ -117,12 +151,46 @@ pub(crate) struct LmiBuilder {
     cones: Vec<SupportedConeT<f64>>,
 }
 
-impl LmiBuilder {
+impl ConicProgram {
     pub fn new(nvar: usize) -> Self {
         Self { nvar, cols: vec![Vec::new(); nvar], b: Vec::new(), cones: Vec::new() }
     }
 
-    /// Add `M0 + sum_k x_k Mk[k] >= 0`; `Mk[k] = None` means variable `k` does not enter.
+    /// Number of variables.
+    pub fn nvar(&self) -> usize {
+        self.nvar
+    }
+
+    fn push_dense_rows(&mut self, rows: &[(Vec<f64>, f64)]) {
+        for (r, bi) in rows {
+            debug_assert_eq!(r.len(), self.nvar);
+            let row = self.b.len();
+            for (k, &v) in r.iter().enumerate() {
+                if v != 0.0 {
+                    self.cols[k].push((row, v));
+                }
+            }
+            self.b.push(*bi);
+        }
+    }
+
+    /// `b_i - a_i^T x >= 0` for each dense row `(a_i, b_i)`.
+    pub fn add_nonnegative(&mut self, rows: &[(Vec<f64>, f64)]) {
+        if rows.is_empty() {
+            return;
+        }
+        self.push_dense_rows(rows);
+        self.cones.push(SupportedConeT::NonnegativeConeT(rows.len()));
+    }
+
+    /// `(b_0 - a_0^T x, ..., b_k - a_k^T x)` in the second-order cone (first entry the norm
+    /// bound).
+    pub fn add_second_order(&mut self, rows: &[(Vec<f64>, f64)]) {
+        self.push_dense_rows(rows);
+        self.cones.push(SupportedConeT::SecondOrderConeT(rows.len()));
+    }
+
+    /// `M0 + sum_k x_k Mk[k] >= 0`; `Mk[k] = None` means variable `k` does not enter.
     pub fn add_psd(&mut self, M0: &DMatrix<f64>, Mk: &[Option<DMatrix<f64>>]) {
         debug_assert_eq!(Mk.len(), self.nvar);
         let d = M0.nrows();
@@ -141,8 +209,9 @@ impl LmiBuilder {
         self.cones.push(SupportedConeT::PSDTriangleConeT(d));
     }
 
-    /// `min q^T x` subject to the accumulated constraints.
-    pub fn solve(self, q: &[f64], settings: &SdpSettings, lambda: f64) -> Result<SdpSolution> {
+    /// `min q^T x` subject to the accumulated constraints. `Err` only when Clarabel rejects
+    /// the data; every termination status is returned in the outcome.
+    pub fn solve(&self, q: &[f64], settings: &SdpSettings) -> Result<ConicOutcome> {
         let m = self.b.len();
         let n = self.nvar;
         let mut colptr = Vec::with_capacity(n + 1);
@@ -150,7 +219,9 @@ impl LmiBuilder {
         let mut nzval = Vec::new();
         colptr.push(0);
         for col in &self.cols {
-            for &(r, v) in col {
+            let mut col = col.clone();
+            col.sort_by_key(|&(r, _)| r);
+            for (r, v) in col {
                 rowval.push(r);
                 nzval.push(v);
             }
@@ -162,10 +233,31 @@ impl LmiBuilder {
             .map_err(|_| LmiError::SetupRejected { rows: m, cols: n })?;
         solver.solve();
         let sol = &solver.solution;
-        let status = SdpStatus::from(sol.status);
+        Ok(ConicOutcome { x: sol.x.clone(), status: SdpStatus::from(sol.status), iterations: sol.iterations })
+    }
+}
+
+/// Accumulates PSD constraints `M_0 + sum_k x_k M_k >= 0` (a [`ConicProgram`] whose failures
+/// are mapped to the errors of eqs. (ALI), (bet)).
+pub(crate) struct LmiBuilder(ConicProgram);
+
+impl LmiBuilder {
+    pub fn new(nvar: usize) -> Self {
+        Self(ConicProgram::new(nvar))
+    }
+
+    /// Add `M0 + sum_k x_k Mk[k] >= 0`; `Mk[k] = None` means variable `k` does not enter.
+    pub fn add_psd(&mut self, M0: &DMatrix<f64>, Mk: &[Option<DMatrix<f64>>]) {
+        self.0.add_psd(M0, Mk)
+    }
+
+    /// `min q^T x` subject to the accumulated constraints.
+    pub fn solve(self, q: &[f64], settings: &SdpSettings, lambda: f64) -> Result<SdpSolution> {
+        let out = self.0.solve(q, settings)?;
+        let status = out.status;
         match status {
             SdpStatus::Solved | SdpStatus::AlmostSolved => {
-                Ok(SdpSolution { x: sol.x.clone(), status, iterations: sol.iterations })
+                Ok(SdpSolution { x: out.x, status, iterations: out.iterations })
             }
             SdpStatus::PrimalInfeasible => Err(LmiError::Infeasible { lambda, status }),
             SdpStatus::DualInfeasible => Err(LmiError::Unbounded { lambda, status }),

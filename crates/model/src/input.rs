@@ -78,6 +78,22 @@ impl Input {
         }
     }
 
+    /// The samples of a `csv` input as CSV text (`t,w1..wm`, shortest round-trip decimals),
+    /// readable by [`Input::from_csv`]; `None` for other kinds.
+    pub fn samples_csv(&self) -> Option<String> {
+        let Input::Samples { t, w, .. } = self else { return None };
+        let mut wr = csv::Writer::from_writer(Vec::new());
+        let mut header = vec!["t".to_string()];
+        header.extend((1..=self.m()).map(|j| format!("w{j}")));
+        wr.write_record(&header).ok()?;
+        for (tk, wk) in t.iter().zip(w) {
+            let mut row = vec![tk.to_string()];
+            row.extend(wk.iter().map(|v| v.to_string()));
+            wr.write_record(&row).ok()?;
+        }
+        String::from_utf8(wr.into_inner().ok()?).ok()
+    }
+
     /// `w(t)` as a new vector.
     pub fn at(&self, t: f64) -> Vec<f64> {
         let mut out = vec![0.0; self.m()];

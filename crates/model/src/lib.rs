@@ -20,4 +20,4 @@ pub use effects::Effects;
 pub use error::ModelError;
 pub use input::Input;
 pub use model_file::{load, parse_str, to_toml_string};
-pub use system::{SimDefaults, System};
+pub use system::{SimDefaults, System, SystemBuilder};

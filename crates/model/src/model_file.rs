@@ -258,7 +258,7 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
         sim.t_end = opt_f64(t, "simulation", "t_end")?;
     }
     let effects = Effects::parse(root.get("effects"), n, p)?;
-    System::new(name, A, B, C, E, theta, input, x0, z0, sim, effects)
+    System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)
 }
 
 fn shape_table(s: &Shape) -> Option<Table> {

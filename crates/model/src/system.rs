@@ -21,8 +21,30 @@ impl Default for SimDefaults {
 }
 
 /// `x' = A x + B w + E z`, `y = C x`, `z in y + Theta` (eqs. (xy), (yz)) with input, initial
-/// state and simulation defaults. Construct through [`System::new`] (or a model file), which
-/// validates everything.
+/// state and simulation defaults. Construct through [`System::builder`] (named fields, so `B`
+/// and `E` cannot be swapped silently) or a model file ([`crate::load`]); both validate
+/// everything.
+///
+/// ```
+/// use geometry::{Interval, Shape};
+/// use model::{Input, System};
+/// use nalgebra::dmatrix;
+///
+/// let sys = System::builder()
+///     .A(dmatrix![0.0, 1.0; -2.0, -0.6])
+///     .B(dmatrix![0.0; 1.0])
+///     .C(dmatrix![1.0, 0.0])
+///     .E(dmatrix![0.0; 1.0])
+///     .theta(Shape::Interval(Interval::symmetric(0.1).unwrap()))
+///     .input(Input::Sine { amplitudes: vec![1.0], omega: 1.0, phase: 0.0 })
+///     .build()
+///     .unwrap();
+/// assert_eq!((sys.n(), sys.m(), sys.p()), (2, 1, 1));
+/// // F = A + E C, eq. (F): mu = -0.3
+/// assert!((sys.mu() + 0.3).abs() < 1e-12);
+/// // a missing matrix is an error naming it, never a panic
+/// assert!(System::builder().A(dmatrix![-1.0]).build().is_err());
+/// ```
 #[derive(Debug, Clone)]
 pub struct System {
     pub name: String,
@@ -43,11 +65,104 @@ fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
     ModelError::Dimension { key: key.into(), expected, got: format!("{}x{}", got.nrows(), got.ncols()) }
 }
 
+/// Named-field construction of a [`System`]; see [`System::builder`]. Required: `A`, `B`, `C`,
+/// `E`. Defaults: name `""`, `Theta = {0}` (the linear system), input zero, `x0 = 0`,
+/// `z0 = C x0`, [`SimDefaults::default`], no effects.
+#[derive(Debug, Clone, Default)]
+pub struct SystemBuilder {
+    name: String,
+    A: Option<DMatrix<f64>>,
+    B: Option<DMatrix<f64>>,
+    C: Option<DMatrix<f64>>,
+    E: Option<DMatrix<f64>>,
+    theta: Option<Shape>,
+    input: Option<Input>,
+    x0: Option<DVector<f64>>,
+    z0: Option<DVector<f64>>,
+    sim: SimDefaults,
+    effects: Effects,
+}
+
+impl SystemBuilder {
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.name = name.into();
+        self
+    }
+    /// Plant matrix `A` (`n x n`).
+    pub fn A(mut self, A: DMatrix<f64>) -> Self {
+        self.A = Some(A);
+        self
+    }
+    /// Input matrix `B` (`n x m`).
+    pub fn B(mut self, B: DMatrix<f64>) -> Self {
+        self.B = Some(B);
+        self
+    }
+    /// Output matrix `C` (`p x n`).
+    pub fn C(mut self, C: DMatrix<f64>) -> Self {
+        self.C = Some(C);
+        self
+    }
+    /// Backlash feedback matrix `E` (`n x p`).
+    pub fn E(mut self, E: DMatrix<f64>) -> Self {
+        self.E = Some(E);
+        self
+    }
+    /// The backlash set `Theta` (eq. (yz)).
+    pub fn theta(mut self, theta: Shape) -> Self {
+        self.theta = Some(theta);
+        self
+    }
+    pub fn input(mut self, input: Input) -> Self {
+        self.input = Some(input);
+        self
+    }
+    pub fn x0(mut self, x0: DVector<f64>) -> Self {
+        self.x0 = Some(x0);
+        self
+    }
+    pub fn z0(mut self, z0: DVector<f64>) -> Self {
+        self.z0 = Some(z0);
+        self
+    }
+    pub fn sim(mut self, sim: SimDefaults) -> Self {
+        self.sim = sim;
+        self
+    }
+    pub fn effects(mut self, effects: Effects) -> Self {
+        self.effects = effects;
+        self
+    }
+    /// Validates (see [`System`]) and builds.
+    pub fn build(self) -> Result<System, ModelError> {
+        let missing = |key: &str| ModelError::Missing { key: format!("plant.{key}") };
+        let A = self.A.ok_or_else(|| missing("A"))?;
+        let B = self.B.ok_or_else(|| missing("B"))?;
+        let C = self.C.ok_or_else(|| missing("C"))?;
+        let E = self.E.ok_or_else(|| missing("E"))?;
+        let (n, m, p) = (A.nrows(), B.ncols(), C.nrows());
+        let theta = self.theta.unwrap_or_else(|| Shape::origin(p));
+        let input = self.input.unwrap_or(Input::Zero { m });
+        let x0 = self.x0.unwrap_or_else(|| DVector::zeros(n));
+        let z0 = match self.z0 {
+            Some(z0) => z0,
+            None if C.ncols() == x0.len() => &C * &x0,
+            None => DVector::zeros(p),
+        };
+        System::validated(self.name, A, B, C, E, theta, input, x0, z0, self.sim, self.effects)
+    }
+}
+
 impl System {
+    /// Named-field construction ([`SystemBuilder`]).
+    pub fn builder() -> SystemBuilder {
+        SystemBuilder::default()
+    }
+
     /// Builds and validates: dimensions of `A (n x n), B (n x m), C (p x n), E (n x p)`,
     /// `Theta` in R^p containing 0, `x0 in R^n`, `z0 - C x0 in Theta` (to `1e-9` relative),
     /// finiteness, `m` of the input equal to the columns of `B`.
-    pub fn new(
+    pub(crate) fn validated(
         name: impl Into<String>,
         A: DMatrix<f64>,
         B: DMatrix<f64>,

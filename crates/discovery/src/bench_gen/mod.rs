@@ -19,7 +19,7 @@ pub mod plant_sim;
 
 use crate::recording::Recording;
 use model::effects::{Effect, PlayLocation};
-use model::{Effects, Input, SimDefaults, System};
+use model::{Input, SimDefaults, System};
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -278,20 +278,19 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
     };
     let x0v = DVector::from_column_slice(&x0);
     let z0 = &plant.C * &x0v;
-    let nominal = System::new(
-        format!("bench {class} #{index} (n = {n})"),
-        plant.A.clone(),
-        plant.B.clone(),
-        plant.C.clone(),
-        plant.E.clone(),
-        theta,
-        Input::Sine { amplitudes: vec![1.0], omega: plant.omega0, phase: 0.0 },
-        x0v,
-        z0,
-        SimDefaults { dt, periods: 20, t_end: Some(duration) },
-        Effects::default(),
-    )
-    .expect("generated plant is valid");
+    let nominal = System::builder()
+        .name(format!("bench {class} #{index} (n = {n})"))
+        .A(plant.A.clone())
+        .B(plant.B.clone())
+        .C(plant.C.clone())
+        .E(plant.E.clone())
+        .theta(theta)
+        .input(Input::Sine { amplitudes: vec![1.0], omega: plant.omega0, phase: 0.0 })
+        .x0(x0v)
+        .z0(z0)
+        .sim(SimDefaults { dt, periods: 20, t_end: Some(duration) })
+        .build()
+        .expect("generated plant is valid");
     let recording = Recording::from_samples(
         &format!("bench-{class}-{index}"),
         &t,

@@ -292,20 +292,18 @@ pub fn theta_table(set: &geometry::Shape) -> Option<toml::Value> {
     use geometry::ConvexSet;
     use nalgebra::{DMatrix, DVector};
     let p = set.dim();
-    let sys = model::System::new(
-        "carrier",
-        -DMatrix::identity(p, p),
-        DMatrix::zeros(p, 1),
-        DMatrix::identity(p, p),
-        DMatrix::zeros(p, p),
-        set.clone(),
-        model::Input::Zero { m: 1 },
-        DVector::zeros(p),
-        DVector::zeros(p),
-        model::SimDefaults::default(),
-        model::Effects::default(),
-    )
-    .ok()?;
+    let sys = model::System::builder()
+        .name("carrier")
+        .A(-DMatrix::identity(p, p))
+        .B(DMatrix::zeros(p, 1))
+        .C(DMatrix::identity(p, p))
+        .E(DMatrix::zeros(p, p))
+        .theta(set.clone())
+        .input(model::Input::Zero { m: 1 })
+        .x0(DVector::zeros(p))
+        .z0(DVector::zeros(p))
+        .build()
+        .ok()?;
     let t: toml::Table = toml::from_str(&model::to_toml_string(&sys)).ok()?;
     t.get("theta").cloned()
 }

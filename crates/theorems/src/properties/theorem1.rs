@@ -2,7 +2,7 @@
 //! see the typo note) is nonsingular on `[0, T]`, the set of `T`-stationary initial conditions
 //! is `R(T) = cap_t Phi(t)^{-1}(C x_*(t) + Theta)`, `x_*` the feedback-free solution (eq. (xz0)).
 //!
-//! Computation (independent of `driver::stationary`, which this crate cannot depend on):
+//! Computation (deliberately independent of `bounds::stationary`, so the two cross-check):
 //! on the grid `t_k = k h`, `h = T/N`, `phi_k = 1 - C (t_k Psi(t_k A)) E` from
 //! `dynamics::linear::expm::t_psi`, `c_k = C x_*(t_k)` with `x_*` exact for sine inputs (one
 //! augmented exponential of `[[A, B a, 0], [0, 0, omega], [0, -omega, 0]]`). For `p = 1` each

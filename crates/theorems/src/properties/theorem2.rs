@@ -5,20 +5,21 @@
 //!
 //! Computation: `eta_T` from `dynamics::periodic::linearised_periodic` (exact for sines, eq.
 //! (xT) with its typo corrected); `osc` = largest distance between 1000 samples;
-//! `||eta_T'||_inf` = sampled maximum; `d` and `D(...)` as certified upper bounds by
-//! `geometry::sphere_max` of support functions, `sigma_{Xi_inf}` by the trapezoid rule (step `0.05`)
-//! ([`super::simulation::XiNodes`]). The closed loop is simulated by catching-up
+//! `||eta_T'||_inf` = sampled maximum; `d` and `D(...)` as certified upper bounds by the
+//! production code of `moreau theta`, `bounds::tube::tube_diameters` (certified quadrature of
+//! `sigma_{C Xi_inf}`, `sigma_{C F Xi_inf}`, sphere maxima of sublinear functions). The closed loop is simulated by catching-up
 //! (`h = min(T/500, 0.01)`) for a transient of `max(15/|mu|, 2T)` rounded up to whole periods (mu in `[-2, -1]`),
 //! then 3 periods are measured: path length per period `sum |Dz|` (minimum over the periods)
 //! and speed `max |Dz|/h`.
 //! Tolerance (discretisation, first-order scheme): `2%` of the right-hand side.
 //! Negative controls: (path) `d` replaced by `0` (the tube ignored); (zinf) the bound halved.
 use super::sets_prelude::*;
-use super::simulation::{op_norm, simulate, XiNodes};
+use super::simulation::simulate;
 use crate::strategies::inputs::InputStrategyConfig;
 use crate::strategies::systems::{system_params, SystemParams, SystemStrategyConfig};
+use bounds::tube::{tube_diameters, TubeSettings};
 use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
-use geometry::{sphere_max, SphereMaxSettings};
+use geometry::SphereMaxSettings;
 
 /// Steps per period of the catching-up scheme (capped by [`MAX_DT`]).
 pub const STEPS_PER_PERIOD: usize = 500;
@@ -26,8 +27,9 @@ pub const STEPS_PER_PERIOD: usize = 500;
 pub const MAX_DT: f64 = 1e-2;
 /// Transient: `TRANSIENT_DECAYS / |mu|` (at least `2 T`), rounded up to whole periods.
 pub const TRANSIENT_DECAYS: f64 = 15.0;
-/// Quadrature step of `sigma_{Xi_inf}`.
-pub const XI_DS: f64 = 5e-2;
+/// Tolerance of the tube quadrature relative to `D(Theta, {0})` (the enclosures stay rigorous;
+/// only their width depends on it).
+pub const TUBE_TOL_REL: f64 = 1e-4;
 
 /// Backlash sets of the default campaign: the strongly convex kinds whose projection is cheap
 /// (ball intersections cost ~50x more per projection in `geometry`; they are covered by
@@ -107,38 +109,13 @@ pub fn measure(sys: &model::System) -> Option<Measured> {
     let lin = linearised_periodic(sys, &LinearisedSettings { samples: 1000, substeps: 8 }).ok()?;
     let osc = lin.osc_lower();
     let deta_inf = lin.deta_inf_sampled();
-    let p = sys.p();
-    let xi = XiNodes::new(sys, XI_DS, 200.0);
+    // d and D(...) by the production kernels of `bounds` (the numbers `moreau theta` prints),
+    // at a tolerance matched to the 2 % allowance of the check.
     let d_theta = sys.theta.deviation_from_origin().upper;
-    let d_xi = d_theta * op_norm(&sys.E) * xi.int_norm; // >= D(Xi_inf, {0}), eq. (DXX)
-    let Ct = sys.C.transpose();
-    let st = SphereMaxSettings { tol_abs: 1e-9, tol_rel: 1e-2, max_evals: 400 };
-    let cn = op_norm(&sys.C);
-    let xi_c = xi.mapped(&Ct);
-    let sig_cxi = |u: &[f64]| xi_c.support(&sys.theta, u);
-    let d_upper = sphere_max(
-        p,
-        |u| {
-            let m: Vec<f64> = u.iter().map(|x| -x).collect();
-            sig_cxi(u) + sig_cxi(&m) + sys.theta.support(u) + sys.theta.support(&m)
-        },
-        2.0 * (cn * d_xi + d_theta),
-        &st,
-    )
-    .upper;
-    let FtCt = sys.F().transpose() * &Ct;
-    let EtCt = sys.E.transpose() * &Ct;
-    let xi_f = xi.mapped(&FtCt);
-    let D_upper = sphere_max(
-        p,
-        |u| {
-            let v = nalgebra::DVector::from_column_slice(u);
-            xi_f.support(&sys.theta, u) + sys.theta.support((&EtCt * &v).as_slice())
-        },
-        op_norm(&FtCt) * d_xi + op_norm(&EtCt) * d_theta,
-        &st,
-    )
-    .upper;
+    let tube = TubeSettings { tol_abs: TUBE_TOL_REL * d_theta.max(f64::MIN_POSITIVE), ..TubeSettings::default() };
+    let st = SphereMaxSettings { tol_abs: 1e-9, tol_rel: 1e-3, max_evals: 2_000 };
+    let diam = tube_diameters(&sys.C, &sys.F(), &sys.E, &sys.theta, &tube, &st).ok()?;
+    let (d_upper, D_upper) = (diam.d.upper, diam.d_ftheta.upper);
     let dt = (T / STEPS_PER_PERIOD as f64).min(MAX_DT);
     let spp = (T / dt).round().max(1.0) as usize;
     let dt = T / spp as f64;

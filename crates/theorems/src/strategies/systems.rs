@@ -8,7 +8,7 @@
 use super::inputs::{periodic_input, InputParams, InputStrategyConfig, MAX_M};
 use super::sets::{point_params, set_params, PointParams, SetKind, SetParams, SetStrategyConfig, MAX_P};
 use geometry::{Ball, ConvexSet, Shape};
-use model::{Effects, SimDefaults, System};
+use model::{SimDefaults, System};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 
@@ -130,7 +130,18 @@ impl SystemParams {
             t => t,
         };
         debug_assert_eq!(theta.dim(), p);
-        System::new("random system (theorems strategy)", A, B, C, E, theta, input, x0, z0, sim, Effects::default())
+        System::builder()
+            .name("random system (theorems strategy)")
+            .A(A)
+            .B(B)
+            .C(C)
+            .E(E)
+            .theta(theta)
+            .input(input)
+            .x0(x0)
+            .z0(z0)
+            .sim(sim)
+            .build()
             .expect("the strategy builds valid systems")
     }
 }

@@ -1,0 +1,272 @@
+//! Labelled quantities: every number of the theta report carries its symbol, the equation
+//! label of `strongly-convex-backlash.tex`, the direction in which it bounds the true value,
+//! and whether that bound is verified. Each is declared once ([`defs`]); the text table
+//! ([`render_table`]), the JSON keys (`ThetaReport::to_json`) and the sweep columns of
+//! `moreau sweep` derive from the declarations.
+
+/// How a reported number relates to the true quantity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundKind {
+    /// Exact up to floating-point rounding.
+    Exact,
+    /// An upper bound of the true value.
+    Upper,
+    /// A lower bound of the true value.
+    Lower,
+    /// Measured or sampled: no bound claimed.
+    Estimate,
+}
+
+impl BoundKind {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            BoundKind::Exact => "exact",
+            BoundKind::Upper => "upper bound",
+            BoundKind::Lower => "lower bound",
+            BoundKind::Estimate => "estimate",
+        }
+    }
+}
+
+/// The declaration of one reported quantity: everything about it that does not depend on
+/// the system. Declared once in [`defs`]; the text table, the `--json` keys and the sweep
+/// columns are all derived from these declarations.
+#[derive(Debug, PartialEq)]
+pub struct QuantityDef {
+    /// Stable snake_case key: the JSON key of the value and the sweep column name.
+    pub key: &'static str,
+    /// The paper's symbol in ASCII (text tables).
+    pub symbol: &'static str,
+    /// The same symbol in LaTeX (sweep tables and figures).
+    pub tex: &'static str,
+    /// Equation label(s) in the paper.
+    pub label: &'static str,
+    /// The direction in which the reported number bounds the true value.
+    pub kind: BoundKind,
+    /// How it is obtained (short; a report may replace it with a more specific note).
+    pub how: &'static str,
+}
+
+impl QuantityDef {
+    /// This quantity with a value and a verified flag computed by the caller.
+    pub fn with(&'static self, value: f64, verified: bool) -> Quantity {
+        Quantity {
+            key: self.key,
+            symbol: self.symbol,
+            label: self.label,
+            value,
+            kind: self.kind,
+            verified,
+            note: self.how.to_string(),
+        }
+    }
+}
+
+/// Every quantity of the theta report, in report order (module constants, one per quantity).
+pub mod defs {
+    use super::BoundKind::{self, *};
+    use super::QuantityDef;
+
+    const fn q(
+        key: &'static str,
+        symbol: &'static str,
+        tex: &'static str,
+        label: &'static str,
+        kind: BoundKind,
+        how: &'static str,
+    ) -> QuantityDef {
+        QuantityDef { key, symbol, tex, label, kind, how }
+    }
+
+    pub const PERIOD: QuantityDef = q("period", "T", "$T$", "(xT)", Exact, "period of the input");
+    pub const MU: QuantityDef = q("mu", "mu", "$\\mu$", "(stab)", Estimate, "max Re eig(F), F = A + E C (Schur form)");
+    pub const R: QuantityDef = q("r", "R", "$R$", "(R)", Upper, "strong convexity constant of Theta");
+    pub const ALPHA: QuantityDef =
+        q("alpha", "alpha", "$\\alpha$", "(alpha)", Lower, "lambda_min(S(C E)), Rump's test");
+    pub const LAMBDA: QuantityDef =
+        q("lambda", "lambda", "$\\lambda$", "(lammu),(ALI)", Lower, "verified decay rate of the certificate");
+    pub const BETA: QuantityDef =
+        q("beta", "beta", "$\\beta$", "(bet)", Upper, "b_hat >= lambda_max(H^T Pi^-1 H), SDP + verification");
+    pub const OSC: QuantityDef = q("osc", "osc", "$\\mathrm{osc}$", "(mho),(osc)", Lower, "diameter of eta_T");
+    pub const D: QuantityDef =
+        q("d", "d", "$d$", "(d),(Xinfsupp)", Upper, "tube quadrature + tail (DXX), certified sphere max");
+    pub const ETA_DOT_INF: QuantityDef = q(
+        "eta_dot_inf",
+        "||eta_T'||_inf",
+        "$\\|\\dot\\eta_T\\|_\\infty$",
+        "(zinf)",
+        Upper,
+        "max speed of the linearised orbit",
+    );
+    pub const D_FTHETA: QuantityDef =
+        q("d_ftheta", "D(C(F Xi_inf + E Theta),{0})", "$D$", "(zinf)", Upper, "tube quadrature + certified sphere max");
+    pub const ZDOT_BOUND: QuantityDef =
+        q("zdot_bound", "limsup |z'| <=", "$\\limsup|\\dot z|$", "(zinf)", Upper, "||eta_T'||_inf + D(...)");
+    pub const GAMMA_1: QuantityDef =
+        q("gamma_1", "gamma_1", "$\\gamma_1$", "(g1)", Lower, "(osc - d)_+ / (T R), R upper");
+    pub const GAMMA_INF: QuantityDef = q(
+        "gamma_inf",
+        "gamma_inf",
+        "$\\gamma_\\infty$",
+        "(ginf)",
+        Upper,
+        "(||eta_T'|| + D(...)) / R at R upper (safe for theta)",
+    );
+    pub const KAPPA: QuantityDef = q(
+        "kappa",
+        "gamma_1/gamma_inf",
+        "$\\gamma_1/\\gamma_\\infty$",
+        "(theta)",
+        Lower,
+        "weight of psi(gamma_inf) in theta (independent of R)",
+    );
+    pub const PSI_0: QuantityDef =
+        q("psi_0", "psi(0)", "$\\psi(0)$", "(psilim)", Upper, "at (alpha, lambda) lower, beta upper");
+    pub const PSI_INF: QuantityDef =
+        q("psi_inf", "psi(gamma_inf)", "$\\psi(\\gamma_\\infty)$", "(phipsi)", Upper, "at gamma_inf (R upper)");
+    pub const PSI_LIMIT: QuantityDef =
+        q("psi_limit", "-lambda", "$-\\lambda$", "(psilim)", Exact, "limit of psi at infinity");
+    pub const THETA: QuantityDef =
+        q("theta", "theta", "$\\theta$", "(theta)", Upper, "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))");
+    pub const PATH_BOUND: QuantityDef =
+        q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");
+    pub const PATH1_BOUND: QuantityDef =
+        q("path1_bound", "sup_partitions", "(path1)", "(path1)", Lower, "dynamic programming over a grid");
+    pub const PATH2_BOUND: QuantityDef =
+        q("path2_bound", "sup_eps (2eps-d)N_eps", "(path2)", "(path2)", Lower, "greedy packing");
+    pub const PHI_FIRST_SINGULAR: QuantityDef = q(
+        "phi_first_singular",
+        "first t with Phi(t) singular",
+        "$t_\\Phi$",
+        "(Phi)",
+        Estimate,
+        "scan of sigma_min(Phi) on [0, T]",
+    );
+    pub const STATIONARY_SLACK: QuantityDef = q(
+        "stationary_slack",
+        "R(T) slack s*",
+        "$s^*$",
+        "(stat1)",
+        Lower,
+        "grid relaxation of (stat1): bounds the continuous slack from below",
+    );
+    pub const MEASURED_RATE: QuantityDef =
+        q("measured_rate", "measured exponent", "measured", "(VV)", Estimate, "pairs of simulated trajectories");
+    pub const PATH_MEASURED: QuantityDef =
+        q("path_measured", "measured path/period", "path", "(path)", Estimate, "min over periods after the transient");
+    pub const ZDOT_MEASURED: QuantityDef = q(
+        "zdot_measured",
+        "measured limsup |z'|",
+        "$|\\dot z|_{\\max}$",
+        "(zinf)",
+        Estimate,
+        "max over periods after the transient",
+    );
+
+    /// All of them, in report order.
+    pub const ALL: [&QuantityDef; 26] = [
+        &PERIOD,
+        &MU,
+        &R,
+        &ALPHA,
+        &LAMBDA,
+        &BETA,
+        &OSC,
+        &D,
+        &ETA_DOT_INF,
+        &D_FTHETA,
+        &ZDOT_BOUND,
+        &GAMMA_1,
+        &GAMMA_INF,
+        &KAPPA,
+        &PSI_0,
+        &PSI_INF,
+        &PSI_LIMIT,
+        &THETA,
+        &PATH_BOUND,
+        &PATH1_BOUND,
+        &PATH2_BOUND,
+        &PHI_FIRST_SINGULAR,
+        &STATIONARY_SLACK,
+        &MEASURED_RATE,
+        &PATH_MEASURED,
+        &ZDOT_MEASURED,
+    ];
+
+    /// The declaration with this key.
+    pub fn by_key(key: &str) -> Option<&'static QuantityDef> {
+        ALL.iter().copied().find(|d| d.key == key)
+    }
+}
+
+/// One labelled number: a [`QuantityDef`] with its value for one system.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub struct Quantity {
+    /// Stable snake_case key (also the JSON key of the value).
+    pub key: &'static str,
+    /// The paper's symbol in ASCII.
+    pub symbol: &'static str,
+    /// Equation label(s) in the paper.
+    pub label: &'static str,
+    pub value: f64,
+    pub kind: BoundKind,
+    /// True when the bound in `kind` is proven (up to floating-point rounding of closed forms).
+    pub verified: bool,
+    /// How it was obtained (short).
+    pub note: String,
+}
+
+impl Quantity {
+    /// Replaces the default note of the declaration.
+    pub fn note(mut self, note: impl Into<String>) -> Self {
+        self.note = note.into();
+        self
+    }
+    /// Replaces the declared kind (e.g. a lower bound that could not be proven is an estimate).
+    pub fn kind(mut self, kind: BoundKind) -> Self {
+        self.kind = kind;
+        self
+    }
+}
+
+/// Formats `v` compactly for the readable report.
+pub fn fmt_value(v: f64) -> String {
+    if v.is_nan() {
+        "n/a".into()
+    } else if v.is_infinite() {
+        if v > 0.0 {
+            "inf".into()
+        } else {
+            "-inf".into()
+        }
+    } else if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e5) {
+        format!("{v:.6}")
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+/// A plain-text table: symbol, label, value, kind, verified.
+pub fn render_table(rows: &[Quantity]) -> String {
+    let mut s = String::new();
+    let w_sym = rows.iter().map(|q| q.symbol.len()).max().unwrap_or(6).max(6);
+    let w_lab = rows.iter().map(|q| q.label.len()).max().unwrap_or(5).max(5);
+    s.push_str(&format!(
+        "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
+        "symbol", "eq.", "value", "kind", "verified", "how"
+    ));
+    for q in rows {
+        s.push_str(&format!(
+            "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
+            q.symbol,
+            q.label,
+            fmt_value(q.value),
+            q.kind.as_str(),
+            if q.verified { "yes" } else { "no" },
+            q.note
+        ));
+    }
+    s
+}

@@ -1,0 +1,516 @@
+//! Assembly of `theta`, eq. (theta), and of every quantity of Theorems 1 and 2 and Section 6
+//! for one model, each labelled with its equation and flagged as a verified bound or an
+//! estimate ([`crate::report::Quantity`]).
+//!
+//! Safe directions (NOTES.md): `d`, `||eta_T'||_inf`, `D(C(F Xi_inf + E Theta), {0})` from
+//! above (tube quadrature with rigorous remainders, maxima over the unit sphere of
+//! sublinear functions certified by conic combination on arcs, `crate::tube::sublinear_max`,
+//! or by `geometry::sphere_max` with a valid Lipschitz constant for `p >= 3`); `osc` from below; `alpha`, `lambda`
+//! from below and `beta` from above (`lmi` certificate); `R` from above. `theta` is increasing
+//! in `R` (the ratio `gamma_1 / gamma_inf` does not depend on `R` and `psi(gamma_inf / R)`
+//! increases with `R`), so both `gamma`s are evaluated at the upper bound of `R`: `gamma_inf` is
+//! then not itself an upper bound of the true `gamma_inf`, but `theta` is one of the true `theta`.
+//! `theta` is verified only if every part is.
+use crate::error::BoundsError;
+use crate::orbit::{packing_bound, partition_bound, path_bound, EtaOrbit, OrbitSettings, PackingBound};
+use crate::report::{BoundKind, Quantity};
+use crate::stationary::{rest_set, RestSet, RestSetSettings};
+use crate::theta::alpha::{alpha, Alpha};
+use crate::theta::psi::Psi;
+use crate::tube::{tube_diameters, TubeKernel, TubeSettings};
+use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
+use geometry::{ConvexSet, Shape, SphereMaxSettings};
+use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
+use model::System;
+use nalgebra::DMatrix;
+use std::sync::Arc;
+
+/// Settings of [`assemble`]. All parts have documented defaults; `measure = None` and
+/// `stationary = None` skip the two costly optional parts (for sweeps).
+#[derive(Debug, Clone)]
+pub struct ThetaSettings {
+    /// Tube quadrature (eqs. (Xinfsupp), (DXX)). Default [`TubeSettings::default`].
+    pub tube: TubeSettings,
+    /// Maxima over the unit sphere (eqs. (d), (zinf)) of sublinear functions
+    /// ([`crate::tube::sublinear_sphere_max`]). Default: `tol_abs 1e-9`, `tol_rel 1e-6`,
+    /// `max_evals 20_000` (the bounds stay valid, only wider, when the budget runs out).
+    pub sphere: SphereMaxSettings,
+    /// Outer search over `lambda` and the beta SDPs. Default [`LambdaSearchSettings::default`].
+    pub lambda: LambdaSearchSettings,
+    /// Orbit samples. Default [`OrbitSettings::default`] (2000 intervals).
+    pub orbit: OrbitSettings,
+    /// Grid points of the (path1) dynamic programme (`O(K^2)`). Default `600`.
+    pub path1_points: usize,
+    /// Number of `eps` values of the (path2) packing search. Default `64`.
+    pub packing_eps: usize,
+    /// Stationary set of Theorem 1; `None` skips it. Default `Some(RestSetSettings::default())`.
+    pub stationary: Option<RestSetSettings>,
+    /// Measured side (pairs of simulated trajectories); `None` skips it. Default:
+    /// `dt = 1e-3`, 40 periods, 10 transient, 2 pairs.
+    pub measure: Option<RateSettings>,
+}
+
+impl Default for ThetaSettings {
+    fn default() -> Self {
+        Self {
+            tube: TubeSettings::default(),
+            sphere: SphereMaxSettings { tol_abs: 1e-9, tol_rel: 1e-6, max_evals: 20_000 },
+            lambda: LambdaSearchSettings::default(),
+            orbit: OrbitSettings::default(),
+            path1_points: 600,
+            packing_eps: 64,
+            stationary: Some(RestSetSettings::default()),
+            measure: Some(RateSettings { periods: 40, transient_periods: 10, pairs: 2, ..Default::default() }),
+        }
+    }
+}
+
+impl ThetaSettings {
+    /// Cheap settings for sweeps: no measurement, no stationary set.
+    pub fn bound_only() -> Self {
+        Self { stationary: None, measure: None, ..Default::default() }
+    }
+}
+
+/// The measured side: exponent of pairs of trajectories and the backlash motion.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub struct MeasuredSide {
+    /// Largest measured exponent over the pairs (`(1/2) slope of ln V`).
+    pub rate: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+    /// Min over periods after the transient of the path length of `z` per period.
+    pub path_length_per_period: f64,
+    /// Max over periods after the transient of `|z'|`.
+    pub limsup_zdot: f64,
+    pub periods: usize,
+    pub transient_periods: usize,
+    pub h: f64,
+}
+
+/// Every quantity of the theta computation for one model.
+#[derive(Debug, Clone, serde::Serialize)]
+#[non_exhaustive]
+pub struct ThetaReport {
+    pub name: String,
+    pub n: usize,
+    pub m: usize,
+    pub p: usize,
+    /// Period `T` of the input.
+    pub period: f64,
+    /// `mu = max Re eig(F)`, eq. (stab).
+    pub mu: f64,
+    /// Upper bound of `R`, eq. (R) (`inf` for polytopes).
+    pub R: f64,
+    pub R_verified: bool,
+    /// `0 in Theta`, eq. (0inZ) (assumed by Theorem 2).
+    pub zero_in_theta: bool,
+    pub alpha: Alpha,
+    /// Verified `lambda` and `b_hat >= beta` at the optimum of eq. (theta) over `lambda`.
+    pub lambda: f64,
+    pub beta: f64,
+    pub beta_sdp: f64,
+    pub certificate_verified: bool,
+    /// The certified `Pi` (rows).
+    pub Pi: Vec<Vec<f64>>,
+    pub osc: f64,
+    /// `osc` from the samples (cross-check of the closed form).
+    pub osc_sampled: f64,
+    pub orbit_verified: bool,
+    pub orbit_method: String,
+    /// `d = diam(C Xi_inf + Theta)`, eq. (d): upper bound; `d_lower` is indicative only (best
+    /// sampled value of the upper function minus the quadrature remainders), not a bound.
+    pub d: f64,
+    pub d_lower: f64,
+    pub eta_dot_inf: f64,
+    /// `D(C(F Xi_inf + E Theta), {0})`, eq. (zinf): upper bound; `d_ftheta_lower` indicative only.
+    pub d_ftheta: f64,
+    pub d_ftheta_lower: f64,
+    /// Both tube diameters `d`, `D(...)` are proven upper bounds (computed by
+    /// [`crate::tube::tube_diameters`]).
+    pub d_verified: bool,
+    /// Right-hand side of (zinf): `||eta_T'||_inf + D(...)`.
+    pub zdot_bound: f64,
+    pub gamma_1: f64,
+    pub gamma_inf: f64,
+    /// `kappa = gamma_1 / gamma_inf`.
+    pub kappa: f64,
+    pub psi_0: f64,
+    pub psi_inf: f64,
+    pub theta: f64,
+    pub theta_verified: bool,
+    /// Kinds of the model's `[[effects]]`: physics outside the paper's class (theta is then
+    /// computed for the nominal model and is not verified for the model).
+    pub effects: Vec<String>,
+    /// `theta < 0` and verified: a unique periodic regime attracting at rate `theta`.
+    pub convergence_guaranteed: bool,
+    pub path_bound: f64,
+    pub path1_bound: f64,
+    /// Number of grid points of the (path1) dynamic programme.
+    pub path1_grid: usize,
+    pub path2: PackingBound,
+    /// Certified curve `(lambda, beta, theta)` of the lambda search.
+    pub curve: Vec<(f64, f64, f64)>,
+    pub stationary: Option<RestSet>,
+    pub measured: Option<MeasuredSide>,
+    /// Tube quadrature diagnostics: cells, truncation point, tail bound (DXX).
+    pub tube_cells: usize,
+    pub tube_s_max: f64,
+    pub tube_tail: f64,
+    pub notes: Vec<String>,
+    #[serde(skip)]
+    tube_C: Arc<TubeKernel>,
+    #[serde(skip)]
+    theta_set: Shape,
+    #[serde(skip)]
+    orbit: Arc<EtaOrbit>,
+}
+
+/// Computes `theta` and all its parts for `sys`; see the module docs.
+///
+/// Errors (no answer exists): no period ([`BoundsError::NoPeriod`]), `F` not Hurwitz
+/// ([`BoundsError::NotHurwitz`]), no certified `lambda` ([`BoundsError::Lmi`]), tube
+/// quadrature budget. Everything else (singular `Phi`, infinite `R`, unverifiable parts) is
+/// reported in the result.
+pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, BoundsError> {
+    let T = sys.period().ok_or(BoundsError::NoPeriod { kind: sys.input.kind() })?;
+    let F = sys.F();
+    let (C, E) = (&sys.C, &sys.E);
+    let p = sys.p();
+    let mu = match lmi::hurwitz_mu(&F) {
+        Ok(mu) => mu,
+        Err(LmiError::NotHurwitz { mu }) => return Err(BoundsError::NotHurwitz { mu }),
+        Err(e) => return Err(BoundsError::Lmi(e)),
+    };
+    let mut notes = Vec::new();
+    let theta_set = sys.theta.clone();
+    let zero_in_theta = theta_set.contains(&vec![0.0; p], 0.0);
+    if !zero_in_theta {
+        notes.push("0 is not in Theta: assumption (0inZ) of Theorem 2 fails, theta is not a verified bound".into());
+    }
+    let sc = theta_set.strong_convexity();
+    let R = sc.upper();
+    // R = inf is trivially a valid upper bound (polytopes: gamma = 0).
+    let R_verified = sc.is_verified_upper() || R == f64::INFINITY;
+
+    // Tubes C Xi_inf and C F Xi_inf and their diameters (eqs. (d), (zinf)).
+    let diam = tube_diameters(C, &F, E, &theta_set, &settings.tube, &settings.sphere)?;
+    let (d, d_lower) = (diam.d.upper, diam.d.lower);
+    let (d_ftheta, d_ftheta_lower) = (diam.d_ftheta.upper, diam.d_ftheta.lower);
+    let d_ok = diam.verified;
+    let tube_C = diam.tube_C;
+
+    // Orbit eta_T.
+    let orbit = EtaOrbit::new(sys, &settings.orbit)?;
+    let osc = orbit.osc;
+    let osc_sampled = orbit.osc_sampled();
+    let eta_dot_inf = orbit.eta_dot_inf;
+    let zdot_bound = eta_dot_inf + d_ftheta;
+
+    // gamma_1, gamma_inf, eqs. (g1), (ginf), at the upper bound of R.
+    let strongly_convex = R.is_finite() && R > 0.0;
+    let (gamma_1, gamma_inf) =
+        if strongly_convex { ((osc - d).max(0.0) / (T * R), zdot_bound / R) } else { (0.0, 0.0) };
+    if !strongly_convex {
+        notes.push(format!(
+            "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0), and convergence is guaranteed only if psi(0) < 0, i.e. alpha > beta / lambda"
+        ));
+    }
+    let kappa = if gamma_inf > 0.0 { (gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
+
+    // alpha, eq. (alpha), and the lambda search (eqs. (ALI), (bet), (theta)).
+    let al = alpha(C, E);
+    let a_low = al.lower;
+    let search = optimise_lambda(
+        &F,
+        E,
+        C,
+        |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf),
+        &settings.lambda,
+    )?;
+    let opt = &search.optimum;
+    let psi = Psi { alpha: a_low, lambda: opt.value.lambda, beta: opt.value.beta };
+    let psi_0 = psi.at_zero();
+    let psi_inf = psi.eval(gamma_inf);
+    let theta = psi.theta(gamma_1, gamma_inf);
+    let curve: Vec<(f64, f64, f64)> =
+        search.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta, v.theta))).collect();
+    if !search.gaps.is_empty() {
+        notes.push(format!(
+            "lambda search: {} of {} evaluations failed (gaps in the curve)",
+            search.gaps.len(),
+            search.curve.len()
+        ));
+    }
+    let cert_ok = opt.certificate.verified;
+    // Effects (friction, inertia, delay, ...) are outside the paper's class: theta below is the
+    // nominal model's and proves nothing about the model with effects.
+    let effects: Vec<String> = sys.effects.list.iter().map(|e| e.kind().to_string()).collect();
+    if !effects.is_empty() {
+        notes.push(format!(
+            "the model has effects outside the paper's class ({}): theta is computed for the nominal model without them and is NOT a certificate for this model (with friction or inertia a continuum of stationary regimes can exist)",
+            effects.join(", ")
+        ));
+    }
+    let theta_verified =
+        zero_in_theta && R_verified && al.verified && cert_ok && orbit.verified && d_ok && effects.is_empty();
+    if !orbit.verified {
+        notes.push(format!("osc and ||eta_T'||_inf are estimates ({})", orbit.method));
+    }
+
+    // Path-length bounds (path), (path1), (path2).
+    let idx = orbit.subsample(settings.path1_points);
+    let sub: Vec<&[f64]> = idx.iter().map(|&i| orbit.eta[i].as_slice()).collect();
+    let all: Vec<&[f64]> = orbit.eta.iter().map(|e| e.as_slice()).collect();
+    let path_b = path_bound(osc, d);
+    let path1 = partition_bound(&sub, d).max(path_b.min(0.0));
+    let path2 = packing_bound(&all[..all.len() - 1], d, osc, settings.packing_eps);
+
+    // Stationary set (Theorem 1).
+    let stationary = match &settings.stationary {
+        Some(st) => match rest_set(sys, st) {
+            Ok(r) => {
+                if let Some(t) = r.phi.first_singular {
+                    notes.push(format!("Phi(t) is singular at t = {t:.6} in [0, T]: Theorem 1's representation (stat1) fails there; R(T) is computed from (zin) instead"));
+                }
+                Some(r)
+            }
+            Err(e) => {
+                notes.push(format!("stationary set not computed: {e}"));
+                None
+            }
+        },
+        None => None,
+    };
+
+    // Measured side.
+    let measured = match &settings.measure {
+        Some(_) if !effects.is_empty() => {
+            notes.push("measured side not computed: the rate measurement simulates the paper's class only, and the model has effects".into());
+            None
+        }
+        Some(ms) => {
+            let mut ms = ms.clone();
+            ms.pi = Some(opt.certificate.Pi.clone());
+            match measure_rate(sys, &ms, None) {
+                Ok(r) => Some(MeasuredSide {
+                    rate: r.exponent,
+                    ci_low: r.ci_low,
+                    ci_high: r.ci_high,
+                    path_length_per_period: r.path_length_per_period,
+                    limsup_zdot: r.limsup_z_speed,
+                    periods: r.periods,
+                    transient_periods: r.transient_periods,
+                    h: r.h,
+                }),
+                Err(e) => {
+                    notes.push(format!("measured side not computed: {e}"));
+                    None
+                }
+            }
+        }
+        None => None,
+    };
+    if let Some(m) = &measured {
+        if theta < 0.0 && m.rate > theta {
+            notes.push(format!("measured exponent {:.4} exceeds theta {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta));
+        }
+    }
+
+    let Pi: Vec<Vec<f64>> =
+        (0..opt.certificate.Pi.nrows()).map(|i| opt.certificate.Pi.row(i).iter().copied().collect()).collect();
+    Ok(ThetaReport {
+        name: sys.name.clone(),
+        n: sys.n(),
+        m: sys.m(),
+        p,
+        period: T,
+        mu,
+        R,
+        R_verified,
+        zero_in_theta,
+        alpha: al,
+        lambda: opt.value.lambda,
+        beta: opt.value.beta,
+        beta_sdp: opt.value.beta_sdp,
+        certificate_verified: cert_ok,
+        Pi,
+        osc,
+        osc_sampled,
+        orbit_verified: orbit.verified,
+        orbit_method: orbit.method.to_string(),
+        d,
+        d_lower,
+        d_verified: d_ok,
+        eta_dot_inf,
+        d_ftheta,
+        d_ftheta_lower,
+        zdot_bound,
+        gamma_1,
+        gamma_inf,
+        kappa,
+        psi_0,
+        psi_inf,
+        theta,
+        theta_verified,
+        effects,
+        convergence_guaranteed: theta_verified && theta < 0.0,
+        path_bound: path_b,
+        path1_bound: path1,
+        path1_grid: sub.len(),
+        path2,
+        curve,
+        stationary,
+        measured,
+        tube_cells: tube_C.cells(),
+        tube_s_max: tube_C.s_max,
+        tube_tail: tube_C.tail_bound(),
+        notes,
+        tube_C: Arc::new(tube_C),
+        theta_set,
+        orbit: Arc::new(orbit),
+    })
+}
+
+impl ThetaReport {
+    /// `psi` of eq. (phipsi) at the certified `(alpha_lower, lambda, b_hat)`.
+    pub fn psi(&self) -> Psi {
+        Psi { alpha: self.alpha.lower, lambda: self.lambda, beta: self.beta }
+    }
+
+    /// Enclosure of the support function of `C Xi_inf` (eq. (Xinfsupp) with `u = C^T v`).
+    pub fn tube_support(&self, v: &[f64]) -> geometry::Bounds {
+        self.tube_C.support_bounds(v)
+    }
+
+    /// Upper bound of the support function of `C Xi_inf + Theta` (the cross-section of the
+    /// tube of Fig. loop around `eta_T`).
+    pub fn tube_theta_support_upper(&self, v: &[f64]) -> f64 {
+        self.tube_C.support_upper(v) + self.theta_set.support(v)
+    }
+
+    /// The orbit `eta_T` (samples, closed-form `osc`, `||eta_T'||`).
+    pub fn orbit(&self) -> &EtaOrbit {
+        &self.orbit
+    }
+
+    /// The labelled quantities in report order ([`crate::report::defs::ALL`]; the stationary
+    /// and measured ones only when computed).
+    pub fn quantities(&self) -> Vec<Quantity> {
+        use crate::report::defs::*;
+        let r_ok = self.R_verified;
+        let cert = self.certificate_verified;
+        let orb = self.orbit_verified;
+        let psi_ok = self.alpha.verified && cert;
+        let mut q = vec![
+            PERIOD.with(self.period, self.period.is_finite() && self.period > 0.0),
+            MU.with(self.mu, false),
+            R.with(self.R, r_ok),
+            ALPHA.with(self.alpha.lower, self.alpha.verified),
+            LAMBDA.with(self.lambda, cert),
+            BETA.with(self.beta, cert),
+            OSC.with(self.osc, orb).note(self.orbit_method.clone()),
+            D.with(self.d, self.d_verified),
+            ETA_DOT_INF.with(self.eta_dot_inf, orb),
+            D_FTHETA.with(self.d_ftheta, self.d_verified),
+            ZDOT_BOUND.with(self.zdot_bound, orb && self.d_verified),
+            GAMMA_1.with(self.gamma_1, orb && r_ok && self.d_verified),
+            GAMMA_INF.with(self.gamma_inf, orb && r_ok && self.d_verified),
+            KAPPA.with(self.kappa, orb && self.d_verified),
+            PSI_0.with(self.psi_0, psi_ok),
+            PSI_INF.with(self.psi_inf, psi_ok),
+            PSI_LIMIT.with(-self.lambda, cert),
+            THETA.with(self.theta, self.theta_verified),
+            PATH_BOUND.with(self.path_bound, orb && self.d_verified),
+            PATH1_BOUND
+                .with(self.path1_bound, orb && self.d_verified)
+                .note(format!("dynamic programming over a {}-point grid", self.path1_grid)),
+            PATH2_BOUND
+                .with(self.path2.value, orb && self.d_verified)
+                .note(format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count)),
+        ];
+        if let Some(s) = &self.stationary {
+            q.push(
+                PHI_FIRST_SINGULAR
+                    .with(s.phi.first_singular.unwrap_or(f64::NAN), false)
+                    .note(format!("min sigma(Phi) on [0,T] = {:.3e}", s.phi.min_sigma)),
+            );
+            // The grid relaxes (stat1), so its slack bounds the continuous one from below.
+            q.push(
+                STATIONARY_SLACK
+                    .with(s.slack, s.verified)
+                    .kind(if s.verified { BoundKind::Lower } else { BoundKind::Estimate })
+                    .note(format!(
+                        "{} -> {}",
+                        s.method,
+                        match s.empty {
+                            Some(true) => "empty",
+                            Some(false) => "nonempty",
+                            None => "undecided",
+                        }
+                    )),
+            );
+        }
+        if let Some(m) = &self.measured {
+            q.push(
+                MEASURED_RATE
+                    .with(m.rate, false)
+                    .note(format!("95% CI [{:.4}, {:.4}], {} periods", m.ci_low, m.ci_high, m.periods)),
+            );
+            q.push(PATH_MEASURED.with(m.path_length_per_period, false));
+            q.push(ZDOT_MEASURED.with(m.limsup_zdot, false));
+        }
+        q
+    }
+
+    /// The quantity with this key, if it was computed.
+    pub fn quantity(&self, key: &str) -> Option<Quantity> {
+        self.quantities().into_iter().find(|q| q.key == key)
+    }
+
+    /// JSON object with stable snake_case keys (see the README of `moreau theta`): one key per
+    /// declared quantity ([`crate::report::defs::ALL`]; `null` when not computed or not
+    /// finite), the verified flags, the system's sizes, `Pi`, the lambda curve, notes, and the
+    /// full `quantities` list.
+    pub fn to_json(&self) -> serde_json::Value {
+        use serde_json::json;
+        let f = |v: f64| if v.is_finite() { json!(v) } else { serde_json::Value::Null };
+        let quantities = self.quantities();
+        let mut m = serde_json::Map::new();
+        m.insert("name".into(), json!(self.name));
+        m.insert("n".into(), json!(self.n));
+        m.insert("m".into(), json!(self.m));
+        m.insert("p".into(), json!(self.p));
+        for def in crate::report::defs::ALL {
+            let v = quantities.iter().find(|q| q.key == def.key).map(|q| f(q.value)).unwrap_or(serde_json::Value::Null);
+            m.insert(def.key.into(), v);
+        }
+        m.insert("r_verified".into(), json!(self.R_verified));
+        m.insert("alpha_verified".into(), json!(self.alpha.verified));
+        m.insert("certificate_verified".into(), json!(self.certificate_verified));
+        m.insert("orbit_verified".into(), json!(self.orbit_verified));
+        m.insert("d_verified".into(), json!(self.d_verified));
+        m.insert("theta_verified".into(), json!(self.theta_verified));
+        m.insert("convergence_guaranteed".into(), json!(self.convergence_guaranteed));
+        m.insert("effects".into(), json!(self.effects));
+        m.insert("pi".into(), json!(self.Pi));
+        m.insert("measured_rate_ci".into(), json!(self.measured.as_ref().map(|m| [f(m.ci_low), f(m.ci_high)])));
+        m.insert("stationary_set_empty".into(), json!(self.stationary.as_ref().and_then(|s| s.empty)));
+        m.insert("stationary_verified".into(), json!(self.stationary.as_ref().map(|s| s.verified)));
+        m.insert("stationary_point".into(), json!(self.stationary.as_ref().and_then(|s| s.point.clone())));
+        m.insert("tube_cells".into(), json!(self.tube_cells));
+        m.insert("tube_tail_dxx".into(), json!(f(self.tube_tail)));
+        m.insert("lambda_curve".into(), json!(self.curve));
+        m.insert("notes".into(), json!(self.notes));
+        let qs: Vec<serde_json::Value> =
+            quantities.iter().map(|q| serde_json::to_value(q).unwrap_or_default()).collect();
+        m.insert("quantities".into(), json!(qs));
+        serde_json::Value::Object(m)
+    }
+}
+
+/// `F` of eq. (F) (convenience re-export for callers holding only the report's system).
+pub fn linearised_matrix(sys: &System) -> DMatrix<f64> {
+    sys.F()
+}

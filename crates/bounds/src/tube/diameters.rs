@@ -1,0 +1,96 @@
+//! The two sphere maxima of Theorem 2 over the output tube, from above:
+//!
+//! ```text
+//! d                         = max_{|v|=1} sigma_{C Xi_inf + Theta}(v) + sigma_{C Xi_inf + Theta}(-v)   (d)
+//! D(C(F Xi_inf + E Theta),{0}) = max_{|v|=1} sigma_{C F Xi_inf}(v) + sigma_Theta(E^T C^T v)           (zinf)
+//! ```
+//! Support functions of `C Xi_inf` and `C F Xi_inf` by the certified quadrature of
+//! [`TubeKernel`]; the maxima by `geometry::sublinear_sphere_max` (both functions are sublinear)
+//! with Lipschitz constants built from the kernels' `int ||K(s)|| ds` and `D(Theta, {0})`.
+//! Used by `theta::assemble` and by the Theorem 2 properties of the `theorems` campaign, so the
+//! campaign checks the numbers that the report prints.
+use crate::error::BoundsError;
+use crate::tube::{Horizon, TubeKernel, TubeSettings};
+use geometry::{sublinear_sphere_max, Bounds, ConvexSet, Shape, SphereMaxSettings};
+use nalgebra::{DMatrix, DVector};
+
+/// `d` and `D(C(F Xi_inf + E Theta),{0})` with the kernels that produced them.
+#[derive(Debug, Clone)]
+pub struct TubeDiameters {
+    /// Kernel of `sigma_{C Xi_inf}`.
+    pub tube_C: TubeKernel,
+    /// Kernel of `sigma_{C F Xi_inf}`.
+    pub tube_CF: TubeKernel,
+    /// `upper`: a proven upper bound of `d` (eq. (d)); `lower`: indicative only (best sampled
+    /// value minus the quadrature widths), not a bound.
+    pub d: Bounds,
+    /// As `d` for `D(C(F Xi_inf + E Theta),{0})` (eq. (zinf)).
+    pub d_ftheta: Bounds,
+    /// Both upper values come from valid Lipschitz or conic-combination bounds of upper
+    /// quadrature enclosures: false when a value is not finite.
+    pub verified: bool,
+}
+
+fn sigma_sym(theta: &Shape, v: &[f64]) -> f64 {
+    let neg: Vec<f64> = v.iter().map(|x| -x).collect();
+    theta.support(v) + theta.support(&neg)
+}
+
+/// Computes [`TubeDiameters`] for `F = A + E C` (eq. (F)), output matrix `C`, loop matrix `E`
+/// and the backlash set `theta`.
+pub fn tube_diameters(
+    C: &DMatrix<f64>,
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    theta: &Shape,
+    tube: &TubeSettings,
+    sphere: &SphereMaxSettings,
+) -> Result<TubeDiameters, BoundsError> {
+    let p = C.nrows();
+    let d_theta = theta.deviation_from_origin().upper;
+    let tube_C = TubeKernel::new(C, F, E, theta, Horizon::Infinite, tube)?;
+    let CF = C * F;
+    let tube_CF = TubeKernel::new(&CF, F, E, theta, Horizon::Infinite, tube)?;
+
+    let lip_d = 2.0 * (tube_C.lipschitz() + d_theta);
+    let d_b = sublinear_sphere_max(
+        p,
+        |v| {
+            let neg: Vec<f64> = v.iter().map(|x| -x).collect();
+            tube_C.support_upper(v) + tube_C.support_upper(&neg) + sigma_sym(theta, v)
+        },
+        lip_d,
+        sphere,
+    );
+    let d_lower = d_b.lower - 2.0 * (tube_C.remainder_bound() + tube_C.tail_bound());
+
+    let CEt = (C * E).transpose();
+    let nCE = CEt.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let lip_f = tube_CF.lipschitz() + nCE * d_theta * (1.0 + 1e-12);
+    let df_b = sublinear_sphere_max(
+        p,
+        |v| {
+            let w = &CEt * DVector::from_column_slice(v);
+            tube_CF.support_upper(v) + theta.support(w.as_slice())
+        },
+        lip_f,
+        sphere,
+    );
+    let df_lower = df_b.lower - tube_CF.remainder_bound() - tube_CF.tail_bound();
+    // The upper values are proofs when every enclosure they were built from is finite and the
+    // sampled maxima lie below them (a sampled value above the bound would expose a broken
+    // Lipschitz constant or a non-sublinear function).
+    let verified = [d_b.upper, df_b.upper, tube_C.remainder_bound(), tube_C.tail_bound()]
+        .iter()
+        .chain(&[tube_CF.remainder_bound(), tube_CF.tail_bound(), lip_d, lip_f])
+        .all(|x| x.is_finite())
+        && d_b.lower <= d_b.upper
+        && df_b.lower <= df_b.upper;
+    Ok(TubeDiameters {
+        tube_C,
+        tube_CF,
+        d: Bounds { lower: d_lower, upper: d_b.upper },
+        d_ftheta: Bounds { lower: df_lower, upper: df_b.upper },
+        verified,
+    })
+}

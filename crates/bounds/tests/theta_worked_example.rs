@@ -1,0 +1,127 @@
+//! The worked example of NOTES.md (a = 1 and a = 5) through `bounds::theta::assemble`, and the
+//! bad-input cases of `assemble` (non-Hurwitz F, no period, polytope with R infinite).
+#![allow(non_snake_case)]
+use bounds::theta::{assemble, ThetaSettings};
+use bounds::BoundsError;
+
+fn load(name: &str) -> model::System {
+    model::load(std::path::Path::new(&format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR")))).unwrap()
+}
+
+#[test]
+fn worked_example_theta_is_negative_verified_and_above_the_measured_rate() {
+    for (file, expect) in [("worked-example.toml", -0.02), ("worked-example-a5.toml", -0.04)] {
+        let sys = load(file);
+        let r = assemble(&sys, &ThetaSettings::default()).unwrap();
+        assert!(
+            r.theta < 0.0 && r.theta_verified && r.convergence_guaranteed,
+            "{file}: theta {} verified {}",
+            r.theta,
+            r.theta_verified
+        );
+        // NOTES.md: an independent computation gives about -0.02 (a = 1) and -0.04 (a = 5).
+        assert!((r.theta - expect).abs() < 0.01, "{file}: theta {}", r.theta);
+        // Structure of eq. (theta): a convex combination of psi(0) and psi(gamma_inf) > -lambda.
+        assert!(r.psi_inf > -r.lambda && r.psi_inf <= r.psi_0);
+        assert!(r.theta <= r.psi_0 && r.theta >= r.psi_inf);
+        assert!(r.kappa <= 1.0 / std::f64::consts::PI + 1e-9, "kappa {} > 1/pi for a sine", r.kappa);
+        assert!((r.alpha.lower).abs() < 1e-12 && r.alpha.verified); // C E = 0
+        assert!((r.mu + 0.3).abs() < 1e-12);
+        assert!(r.lambda > 0.0 && r.lambda < 0.3);
+        // Reality: the bound holds.
+        let m = r.measured.as_ref().expect("measured side");
+        assert!(m.rate <= r.theta, "{file}: measured {} > theta {}", m.rate, r.theta);
+        assert!(m.path_length_per_period >= r.path_bound && m.path_length_per_period >= r.path1_bound * (1.0 - 1e-3));
+        assert!(m.path_length_per_period >= r.path2.value * (1.0 - 1e-3));
+        assert!(m.limsup_zdot <= r.zdot_bound, "{file}: limsup |z'| {} > (zinf) {}", m.limsup_zdot, r.zdot_bound);
+        assert!(r.path1_bound >= r.path_bound - 1e-12);
+        // Stationary set: the input is large, R(T) is empty (proven for p = 1).
+        let st = r.stationary.as_ref().unwrap();
+        assert_eq!(st.empty, Some(true));
+        assert!(st.verified && st.phi.first_singular.is_none());
+        // JSON has the stable keys.
+        let j = r.to_json();
+        for k in [
+            "mu",
+            "alpha",
+            "lambda",
+            "beta",
+            "osc",
+            "d",
+            "eta_dot_inf",
+            "d_ftheta",
+            "gamma_1",
+            "gamma_inf",
+            "psi_0",
+            "psi_inf",
+            "theta",
+            "theta_verified",
+            "measured_rate",
+            "path_bound",
+            "path1_bound",
+            "path_measured",
+            "stationary_set_empty",
+        ] {
+            assert!(j.get(k).is_some_and(|v| !v.is_null()), "{file}: key {k} missing or null");
+        }
+    }
+}
+
+#[test]
+fn theta_is_monotone_in_its_parts_negative_control() {
+    // If the lower-bounded gamma_1 were replaced by a larger value, theta would drop: theta is
+    // NOT a valid bound with an overestimated gamma_1 (the safe direction matters).
+    let sys = load("worked-example.toml");
+    let r = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
+    let psi = r.psi();
+    assert!((psi.theta(r.gamma_1, r.gamma_inf) - r.theta).abs() < 1e-15);
+    assert!(psi.theta(r.gamma_1 * 1.5, r.gamma_inf) < r.theta);
+    assert!(psi.theta(r.gamma_1, r.gamma_inf * 1.5) > r.theta);
+    // Tube accessor: C Xi_inf for p = 1 is an interval symmetric about 0; d = its width + 0.2.
+    let (a, b) = (r.tube_support(&[1.0]), r.tube_support(&[-1.0]));
+    assert!((a.upper - b.upper).abs() < 1e-12);
+    assert!((2.0 * a.upper + 0.2 - r.d).abs() < 1e-9, "{} vs {}", 2.0 * a.upper + 0.2, r.d);
+}
+
+#[test]
+fn bad_inputs_give_named_errors_or_reported_cases() {
+    let sys = load("worked-example.toml");
+    // Non-Hurwitz F: A + E C with a negative damping.
+    let mut bad = sys.clone();
+    bad.A[(1, 1)] = 0.6;
+    match assemble(&bad, &ThetaSettings::bound_only()) {
+        Err(BoundsError::NotHurwitz { mu }) => assert!(mu > 0.0),
+        other => panic!("expected NotHurwitz, got {other:?}"),
+    }
+    // No period.
+    let zero = sys.with_input(model::Input::Zero { m: 1 });
+    assert!(matches!(assemble(&zero, &ThetaSettings::bound_only()), Err(BoundsError::NoPeriod { kind: "zero" })));
+    // Polytope: R infinite, gamma = 0, theta = psi(0) (reported, not an error).
+    let poly = load("polytope-p2.toml");
+    let r = assemble(&poly, &ThetaSettings::bound_only()).unwrap();
+    assert!(r.R.is_infinite() && r.gamma_1 == 0.0 && r.gamma_inf == 0.0);
+    assert_eq!(r.theta, r.psi_0);
+    assert!(r.theta > 0.0 && !r.convergence_guaranteed, "alpha = 0 gives psi(0) > 0");
+    assert!(r.notes.iter().any(|n| n.contains("not strongly convex")));
+}
+
+#[test]
+fn assemble_is_deterministic_and_thread_safe() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<bounds::theta::ThetaReport>();
+    let sys = load("ellipse-p2.toml");
+    let s = ThetaSettings::bound_only();
+    let reference = assemble(&sys, &s).unwrap();
+    let results: Vec<f64> = std::thread::scope(|sc| {
+        let hs: Vec<_> = (0..3).map(|_| sc.spawn(|| assemble(&sys, &s).unwrap().theta)).collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for t in results {
+        assert_eq!(t.to_bits(), reference.theta.to_bits());
+    }
+    // psi as a function and the tube support function are usable from the report.
+    let psi = reference.psi();
+    assert!(psi.eval(0.0) == reference.psi_0 && psi.limit() == -reference.lambda);
+    let up = reference.tube_theta_support_upper(&[1.0, 0.0]);
+    assert!(up > reference.tube_support(&[1.0, 0.0]).upper);
+}

@@ -1,6 +1,0 @@
-//! `moreau`: the command-line tool of the workspace. See `moreau --help`.
-use std::process::ExitCode;
-
-fn main() -> ExitCode {
-    driver::cli::main()
-}

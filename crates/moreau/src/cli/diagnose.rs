@@ -1,0 +1,140 @@
+//! `moreau diagnose --model M.toml --data R.csv --out DIR`: compare a nominal model with a
+//! recording, locate the mismatch, name the missing physics, refit and validate
+//! (crate `discovery`). Writes `report.md`, `report.json`, `fitted.toml`, `residual.svg`,
+//! `fit.svg` (and PNG copies) into DIR, all together or not at all.
+use crate::output::StagedDir;
+use crate::plot::{self, LinePlot, Series};
+use anyhow::Context;
+use discovery::{DiagnoseSettings, Recording, Report};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Nominal model file (TOML).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Recording CSV: header `t,w,y` or `t,w1..wm,y1..yp`, optional `z`.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Fraction of the record used for estimation (the rest validates). Default 0.7.
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.7)]
+    pub estimation_fraction: f64,
+    /// Greatest number of effects added by forward selection.
+    #[arg(long, default_value_t = 2)]
+    pub max_effects: usize,
+}
+
+/// At most `max` evenly spaced points of a series (for figures of long records).
+fn thin(t: &[f64], v: &[f64], max: usize) -> (Vec<f64>, Vec<f64>) {
+    let step = (t.len() / max.max(1)).max(1);
+    (t.iter().step_by(step).copied().collect(), v.iter().step_by(step).copied().collect())
+}
+
+/// The two figures of a report: residual timeline with windows shaded, and measured vs
+/// nominal vs fitted (output 1).
+pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
+    let s = &r.series;
+    let p = s.p.max(1);
+    let col = |v: &[f64], i: usize| -> Vec<f64> { v.iter().skip(i).step_by(p).copied().collect() };
+    let mut out = Vec::new();
+    let windows: Vec<(f64, f64)> = r.windows.iter().map(|w| (w.t_start, w.t_end)).collect();
+    let y0 = col(&s.y, 0);
+    let en: Vec<f64> = col(&s.y, 0).iter().zip(col(&s.yhat_nominal, 0)).map(|(a, b)| a - b).collect();
+    let ef: Vec<f64> = col(&s.y, 0).iter().zip(col(&s.yhat_fitted, 0)).map(|(a, b)| a - b).collect();
+    let mk = |label: &str, v: &[f64]| {
+        let (x, y) = thin(&s.t, v, 4000);
+        Series { label: label.into(), x, y }
+    };
+    out.push((
+        "residual",
+        LinePlot {
+            title: format!(
+                "Residual y - yhat (output 1); shaded: located windows; validation from t = {:.3}",
+                r.validation_segment[0]
+            ),
+            x_label: "t (s)".into(),
+            y_label: "residual".into(),
+            series: vec![mk("nominal", &en), mk("fitted", &ef)],
+            windows: windows.clone(),
+            size: (1200, 500),
+        },
+    ));
+    out.push((
+        "fit",
+        LinePlot {
+            title: format!("Measured vs nominal vs fitted (output 1): {}", r.selected()),
+            x_label: "t (s)".into(),
+            y_label: "y".into(),
+            series: vec![
+                mk("measured", &y0),
+                mk("nominal", &col(&s.yhat_nominal, 0)),
+                mk("fitted", &col(&s.yhat_fitted, 0)),
+            ],
+            windows: vec![(r.validation_segment[0], r.validation_segment[1])],
+            size: (1200, 500),
+        },
+    ));
+    out
+}
+
+/// Writes every output of a report into `out` atomically.
+pub fn write_outputs(r: &Report, out: &std::path::Path) -> anyhow::Result<()> {
+    let figs = figures(r);
+    let st = StagedDir::new(out)?;
+    let mut captions = Vec::new();
+    for (name, fig) in &figs {
+        let svg = plot::to_svg_string(fig).with_context(|| format!("figure {name}"))?;
+        std::fs::write(st.path(&format!("{name}.svg")), svg)?;
+        plot::write_png(fig, &st.path(&format!("{name}.png"))).with_context(|| format!("figure {name}"))?;
+        captions.push((format!("{name}.svg"), fig.title.clone()));
+    }
+    let caps: Vec<(&str, &str)> = captions.iter().map(|(a, b)| (a.as_str(), b.as_str())).collect();
+    std::fs::write(st.path("report.md"), r.to_markdown(&caps))?;
+    std::fs::write(st.path("report.json"), serde_json::to_string_pretty(r)?)?;
+    if let Some(m) = &r.fitted_model {
+        let text = model::to_toml_string(m);
+        if let (model::Input::Samples { path, .. }, Some(csv)) = (&m.input, m.input.samples_csv()) {
+            std::fs::write(st.path(path), csv)?;
+        }
+        std::fs::write(st.path("fitted.toml"), text)?;
+        model::load(&st.path("fitted.toml")).context("the fitted model does not read back (internal error)")?;
+    }
+    st.commit()
+}
+
+pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    let sys = model::load(&a.model).with_context(|| format!("model {}", a.model.display()))?;
+    let rec = Recording::load(&a.data)?;
+    let settings = DiagnoseSettings {
+        estimation_fraction: a.estimation_fraction,
+        max_effects: a.max_effects,
+        ..Default::default()
+    };
+    let start = std::time::Instant::now();
+    let r = discovery::diagnose(&sys, &rec, &settings)?;
+    let secs = start.elapsed().as_secs_f64();
+    write_outputs(&r, &a.out)?;
+    println!("{}", r.verdict);
+    let pct = |v: &[Option<f64>]| {
+        v.iter().map(|x| x.map_or("undefined".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
+    };
+    println!(
+        "validation fit % (nominal -> fitted): [{}] -> [{}]; RMSE {:?} -> {:?}",
+        pct(&r.fit_before.fit_percent),
+        pct(&r.fit_after.fit_percent),
+        r.fit_before.rmse,
+        r.fit_after.rmse
+    );
+    if !r.fit_before.constant_outputs.is_empty() {
+        println!("fit % undefined: the validation output is constant; judge by the RMSE");
+    }
+    for e in &r.effects {
+        println!("  {}: {:?}", e.label, e.params);
+    }
+    println!("{} hypotheses ranked in {secs:.2} s; report in {}", r.ranking.len(), a.out.display());
+    Ok(ExitCode::SUCCESS)
+}

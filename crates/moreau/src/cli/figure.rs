@@ -1,0 +1,93 @@
+//! `moreau figure psi|tube|trajectory|sweep INPUT --out DIR`
+use crate::figures::{self, trajectory::TrajectorySettings, Figure};
+use crate::sweep::SweepResult;
+use anyhow::Context;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kind {
+    /// Fig. psi1: psi(gamma) with psi(0), psi(gamma_inf), the limit -lambda and the chord (theta). INPUT: model file.
+    Psi,
+    /// Fig. loop: the orbit eta_T, the tube eta_T + C Xi_inf + Theta, the simulated periodic z. INPUT: model file.
+    Tube,
+    /// y, z and x against time. INPUT: model file.
+    Trajectory,
+    /// Columns of a sweep against a swept parameter. INPUT: sweep.json (or its directory).
+    Sweep,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Which figure.
+    #[arg(value_enum)]
+    pub kind: Kind,
+    /// Model file (psi, tube, trajectory) or sweep result (sweep: sweep.json or its directory).
+    pub input: PathBuf,
+    /// Output directory (fig-psi1, fig-loop, trajectory-yz/-x or sweep-<columns>, each .svg and .png).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// sweep: numeric columns to draw.
+    #[arg(long, value_delimiter = ',', default_value = "theta,measured_rate")]
+    pub columns: Vec<String>,
+    /// sweep: the axis on the horizontal axis (default: the first).
+    #[arg(long)]
+    pub x: Option<String>,
+    /// trajectory: final time (default: the model's periods, or t_end).
+    #[arg(allow_negative_numbers = true, long)]
+    pub t_end: Option<f64>,
+    /// trajectory: time step (default: the model's dt).
+    #[arg(allow_negative_numbers = true, long)]
+    pub dt: Option<f64>,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    for (name, v) in [("--t-end", a.t_end), ("--dt", a.dt)] {
+        if let Some(v) = v {
+            anyhow::ensure!(v > 0.0 && v.is_finite(), "{name} {v}: must be positive and finite");
+        }
+    }
+    let figs: Vec<(String, Figure)> = match a.kind {
+        Kind::Sweep => {
+            let path = if a.input.is_dir() { a.input.join("sweep.json") } else { a.input.clone() };
+            let r = SweepResult::read(&path)?;
+            let cols: Vec<&str> = a.columns.iter().map(String::as_str).collect();
+            let f = figures::sweep::sweep_figure(&r, a.x.as_deref(), &cols)?;
+            vec![(format!("sweep-{}", cols.join("-")), f)]
+        }
+        _ => {
+            let sys = model::load(&a.input).with_context(|| a.input.display().to_string())?;
+            match a.kind {
+                Kind::Trajectory => {
+                    let (yz, x) = figures::trajectory::trajectory_figures(
+                        &sys,
+                        &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() },
+                    )?;
+                    vec![("trajectory-yz".into(), yz), ("trajectory-x".into(), x)]
+                }
+                Kind::Psi => {
+                    let r = bounds::theta::assemble(&sys, &bounds::theta::ThetaSettings::bound_only())?;
+                    eprintln!(
+                        "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
+                        r.theta,
+                        if r.theta_verified { "verified" } else { "not verified" },
+                        r.psi_0,
+                        r.psi_inf,
+                        -r.lambda
+                    );
+                    vec![("fig-psi1".into(), figures::psi::from_report(&r))]
+                }
+                Kind::Tube => {
+                    let r = bounds::theta::assemble(&sys, &bounds::theta::ThetaSettings::bound_only())?;
+                    let z = figures::tube::periodic_z(&sys, 2000)?;
+                    vec![("fig-loop".into(), figures::tube::tube_figure(&sys, &r, &z))]
+                }
+                Kind::Sweep => unreachable!("handled above"),
+            }
+        }
+    };
+    for f in figures::write_figure(&figs, &a.out)? {
+        println!("{}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}

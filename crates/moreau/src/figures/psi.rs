@@ -1,0 +1,66 @@
+//! Fig. psi1: `psi(gamma)` of eq. (phipsi), its value `psi(0)` (eq. (psilim)), the limit
+//! `-lambda`, the value `psi(gamma_inf)` and the chord over `[0, gamma_inf]` whose value at
+//! `gamma_1` is `theta` (eq. (theta)).
+use super::canvas::{Element, Figure, BLUE, GREY, ORANGE, RED};
+use crate::sweep::table::sig;
+use bounds::theta::{Psi, ThetaReport};
+
+/// Fig. psi1 from the function and the two gammas (`theta` is read off the chord).
+pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
+    // with gamma_inf = 0 (R infinite, e.g. a polytope) show psi on its own scale
+    let own = 4.0 * (psi.alpha.abs() + psi.lambda.abs() + psi.beta.abs().sqrt());
+    let g_max = if gamma_inf.is_finite() && gamma_inf > 0.0 {
+        1.6 * gamma_inf
+    } else if own > 0.0 && own.is_finite() {
+        own
+    } else {
+        1.0
+    };
+    let v = |x: f64| sig(x, 4, false);
+    let k = 400;
+    let curve: Vec<(f64, f64)> = (0..=k).map(|i| g_max * i as f64 / k as f64).map(|g| (g, psi.eval(g))).collect();
+    let (p0, pinf) = (psi.at_zero(), psi.eval(gamma_inf));
+    let theta = psi.theta(gamma_1, gamma_inf);
+    let mut f = Figure::new("ψ(γ), eq. (phipsi), and θ of eq. (theta)", "γ", "ψ(γ)");
+    f.elements.push(Element::Line { label: "ψ(γ)".into(), pts: curve, color: BLUE, dashed: false });
+    f.elements.push(Element::Line {
+        label: format!("limit −λ = {}", v(psi.limit())),
+        pts: vec![(0.0, psi.limit()), (g_max, psi.limit())],
+        color: GREY,
+        dashed: true,
+    });
+    f.elements.push(Element::Line {
+        label: "chord over [0, γ∞]".into(),
+        pts: vec![(0.0, p0), (gamma_inf, pinf)],
+        color: ORANGE,
+        dashed: false,
+    });
+    f.elements.push(Element::Line {
+        label: String::new(),
+        pts: vec![(gamma_1, psi.limit()), (gamma_1, theta)],
+        color: GREY,
+        dashed: true,
+    });
+    f.elements.push(Element::Markers {
+        label: String::new(),
+        pts: vec![(0.0, p0), (gamma_inf, pinf)],
+        text: if gamma_inf > 0.0 {
+            vec![format!("ψ(0) = {}", v(p0)), format!("ψ(γ∞) = {}", v(pinf))]
+        } else {
+            vec![format!("ψ(0) = ψ(γ∞) = {} (γ∞ = 0)", v(p0)), String::new()]
+        },
+        color: BLUE,
+    });
+    f.elements.push(Element::Markers {
+        label: format!("θ = {} at γ₁ = {}", v(theta), v(gamma_1)),
+        pts: vec![(gamma_1, theta)],
+        text: vec!["θ".into()],
+        color: RED,
+    });
+    f
+}
+
+/// Fig. psi1 of a theta report.
+pub fn from_report(r: &ThetaReport) -> Figure {
+    psi_figure(&r.psi(), r.gamma_1, r.gamma_inf)
+}

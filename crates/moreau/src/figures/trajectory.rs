@@ -1,0 +1,63 @@
+//! Trajectories: `y = C x` and `z` against time (and the states `x` in a second figure), from
+//! the catching-up scheme (eq. (zdot) discretised, NOTES.md) started at the model's `x0, z0`,
+//! or the extended-model simulator for a model with `[[effects]]`.
+use super::canvas::{palette, Element, Figure};
+use super::FigureError;
+use model::System;
+
+/// Settings of the trajectory figure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrajectorySettings {
+    /// Final time; default: the model's `periods` periods (or its `t_end`, or 100).
+    pub t_end: Option<f64>,
+    /// Step; default: the model's `dt`.
+    pub dt: Option<f64>,
+    /// Points drawn per curve (at most). Default `4000`.
+    pub max_points: usize,
+}
+
+impl Default for TrajectorySettings {
+    fn default() -> Self {
+        Self { t_end: None, dt: None, max_points: 4000 }
+    }
+}
+
+/// Two figures: (`y` and `z` against `t`, `x` against `t`).
+pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figure, Figure), FigureError> {
+    let dt = s.dt.unwrap_or(sys.sim.dt);
+    let t_end = s.t_end.unwrap_or_else(|| match sys.period() {
+        Some(T) => T * sys.sim.periods as f64,
+        None => sys.sim.t_end.unwrap_or(100.0),
+    });
+    let steps = ((t_end / dt).ceil() as usize).max(1);
+    let every = (steps / s.max_points.max(1)).max(1);
+    let tr = dynamics::trajectory::simulate_model(sys, dt, steps, every)?;
+    let mut yz = Figure::new(&format!("Trajectory of `{}`: y = C x and z", sys.name), "t", "y, z");
+    let mut xf = Figure::new(&format!("Trajectory of `{}`: state x", sys.name), "t", "x");
+    let ys: Vec<Vec<f64>> = (0..tr.len()).map(|i| tr.y_at(&sys.C, i)).collect();
+    let p = sys.p();
+    for k in 0..p {
+        let sub = if p > 1 { format!("{}", k + 1) } else { String::new() };
+        yz.elements.push(Element::Line {
+            label: format!("y{sub}"),
+            pts: tr.t.iter().zip(&ys).map(|(&t, y)| (t, y[k])).collect(),
+            color: palette(2 * k),
+            dashed: false,
+        });
+        yz.elements.push(Element::Line {
+            label: format!("z{sub}"),
+            pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.z_at(i)[k])).collect(),
+            color: palette(2 * k + 1),
+            dashed: false,
+        });
+    }
+    for k in 0..sys.n() {
+        xf.elements.push(Element::Line {
+            label: format!("x{}", k + 1),
+            pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.x_at(i)[k])).collect(),
+            color: palette(k),
+            dashed: false,
+        });
+    }
+    Ok((yz, xf))
+}

@@ -1,0 +1,6 @@
+//! `moreau`: the command-line tool of the workspace. See `moreau --help`.
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    moreau::cli::main()
+}

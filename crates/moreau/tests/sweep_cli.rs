@@ -1,0 +1,148 @@
+//! `moreau sweep`, `moreau merge`, `moreau figure` end to end with the real theta evaluator:
+//! the committed example reproduces, shards merge to the unsharded table, bad input gives a
+//! one-line error, exit code 2 and no output.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
+}
+
+fn moreau(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_moreau")).args(args).current_dir(root()).output().unwrap()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn assert_one_line_error(o: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: ") && err.contains(needle), "expected `{needle}` in: {err}");
+}
+
+#[test]
+fn example_sweep_reproduces_the_committed_latex_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("amp");
+    let o = moreau(&["sweep", "examples/sweeps/amplitude.toml", "--out", s(&out), "--quiet", "--threads", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["sweep.tex", "sweep.md"] {
+        let fresh = std::fs::read_to_string(out.join(f)).unwrap();
+        let reference = std::fs::read_to_string(root().join("examples/sweeps/amplitude").join(f)).unwrap();
+        assert_eq!(fresh, reference, "{f} differs from the committed reference: if the change of theta is intended, regenerate with `moreau sweep examples/sweeps/amplitude.toml --out examples/sweeps/amplitude --fresh`");
+    }
+    // the bound holds where it is verified: theta >= measured exponent (both rates of decay)
+    let r = moreau::sweep::SweepResult::read(&out.join("sweep.json")).unwrap();
+    let col = |n: &str| r.columns.iter().position(|c| c.name == n).unwrap();
+    for p in &r.points {
+        if let (moreau::sweep::Cell::Num(theta), moreau::sweep::Cell::Num(rate)) =
+            (&p.cells[col("theta")], &p.cells[col("measured_rate")])
+        {
+            assert!(theta >= rate, "point {}: theta {theta} below the measured exponent {rate}", p.index);
+        }
+    }
+}
+
+const SMALL: &str = "name = \"small\"\nmodel = \"MODEL\"\n[[axis]]\nparameter = \"input.amplitude\"\nvalues = [1.0, 2.0, 4.0]\n[evaluate]\nmeasure = false\n";
+
+fn small_spec(dir: &Path, body: &str) -> PathBuf {
+    let p = dir.join("spec.toml");
+    std::fs::write(&p, body.replace("MODEL", s(&root().join("examples/worked-example.toml")))).unwrap();
+    p
+}
+
+#[test]
+fn shards_from_the_cli_merge_to_the_unsharded_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = small_spec(tmp.path(), SMALL);
+    let full = tmp.path().join("full");
+    assert!(moreau(&["sweep", s(&spec), "--out", s(&full), "-q"]).status.success());
+    let shards = tmp.path().join("shards");
+    for k in ["0/2", "1/2"] {
+        let o = moreau(&["sweep", s(&spec), "--out", s(&shards), "--shard", k, "-q"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let merged = tmp.path().join("merged");
+    let o = moreau(&["merge", s(&shards), "--out", s(&merged)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["sweep.json", "sweep.csv", "sweep.md", "sweep.tex"] {
+        assert_eq!(std::fs::read(full.join(f)).unwrap(), std::fs::read(merged.join(f)).unwrap(), "{f}");
+    }
+    // a merge of shards of different specs is refused and writes nothing
+    let other = small_spec(&tmp.path().join("o").tap_mkdir(), &SMALL.replace("4.0", "5.0"));
+    let oshards = tmp.path().join("oshards");
+    assert!(moreau(&["sweep", s(&other), "--out", s(&oshards), "--shard", "1/2", "-q"]).status.success());
+    let bad = tmp.path().join("bad");
+    let o = moreau(&[
+        "merge",
+        s(&shards.join("sweep-shard-0-of-2.json")),
+        s(&oshards.join("sweep-shard-1-of-2.json")),
+        "--out",
+        s(&bad),
+    ]);
+    assert_one_line_error(&o, "shards of different specs");
+    assert!(!bad.exists());
+}
+
+trait TapMkdir {
+    fn tap_mkdir(self) -> Self;
+}
+impl TapMkdir for PathBuf {
+    fn tap_mkdir(self) -> Self {
+        std::fs::create_dir_all(&self).unwrap();
+        self
+    }
+}
+
+#[test]
+fn bad_sweep_input_gives_one_line_errors_and_no_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let cases = [
+        (SMALL.replace("input.amplitude", "plant.A[0][7]"), "outside the 2x2 matrix"),
+        (SMALL.replace("input.amplitude", "plant.K[0][0]"), "`plant.K[0][0]`: unknown parameter"),
+        (SMALL.replace("values = [1.0, 2.0, 4.0]", "range = { from = 1.0, to = 0.0, step = 0.1 }"), "empty range"),
+        (SMALL.replace("measure = false", "measure = \"yes\""), "evaluate.measure"),
+    ];
+    for (body, needle) in cases {
+        let spec = small_spec(tmp.path(), &body);
+        assert_one_line_error(&moreau(&["sweep", s(&spec), "--out", s(&out), "-q"]), needle);
+        assert!(!out.exists(), "nothing written for `{needle}`");
+    }
+    let spec = small_spec(tmp.path(), SMALL);
+    assert_one_line_error(&moreau(&["sweep", s(&spec), "--out", s(&out), "--shard", "2/2"]), "bad shard `2/2`");
+    assert_one_line_error(&moreau(&["sweep", s(&spec), "--out", s(&out), "--digits", "0"]), "--digits 0");
+    assert!(!out.exists());
+    // a good table is not replaced by another spec's
+    assert!(moreau(&["sweep", s(&spec), "--out", s(&out), "-q"]).status.success());
+    let before = std::fs::read(out.join("sweep.tex")).unwrap();
+    let other = small_spec(tmp.path(), &SMALL.replace("4.0", "6.0"));
+    assert_one_line_error(&moreau(&["sweep", s(&other), "--out", s(&out), "-q"]), "different sweep");
+    assert_eq!(std::fs::read(out.join("sweep.tex")).unwrap(), before);
+}
+
+#[test]
+fn figures_are_written_as_svg_and_png_with_text() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("fig");
+    for kind in ["psi", "tube", "trajectory"] {
+        let o = moreau(&["figure", kind, "examples/worked-example.toml", "--out", s(&out)]);
+        assert!(o.status.success(), "{kind}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    for (stem, text) in
+        [("fig-psi1", "ψ(γ)"), ("fig-loop", "η_T"), ("trajectory-yz", "y = C x"), ("trajectory-x", "x1")]
+    {
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        assert!(svg.contains("<text") && svg.contains(text), "{stem}.svg lacks `{text}`");
+        let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
+        assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "{stem}.png");
+    }
+    let o = moreau(&["figure", "sweep", "examples/sweeps/amplitude", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("sweep-theta-measured_rate.svg").exists());
+    let o = moreau(&["figure", "sweep", "examples/sweeps/amplitude", "--out", s(&out), "--columns", "theta,nonsense"]);
+    assert_one_line_error(&o, "no numeric column `nonsense`");
+}
