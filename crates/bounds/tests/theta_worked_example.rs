@@ -77,8 +77,9 @@ fn theta_is_monotone_in_its_parts_negative_control() {
     assert!((psi.theta(r.gamma_1, r.gamma_inf) - r.theta).abs() < 1e-15);
     assert!(psi.theta(r.gamma_1 * 1.5, r.gamma_inf) < r.theta);
     assert!(psi.theta(r.gamma_1, r.gamma_inf * 1.5) > r.theta);
-    // Tube accessor: C Xi_inf for p = 1 is an interval symmetric about 0; d = its width + 0.2.
-    let (a, b) = (r.tube_support(&[1.0]), r.tube_support(&[-1.0]));
+    // The output tube: C Xi_inf for p = 1 is an interval symmetric about 0; d = its width + 0.2.
+    let tube = bounds::tube::OutputTube::new(&sys, &ThetaSettings::bound_only().tube).unwrap();
+    let (a, b) = (tube.tube_support(&[1.0]), tube.tube_support(&[-1.0]));
     assert!((a.upper - b.upper).abs() < 1e-12);
     assert!((2.0 * a.upper + 0.2 - r.d).abs() < 1e-9, "{} vs {}", 2.0 * a.upper + 0.2, r.d);
 }
@@ -122,6 +123,7 @@ fn assemble_is_deterministic_and_thread_safe() {
     // psi as a function and the tube support function are usable from the report.
     let psi = reference.psi();
     assert!(psi.eval(0.0) == reference.psi_0 && psi.limit() == -reference.lambda);
-    let up = reference.tube_theta_support_upper(&[1.0, 0.0]);
-    assert!(up > reference.tube_support(&[1.0, 0.0]).upper);
+    let tube = bounds::tube::OutputTube::new(&sys, &s.tube).unwrap();
+    let up = tube.support_upper(&[1.0, 0.0]);
+    assert!(up > tube.tube_support(&[1.0, 0.0]).upper);
 }

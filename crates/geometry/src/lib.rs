@@ -19,6 +19,8 @@
 //! - [`sublinear_max`]: sharper certified maxima over the unit sphere of sublinear functions
 //!   (sums of support functions, eqs. (d), (zinf)) by conic combination on arcs and triangles.
 //! - [`curvature`]: numerical `R` of planar sets from the support function.
+//! - `strategies` (feature `proptest-support`): seeded proptest strategies for random sets
+//!   containing 0 and points with inward normals, shared by the tests of every crate.
 //!
 //! All points are plain `&[f64]` slices so that hot loops (the catching-up integrator)
 //! neither allocate nor convert.
@@ -33,6 +35,8 @@ pub mod normal_cone;
 pub mod ops;
 pub mod shapes;
 pub mod sphere_max;
+#[cfg(feature = "proptest-support")]
+pub mod strategies;
 pub mod strong_convexity;
 pub mod sublinear_max;
 

@@ -14,9 +14,9 @@
 //! samples are exact, and the sampled maximum of `|eta_T'|` is not an upper bound, so both are
 //! reported as estimates (`verified = false`).
 use crate::error::BoundsError;
-use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
+use dynamics::periodic::linearised::{linearised_periodic, sine_phasor, LinearisedSettings};
 use model::{Input, System};
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DVector};
 use std::f64::consts::TAU;
 
 /// Settings of the orbit samples.
@@ -34,6 +34,7 @@ impl Default for OrbitSettings {
 
 /// Samples of `eta_T`, `eta_T'` and the two quantities of Theorem 2 computed from them.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct EtaOrbit {
     pub period: f64,
     pub t: Vec<f64>,
@@ -89,15 +90,11 @@ impl EtaOrbit {
 
     fn sine(sys: &System, a: &[f64], omega: f64, phase: f64, T: f64, K: usize) -> Self {
         let n = sys.n();
-        let F = sys.F();
-        let Ba = &sys.B * DVector::from_column_slice(a);
-        let M: DMatrix<Complex<f64>> =
-            DMatrix::from_fn(n, n, |i, j| Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 }));
-        let rhs: DVector<Complex<f64>> = Ba.map(|x| Complex::new(x, 0.0));
-        // Condition number of the complex matrix for the rounding margin.
-        let sv = M.clone().singular_values();
-        let cond = sv.max() / sv.min().max(1e-300);
-        let g = M.lu().solve(&rhs).unwrap_or_else(|| DVector::from_element(n, Complex::new(f64::NAN, f64::NAN)));
+        // g = (i omega I - F)^{-1} B a and the condition number for the rounding margin.
+        let (g, cond) = match sine_phasor(&sys.F(), &sys.B, a, omega) {
+            Some(ph) => (ph.g, ph.cond),
+            None => (DVector::from_element(n, Complex::new(f64::NAN, f64::NAN)), f64::INFINITY),
+        };
         let gr = g.map(|z| z.re);
         let gi = g.map(|z| z.im);
         let P = &sys.C * &gr;

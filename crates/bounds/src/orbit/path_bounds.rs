@@ -40,6 +40,7 @@ pub fn partition_bound(eta: &[&[f64]], d: f64) -> f64 {
 
 /// Result of the (path2) search.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct PackingBound {
     /// `max (2 eps - d) N`.
     pub value: f64,

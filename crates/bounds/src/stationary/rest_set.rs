@@ -51,6 +51,7 @@ impl Default for RestSetSettings {
 
 /// Result of [`rest_set`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct RestSet {
     pub period: f64,
     /// Scan of `Phi` (Theorem 1's hypothesis).

@@ -17,13 +17,12 @@ use crate::report::{BoundKind, Quantity};
 use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
-use crate::tube::{tube_diameters, TubeKernel, TubeSettings};
+use crate::tube::{tube_diameters, TubeSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
-use geometry::{ConvexSet, Shape, SphereMaxSettings};
+use geometry::{ConvexSet, SphereMaxSettings};
 use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
 use model::System;
 use nalgebra::DMatrix;
-use std::sync::Arc;
 
 /// Settings of [`assemble`]. All parts have documented defaults; `measure = None` and
 /// `stationary = None` skip the two costly optional parts (for sweeps).
@@ -159,12 +158,6 @@ pub struct ThetaReport {
     pub tube_s_max: f64,
     pub tube_tail: f64,
     pub notes: Vec<String>,
-    #[serde(skip)]
-    tube_C: Arc<TubeKernel>,
-    #[serde(skip)]
-    theta_set: Shape,
-    #[serde(skip)]
-    orbit: Arc<EtaOrbit>,
 }
 
 /// Computes `theta` and all its parts for `sys`; see the module docs.
@@ -367,9 +360,6 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         tube_s_max: tube_C.s_max,
         tube_tail: tube_C.tail_bound(),
         notes,
-        tube_C: Arc::new(tube_C),
-        theta_set,
-        orbit: Arc::new(orbit),
     })
 }
 
@@ -377,22 +367,6 @@ impl ThetaReport {
     /// `psi` of eq. (phipsi) at the certified `(alpha_lower, lambda, b_hat)`.
     pub fn psi(&self) -> Psi {
         Psi { alpha: self.alpha.lower, lambda: self.lambda, beta: self.beta }
-    }
-
-    /// Enclosure of the support function of `C Xi_inf` (eq. (Xinfsupp) with `u = C^T v`).
-    pub fn tube_support(&self, v: &[f64]) -> geometry::Bounds {
-        self.tube_C.support_bounds(v)
-    }
-
-    /// Upper bound of the support function of `C Xi_inf + Theta` (the cross-section of the
-    /// tube of Fig. loop around `eta_T`).
-    pub fn tube_theta_support_upper(&self, v: &[f64]) -> f64 {
-        self.tube_C.support_upper(v) + self.theta_set.support(v)
-    }
-
-    /// The orbit `eta_T` (samples, closed-form `osc`, `||eta_T'||`).
-    pub fn orbit(&self) -> &EtaOrbit {
-        &self.orbit
     }
 
     /// The labelled quantities in report order ([`crate::report::defs::ALL`]; the stationary

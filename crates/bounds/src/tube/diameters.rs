@@ -16,6 +16,7 @@ use nalgebra::{DMatrix, DVector};
 
 /// `d` and `D(C(F Xi_inf + E Theta),{0})` with the kernels that produced them.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct TubeDiameters {
     /// Kernel of `sigma_{C Xi_inf}`.
     pub tube_C: TubeKernel,
@@ -93,4 +94,33 @@ pub fn tube_diameters(
         d_ftheta: Bounds { lower: df_lower, upper: df_b.upper },
         verified,
     })
+}
+
+/// The cross-section `C Xi_inf + Theta` of the tube around the orbit `eta_T` (Fig. loop of the
+/// paper): its support function from above, for figures and for callers that need the tube
+/// without the rest of the theta computation.
+#[derive(Debug, Clone)]
+pub struct OutputTube {
+    /// Kernel of `sigma_{C Xi_inf}`.
+    pub kernel: TubeKernel,
+    /// The backlash set `Theta`.
+    pub theta: Shape,
+}
+
+impl OutputTube {
+    /// Builds the kernel of `sigma_{C Xi_inf}` for `sys` (`F = A + E C`, eq. (F)).
+    pub fn new(sys: &model::System, tube: &TubeSettings) -> Result<Self, BoundsError> {
+        let kernel = TubeKernel::new(&sys.C, &sys.F(), &sys.E, &sys.theta, Horizon::Infinite, tube)?;
+        Ok(Self { kernel, theta: sys.theta.clone() })
+    }
+
+    /// Enclosure of `sigma_{C Xi_inf}(v)` (eq. (Xinfsupp) with `u = C^T v`).
+    pub fn tube_support(&self, v: &[f64]) -> Bounds {
+        self.kernel.support_bounds(v)
+    }
+
+    /// Upper bound of `sigma_{C Xi_inf + Theta}(v)`.
+    pub fn support_upper(&self, v: &[f64]) -> f64 {
+        self.kernel.support_upper(v) + self.theta.support(v)
+    }
 }

@@ -5,6 +5,6 @@
 pub mod diameters;
 pub mod xi_support;
 
-pub use diameters::{tube_diameters, TubeDiameters};
+pub use diameters::{tube_diameters, OutputTube, TubeDiameters};
 pub use geometry::sublinear_sphere_max;
 pub use xi_support::{dxx_bound, exp_norm_integral, Horizon, TubeKernel, TubeSettings};

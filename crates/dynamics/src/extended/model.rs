@@ -486,6 +486,7 @@ pub fn simulate_trajectory(
 /// paper's uniqueness argument does not cover effects, so no fixed point is claimed: the
 /// residuals say whether successive periods still differ).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct SimulatedRegime {
     pub period: f64,
     pub h: f64,

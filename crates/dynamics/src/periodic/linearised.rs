@@ -164,6 +164,31 @@ pub fn linearised_periodic(sys: &System, settings: &LinearisedSettings) -> Resul
     Ok(LinearisedPeriodic { period: T, t, xi: cols(&X), dxi: cols(&dX), eta: cols(&Y), deta: cols(&dY), exact })
 }
 
+/// The phasor of the `T`-periodic solution for a sine input `w = a sin(omega t + phase)`:
+/// `g = (i omega I - F)^{-1} B a`, so `xi_T(t) = Im(g e^{i(omega t + phase)})`, with the
+/// condition number of `i omega I - F` (for rounding margins). `None` when `i omega` is an
+/// eigenvalue of `F` to working precision.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SinePhasor {
+    pub g: DVector<Complex<f64>>,
+    /// `sigma_max / sigma_min` of `i omega I - F`.
+    pub cond: f64,
+}
+
+/// See [`SinePhasor`]: the one place where `(i omega I - F)^{-1} B a` is solved (used by
+/// [`sine_frequency_response`] and by the closed-form orbit of `bounds`).
+pub fn sine_phasor(F: &DMatrix<f64>, B: &DMatrix<f64>, a: &[f64], omega: f64) -> Option<SinePhasor> {
+    let n = F.nrows();
+    let M: DMatrix<Complex<f64>> =
+        DMatrix::from_fn(n, n, |i, j| Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 }));
+    let Ba = B * DVector::from_column_slice(a);
+    let rhs: DVector<Complex<f64>> = Ba.map(|x| Complex::new(x, 0.0));
+    let sv = M.clone().singular_values();
+    let cond = sv.max() / sv.min().max(1e-300);
+    let g = M.lu().solve(&rhs)?;
+    Some(SinePhasor { g, cond })
+}
+
 /// Closed form for a sine input, for checks: `xi_T(t) = Im[(i omega I - F)^{-1} B a e^{i(omega t + phase)}]`.
 pub fn sine_frequency_response(
     F: &DMatrix<f64>,
@@ -173,15 +198,9 @@ pub fn sine_frequency_response(
     phase: f64,
     t: f64,
 ) -> Option<DVector<f64>> {
-    let n = F.nrows();
-    let M: DMatrix<Complex<f64>> = DMatrix::from_fn(n, n, |i, j| {
-        // i omega I - F
-        Complex::new(-F[(i, j)], if i == j { omega } else { 0.0 })
-    });
-    let Ba = B * DVector::from_column_slice(a);
-    let rhs: DVector<Complex<f64>> = Ba.map(|v| Complex::new(v, 0.0) * Complex::new(0.0, omega * t + phase).exp());
-    let sol = M.lu().solve(&rhs)?;
-    Some(sol.map(|c| c.im))
+    let ph = sine_phasor(F, B, a, omega)?;
+    let e = Complex::new(0.0, omega * t + phase).exp();
+    Some(ph.g.map(|c| (c * e).im))
 }
 
 #[cfg(test)]

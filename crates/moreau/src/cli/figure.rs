@@ -78,9 +78,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                     vec![("fig-psi1".into(), figures::psi::from_report(&r))]
                 }
                 Kind::Tube => {
-                    let r = bounds::theta::assemble(&sys, &bounds::theta::ThetaSettings::bound_only())?;
+                    let settings = bounds::theta::ThetaSettings::bound_only();
+                    let orbit = bounds::orbit::EtaOrbit::new(&sys, &settings.orbit)?;
+                    let tube = bounds::tube::OutputTube::new(&sys, &settings.tube)?;
                     let z = figures::tube::periodic_z(&sys, 2000)?;
-                    vec![("fig-loop".into(), figures::tube::tube_figure(&sys, &r, &z))]
+                    vec![("fig-loop".into(), figures::tube::tube_figure(&sys, &orbit, &tube, &z))]
                 }
                 Kind::Sweep => unreachable!("handled above"),
             }

@@ -6,7 +6,8 @@
 //! orbit points).
 use super::canvas::{Element, Figure, BLUE, RED};
 use super::FigureError;
-use bounds::theta::ThetaReport;
+use bounds::orbit::EtaOrbit;
+use bounds::tube::OutputTube;
 use dynamics::integrators::catching_up::CatchingUpSettings;
 use dynamics::periodic::poincare::{periodic_regime, PoincareSettings};
 use model::System;
@@ -69,9 +70,9 @@ pub fn support_polygon(p: usize, k: usize, h: impl Fn(&[f64]) -> f64) -> Vec<(f6
         .collect()
 }
 
-/// Fig. loop for `sys` and its theta report (`z_periodic` from [`periodic_z`]).
-pub fn tube_figure(sys: &System, r: &ThetaReport, z_periodic: &PeriodicZ) -> Figure {
-    let orbit = r.orbit();
+/// Fig. loop for `sys`: the orbit `eta_T`, the tube cross-sections `C Xi_inf + Theta` (from
+/// above) and the simulated periodic `z` (`z_periodic` from [`periodic_z`]).
+pub fn tube_figure(sys: &System, orbit: &EtaOrbit, tube: &OutputTube, z_periodic: &PeriodicZ) -> Figure {
     let p = sys.p();
     let (tz, z) = (&z_periodic.t, &z_periodic.z);
     let z_label = if z_periodic.converged {
@@ -80,8 +81,8 @@ pub fn tube_figure(sys: &System, r: &ThetaReport, z_periodic: &PeriodicZ) -> Fig
         format!("z (fixed point NOT converged, residual {:.1e})", z_periodic.residual)
     };
     if p == 1 {
-        let up: Vec<f64> = orbit.eta.iter().map(|e| e[0] + r.tube_theta_support_upper(&[1.0])).collect();
-        let lo: Vec<f64> = orbit.eta.iter().map(|e| e[0] - r.tube_theta_support_upper(&[-1.0])).collect();
+        let up: Vec<f64> = orbit.eta.iter().map(|e| e[0] + tube.support_upper(&[1.0])).collect();
+        let lo: Vec<f64> = orbit.eta.iter().map(|e| e[0] - tube.support_upper(&[-1.0])).collect();
         let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "t (one period)", "η_T, z");
         f.elements.push(Element::Band {
             label: "tube η_T + C Ξ∞ + Θ".into(),
@@ -106,7 +107,7 @@ pub fn tube_figure(sys: &System, r: &ThetaReport, z_periodic: &PeriodicZ) -> Fig
     }
     let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "η₁, z₁", "η₂, z₂");
     f.equal_aspect = true;
-    let section = support_polygon(p, 96, |v| r.tube_theta_support_upper(v));
+    let section = support_polygon(p, 96, |v| tube.support_upper(v));
     let m = orbit.eta.len();
     let count = 40.min(m);
     for (n, i) in (0..count).map(|j| j * (m - 1) / count.max(1)).enumerate() {

@@ -3,7 +3,8 @@
 //! They generate parameters, not objects, so that shrinking moves towards simple cases;
 //! every `*Params` has a `build` method.
 pub mod inputs;
-pub mod sets;
+/// Random sets and points: `geometry::strategies` (feature `proptest-support`).
+pub use geometry::strategies as sets;
 pub mod systems;
 
 /// `count` values drawn from `strategy` by a deterministic generator seeded with `seed`

@@ -1,18 +1,19 @@
-//! Random convex compacts `Theta` containing the origin (eq. (0inZ)), with bounded
+//! Proptest strategies (feature `proptest-support`), shared by the property tests of every
+//! crate: random convex compacts `Theta` containing the origin (eq. (0inZ)), with bounded
 //! conditioning, and random points with inward normals on them (eq. (N)).
 //!
 //! Strategies generate *parameters* ([`SetParams`], [`PointParams`]) rather than sets, so that
 //! proptest shrinks towards simple shapes (axis-aligned, centred, unit scale); the set is
 //! built by [`SetParams::build`]. Every generated set contains `0` with a margin, so it can
 //! be the backlash set of a model file.
-use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, Polytope, Shape};
+use crate::{Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, Polytope, Shape};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
 
 /// Largest dimension the strategies generate.
 pub const MAX_P: usize = 4;
 
-/// The parametric shapes of `geometry::Shape`.
+/// The parametric shapes of `crate::Shape`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SetKind {
     Interval,
@@ -85,7 +86,7 @@ pub struct SetParams {
 }
 
 fn unit(v: &[f64]) -> Vec<f64> {
-    let n = geometry::linalg::norm(v);
+    let n = crate::linalg::norm(v);
     if n < 1e-9 {
         let mut e = vec![0.0; v.len()];
         e[0] = 1.0;
