@@ -14,7 +14,7 @@
 //! - [`convergence`]: error of catching-up against the reference for a ladder of steps, order.
 //! - [`periodic::poincare`]: fixed point of the Poincare map, residual;
 //!   [`periodic::linearised`]: `xi_T`, `eta_T` (eqs. (xT) corrected, (xiT), (etaT)) and their
-//!   derivatives on a grid; [`periodic::localisation`]: check of (loc).
+//!   derivatives on a grid (the (loc) check is in `bounds::tube::localisation`).
 //! - [`rate::lyapunov_exponent`]: `(1/2) limsup (1/t) ln V`, `V` of eq. (V_Gamma), by
 //!   regression over periods with a 95% interval and Benettin renormalisation;
 //!   [`rate::path_length`]: path length of `z` per period and `max |z'|`.

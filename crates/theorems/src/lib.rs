@@ -2,10 +2,12 @@
 //! (`../shared/paper/strongly-convex-backlash.tex`), shared by `cargo test -p theorems` and
 //! `moreau check`.
 //!
-//! - [`strategies`]: seeded proptest strategies for random strongly convex sets, points with
-//!   inward normals, Hurwitz systems with controlled `mu`, periodic inputs;
+//! - [`strategies`]: seeded proptest strategies for random strongly convex sets and points with
+//!   inward normals (`geometry::strategies`, feature `proptest-support`), Hurwitz systems with
+//!   controlled `mu`, periodic inputs;
 //! - [`properties`]: one module per result, named after it (`lemma_a2.rs` checks eq.
-//!   (lem1:2)), each with a negative control that must fail;
+//!   (lem1:2)), each with a negative control that must fail; Lemma 2 and Theorem 2 check the
+//!   production kernels of `bounds::tube` (the numbers `moreau theta` prints), not a copy;
 //! - [`campaign`]: the deterministic runner (cases, minimum normalised slack, violations,
 //!   shrunk counterexample).
 //!

@@ -1,8 +1,10 @@
 //! Tubular localisation of Section 4 (Lemma 2): `x(t) in xi(t) + Xi(t)`, eq. (xX), with the
 //! support functions of `Xi(t)` and `Xi_inf` (eqs. (Xsupp), (Xinfsupp)) and the tail bound
 //! (DXX). See [`xi_support`]; the tube diameters `d` (eq. (d)) and `D(C(F Xi_inf + E Theta),{0})`
-//! (eq. (zinf)) of Theorem 2: [`diameters`].
+//! (eq. (zinf)) of Theorem 2: [`diameters`]; the check of (loc) for a periodic state:
+//! [`localisation`].
 pub mod diameters;
+pub mod localisation;
 pub mod xi_support;
 
 pub use diameters::{tube_diameters, OutputTube, TubeDiameters};

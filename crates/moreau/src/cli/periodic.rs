@@ -2,8 +2,8 @@
 //! the Poincare map), its residual and the (loc) check, the measured convergence exponent with
 //! its 95% interval, and the path length of z per period.
 use anyhow::{bail, Context};
+use bounds::tube::localisation::{check_localisation, LocalisationSettings};
 use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
-use dynamics::periodic::localisation::{check_localisation, LocalisationSettings};
 use dynamics::periodic::poincare::{periodic_regime, PoincareSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
 use std::path::PathBuf;
@@ -48,7 +48,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let reg = periodic_regime(&sys, &PoincareSettings { dt, ..Default::default() })?;
     let lin = linearised_periodic(&sys, &LinearisedSettings::default())?;
-    let loc = check_localisation(&sys, lin.xi0(), &reg.x0, &reg.z0, &LocalisationSettings::default());
+    let loc = check_localisation(&sys, lin.xi0(), &reg.x0, &reg.z0, &LocalisationSettings::default())?;
     let transient = (a.periods / 6).max(1).min(10);
     let rate = measure_rate(
         &sys,

@@ -4,8 +4,11 @@
 //!
 //! `x - xi_T(0) in Xi_inf` iff `u . (x - xi_T(0)) <= sigma(u)` for every `u`; this checks it for
 //! the `2n` coordinate directions and `random_directions` seeded random unit vectors, with
-//! `sigma` by the trapezoid rule up to the time where `|e^{sF}| < 1e-14`. A numerical CHECK of
-//! a necessary condition (not a certificate): it reports the worst margin.
+//! `sigma` from above by the certified quadrature of [`TubeKernel`] (`L = I_n`), the same kernel
+//! as the bounds of `theta`. A numerical CHECK of a necessary condition (not a certificate): it
+//! reports the worst margin.
+use crate::error::BoundsError;
+use crate::tube::{Horizon, TubeKernel, TubeSettings};
 use geometry::ConvexSet;
 use model::System;
 use nalgebra::{DMatrix, DVector};
@@ -18,17 +21,20 @@ pub struct LocalisationSettings {
     pub random_directions: usize,
     /// Seed of the directions. Default `7`.
     pub seed: u64,
-    /// Quadrature step for (Xinfsupp). Default `2e-3`.
-    pub ds: f64,
-    /// Accept margins down to `-tol_abs (1 + |x|)` (quadrature error). Default `1e-6`.
+    /// Quadrature of (Xinfsupp). Default: `tol_abs = 1e-7` per unit direction.
+    pub tube: TubeSettings,
+    /// Accept margins down to `-tol_abs (1 + |x|)` (rounding of the periodic state). Default `1e-6`.
     pub tol_abs: f64,
-    /// Upper limit of the time integral. Default `2000`.
-    pub max_time: f64,
 }
 
 impl Default for LocalisationSettings {
     fn default() -> Self {
-        Self { random_directions: 64, seed: 7, ds: 2e-3, tol_abs: 1e-6, max_time: 2000.0 }
+        Self {
+            random_directions: 64,
+            seed: 7,
+            tube: TubeSettings { tol_abs: 1e-7, ..TubeSettings::default() },
+            tol_abs: 1e-6,
+        }
     }
 }
 
@@ -44,44 +50,6 @@ pub struct LocalisationCheck {
     pub directions: usize,
 }
 
-/// Quadrature nodes `e^{s_k F} E` for (Xinfsupp).
-pub struct XiInfSupport<'a> {
-    theta: &'a geometry::Shape,
-    nodes: Vec<DMatrix<f64>>,
-    ds: f64,
-}
-
-impl<'a> XiInfSupport<'a> {
-    pub fn new(sys: &'a System, ds: f64, max_time: f64) -> Self {
-        let F = sys.F();
-        let step = (&F * ds).exp();
-        let mut P = DMatrix::<f64>::identity(sys.n(), sys.n());
-        let mut nodes = Vec::new();
-        let mut s = 0.0;
-        while s <= max_time {
-            nodes.push((&P * &sys.E).transpose());
-            if P.norm() < 1e-14 {
-                break;
-            }
-            P = &step * &P;
-            s += ds;
-        }
-        Self { theta: &sys.theta, nodes, ds }
-    }
-    /// `sigma_{Xi_inf}(u)` by the trapezoid rule.
-    pub fn support(&self, u: &[f64]) -> f64 {
-        let u = DVector::from_column_slice(u);
-        let k = self.nodes.len();
-        let mut s = 0.0;
-        for (i, M) in self.nodes.iter().enumerate() {
-            let v = M * &u;
-            let f = self.theta.support(v.as_slice());
-            s += if i == 0 || i + 1 == k { 0.5 * f } else { f };
-        }
-        s * self.ds
-    }
-}
-
 /// Checks (loc) for the periodic state `(x, z)` given `xi_T(0)`.
 pub fn check_localisation(
     sys: &System,
@@ -89,9 +57,10 @@ pub fn check_localisation(
     x: &[f64],
     z: &[f64],
     settings: &LocalisationSettings,
-) -> LocalisationCheck {
+) -> Result<LocalisationCheck, BoundsError> {
     let n = sys.n();
-    let sup = XiInfSupport::new(sys, settings.ds, settings.max_time);
+    let I = DMatrix::<f64>::identity(n, n);
+    let sup = TubeKernel::new(&I, &sys.F(), &sys.E, &sys.theta, Horizon::Infinite, &settings.tube)?;
     let d: Vec<f64> = x.iter().zip(xi_T0).map(|(a, b)| a - b).collect();
     let mut dirs: Vec<Vec<f64>> = Vec::new();
     for i in 0..n {
@@ -110,7 +79,7 @@ pub fn check_localisation(
     let mut worst = f64::INFINITY;
     let mut worst_dir = vec![0.0; n];
     for u in &dirs {
-        let m = sup.support(u) - geometry::linalg::dot(u, &d);
+        let m = sup.support_upper(u) - geometry::linalg::dot(u, &d);
         if m < worst {
             worst = m;
             worst_dir = u.clone();
@@ -119,36 +88,38 @@ pub fn check_localisation(
     let q: Vec<f64> = (DVector::from_column_slice(z) - &sys.C * DVector::from_column_slice(x)).as_slice().to_vec();
     let q_in = sys.theta.contains(&q, 1e-9);
     let tol = settings.tol_abs * (1.0 + geometry::linalg::norm(x));
-    LocalisationCheck {
+    Ok(LocalisationCheck {
         inside: q_in && worst >= -tol,
         worst_margin: worst,
         worst_direction: worst_dir,
         q_in_theta: q_in,
         directions: dirs.len(),
-    }
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::periodic::linearised::{linearised_periodic, LinearisedSettings};
-    use crate::periodic::poincare::{periodic_regime, PoincareSettings};
+    use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
+    use dynamics::periodic::poincare::{periodic_regime, PoincareSettings};
 
     #[test]
     fn periodic_state_is_inside_and_a_far_point_is_not() {
         let sys = model::parse_str(include_str!("../../../../examples/worked-example.toml")).unwrap();
         let r = periodic_regime(&sys, &PoincareSettings::default()).unwrap();
         let L = linearised_periodic(&sys, &LinearisedSettings { samples: 10, substeps: 1 }).unwrap();
-        let c = check_localisation(&sys, L.xi0(), &r.x0, &r.z0, &LocalisationSettings::default());
+        let c = check_localisation(&sys, L.xi0(), &r.x0, &r.z0, &LocalisationSettings::default()).unwrap();
         assert!(c.inside, "{c:?}");
         // sigma_{Xi_inf}(e_1) for the worked example: int_0^inf 0.1 |(e^{sF} E)_1| ds, finite, > 0
-        let sup = XiInfSupport::new(&sys, 2e-3, 2000.0);
-        let s1 = sup.support(&[1.0, 0.0]);
+        let I = DMatrix::<f64>::identity(2, 2);
+        let sup =
+            TubeKernel::new(&I, &sys.F(), &sys.E, &sys.theta, Horizon::Infinite, &TubeSettings::default()).unwrap();
+        let s1 = sup.support_upper(&[1.0, 0.0]);
         assert!(s1 > 0.01 && s1 < 1.0, "{s1}");
         // negative control: move x by twice the width of Xi_inf along e_1
         let far = vec![r.x0[0] + 2.0 * s1 + 0.01, r.x0[1]];
         let zf = vec![far[0] + (r.z0[0] - r.x0[0])];
-        let c2 = check_localisation(&sys, L.xi0(), &far, &zf, &LocalisationSettings::default());
+        let c2 = check_localisation(&sys, L.xi0(), &far, &zf, &LocalisationSettings::default()).unwrap();
         assert!(!c2.inside && c2.worst_margin < 0.0, "{c2:?}");
     }
 }
