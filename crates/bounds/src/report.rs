@@ -129,6 +129,22 @@ pub mod defs {
         q("psi_limit", "-lambda", "$-\\lambda$", "(psilim)", Exact, "limit of psi at infinity");
     pub const THETA: QuantityDef =
         q("theta", "theta", "$\\theta$", "(theta)", Upper, "psi(0) - (gamma_1/gamma_inf)(psi(0) - psi(gamma_inf))");
+    pub const GAMMA_1_STAR: QuantityDef = q(
+        "gamma_1_star",
+        "gamma_1*",
+        "$\\gamma_1^*$",
+        "(g1),(path1)",
+        Lower,
+        "max((path), (path1), (path2)) / (T R), R upper",
+    );
+    pub const THETA_STAR: QuantityDef = q(
+        "theta_star",
+        "theta*",
+        "$\\theta^*$",
+        "(theta),(path1)",
+        Upper,
+        "eq. (theta) with gamma_1* (beyond the paper, proofs-notes/theta-star.md)",
+    );
     pub const PATH_BOUND: QuantityDef =
         q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");
     pub const PATH1_BOUND: QuantityDef =
@@ -165,7 +181,7 @@ pub mod defs {
     );
 
     /// All of them, in report order.
-    pub const ALL: [&QuantityDef; 26] = [
+    pub const ALL: [&QuantityDef; 28] = [
         &PERIOD,
         &MU,
         &R,
@@ -184,6 +200,8 @@ pub mod defs {
         &PSI_INF,
         &PSI_LIMIT,
         &THETA,
+        &GAMMA_1_STAR,
+        &THETA_STAR,
         &PATH_BOUND,
         &PATH1_BOUND,
         &PATH2_BOUND,

@@ -127,3 +127,17 @@ fn assemble_is_deterministic_and_thread_safe() {
     let up = tube.support_upper(&[1.0, 0.0]);
     assert!(up > tube.tube_support(&[1.0, 0.0]).upper);
 }
+
+#[test]
+fn theta_star_is_sharper_and_verified_on_the_worked_example() {
+    let sys = load("worked-example.toml");
+    let r = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
+    assert!((r.theta + 0.017232).abs() < 1e-5, "paper's theta unchanged: {}", r.theta);
+    assert!(r.theta_star <= -0.095 && r.theta_star_verified, "theta* = {}", r.theta_star);
+    assert_eq!(r.theta_best_method, "theta_star");
+    assert!(r.gamma_1_star >= r.gamma_1 && r.kappa_star <= 1.0);
+    // Negative control: an overestimated path (d ignored) gives a smaller, invalid theta*.
+    let psi = bounds::theta::Psi { alpha: r.alpha.lower, lambda: r.lambda_star, beta: r.beta_star };
+    let too_long = (r.osc * 2.0) / (r.period * r.R);
+    assert!(psi.theta(too_long, r.gamma_inf) < r.theta_star);
+}

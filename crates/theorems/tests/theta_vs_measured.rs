@@ -56,6 +56,9 @@ fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
                 .expect("assembled once already");
         let m = full.measured.expect("measured side computed");
         out.push((format!("case {i} (n = {}, mu = {:.3})", sys.n(), full.mu), full.theta, m.ci_low, m.ci_high));
+        if full.theta_star_verified {
+            out.push((format!("case {i} theta* (n = {})", sys.n()), full.theta_star, m.ci_low, m.ci_high));
+        }
     }
     (out, tried)
 }

@@ -142,8 +142,28 @@ pub struct ThetaReport {
     /// Kinds of the model's `[[effects]]`: physics outside the paper's class (theta is then
     /// computed for the nominal model and is not verified for the model).
     pub effects: Vec<String>,
-    /// `theta < 0` and verified: a unique periodic regime attracting at rate `theta`.
+    /// The best verified bound ([`ThetaReport::theta_best`]) is `< 0`: a unique periodic regime
+    /// attracting at that rate.
     pub convergence_guaranteed: bool,
+    /// `gamma_1* = max((path), (path1), (path2)) / (T R)` (from below; `>= gamma_1`).
+    pub gamma_1_star: f64,
+    /// `gamma_1* / gamma_inf`.
+    pub kappa_star: f64,
+    /// `theta*`: eq. (theta) with `gamma_1*` (beyond the paper; proofs-notes/theta-star.md),
+    /// minimised over the certified `(lambda, b_hat)` of the lambda search.
+    pub theta_star: f64,
+    pub theta_star_verified: bool,
+    /// The certified `(lambda, b_hat)` at which `theta*` is attained.
+    pub lambda_star: f64,
+    pub beta_star: f64,
+    /// Which path bound gives `gamma_1*`: `(path)`, `(path1)` or `(path2)`.
+    pub path_best_method: &'static str,
+    /// The smallest verified bound of the exponent (`theta` or `theta*`), or `theta` when none
+    /// is verified.
+    pub theta_best: f64,
+    /// `"theta"` or `"theta_star"`.
+    pub theta_best_method: &'static str,
+    pub theta_best_verified: bool,
     pub path_bound: f64,
     pub path1_bound: f64,
     /// Number of grid points of the (path1) dynamic programme.
@@ -260,6 +280,32 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let path1 = partition_bound(&sub, d).max(path_b.min(0.0));
     let path2 = packing_bound(&all[..all.len() - 1], d, osc, settings.packing_eps);
 
+    // theta* (beyond eq. (g1)): the chord argument of eq. (theta) with gamma_1 from the
+    // strongest proven path bound. Over a window of k periods the path of z is at least
+    // k S - (one wrap-around term), S any cyclic partition sum (path1) or packing sum (path2),
+    // so the long-run mean of |z'|/R is at least S / (T R): the same chord (psiup) then gives
+    // theta* (proofs-notes/theta-star.md). Each (lambda, b_hat) of the certified curve gives a
+    // valid theta*; the best is kept.
+    let (path_best, path_best_method) = [(path_b, "(path)"), (path1, "(path1)"), (path2.value, "(path2)")]
+        .into_iter()
+        .fold((0.0f64, "(path)"), |a, b| if b.0 > a.0 { b } else { a });
+    // Rounding of the sums of distances (at most 2000 terms, each within a few ulps): a relative
+    // margin far above it.
+    let path_safe = path_best * (1.0 - 1e-10);
+    let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
+    let kappa_star = if gamma_inf > 0.0 { down(gamma_1_star / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
+    let (theta_star, lambda_star, beta_star) = curve
+        .iter()
+        .map(|&(l, b, _)| (Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf), l, b))
+        .fold((theta, opt.value.lambda, opt.value.beta), |a, c| if c.0 < a.0 { c } else { a });
+    // The same proof obligations as theta (the path bounds use the same d and orbit samples).
+    let theta_star_verified = theta_verified;
+    let (theta_best, theta_best_method, theta_best_verified) = if theta_star_verified && theta_star < theta {
+        (theta_star, "theta_star", true)
+    } else {
+        (theta, "theta", theta_verified)
+    };
+
     // Stationary set (Theorem 1).
     let stationary = match &settings.stationary {
         Some(st) => match rest_set(sys, st) {
@@ -309,6 +355,9 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         if theta < 0.0 && m.rate > theta {
             notes.push(format!("measured exponent {:.4} exceeds theta {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta));
         }
+        if theta_best < 0.0 && m.rate > theta_best && theta_best < theta {
+            notes.push(format!("measured exponent {:.4} exceeds theta_star {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta_best));
+        }
     }
 
     let Pi: Vec<Vec<f64>> =
@@ -348,7 +397,17 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         theta,
         theta_verified,
         effects,
-        convergence_guaranteed: theta_verified && theta < 0.0,
+        convergence_guaranteed: theta_best_verified && theta_best < 0.0,
+        gamma_1_star,
+        kappa_star,
+        theta_star,
+        theta_star_verified,
+        lambda_star,
+        beta_star,
+        path_best_method,
+        theta_best,
+        theta_best_method,
+        theta_best_verified,
         path_bound: path_b,
         path1_bound: path1,
         path1_grid: sub.len(),
@@ -396,6 +455,12 @@ impl ThetaReport {
             PSI_INF.with(self.psi_inf, psi_ok),
             PSI_LIMIT.with(-self.lambda, cert),
             THETA.with(self.theta, self.theta_verified),
+            GAMMA_1_STAR
+                .with(self.gamma_1_star, orb && r_ok && self.d_verified)
+                .note(format!("{} / (T R), R upper", self.path_best_method)),
+            THETA_STAR
+                .with(self.theta_star, self.theta_star_verified)
+                .note(format!("eq. (theta) with gamma_1*, at lambda = {:.6}", self.lambda_star)),
             PATH_BOUND.with(self.path_bound, orb && self.d_verified),
             PATH1_BOUND
                 .with(self.path1_bound, orb && self.d_verified)
@@ -466,6 +531,11 @@ impl ThetaReport {
         m.insert("orbit_verified".into(), json!(self.orbit_verified));
         m.insert("d_verified".into(), json!(self.d_verified));
         m.insert("theta_verified".into(), json!(self.theta_verified));
+        m.insert("theta_star_verified".into(), json!(self.theta_star_verified));
+        m.insert("theta_best".into(), json!(f(self.theta_best)));
+        m.insert("theta_best_method".into(), json!(self.theta_best_method));
+        m.insert("theta_best_verified".into(), json!(self.theta_best_verified));
+        m.insert("kappa_star".into(), json!(f(self.kappa_star)));
         m.insert("convergence_guaranteed".into(), json!(self.convergence_guaranteed));
         m.insert("effects".into(), json!(self.effects));
         m.insert("pi".into(), json!(self.Pi));
@@ -481,6 +551,15 @@ impl ThetaReport {
             quantities.iter().map(|q| serde_json::to_value(q).unwrap_or_default()).collect();
         m.insert("quantities".into(), json!(qs));
         serde_json::Value::Object(m)
+    }
+}
+
+/// The largest float below `x` (for values that must be rounded down; `x` finite).
+fn down(x: f64) -> f64 {
+    if x.is_finite() && x != 0.0 {
+        x.next_down()
+    } else {
+        x
     }
 }
 

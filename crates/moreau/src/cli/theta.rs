@@ -63,6 +63,12 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
             fmt_value(rep.theta),
             rep.effects.join(", ")
         )
+    } else if rep.convergence_guaranteed && rep.theta_best_method == "theta_star" {
+        format!(
+            "theta* = {} < 0 (verified; paper's theta = {}): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= theta*.",
+            fmt_value(rep.theta_best),
+            fmt_value(rep.theta)
+        )
     } else if rep.convergence_guaranteed {
         format!(
             "theta = {} < 0 (verified): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= theta.",
