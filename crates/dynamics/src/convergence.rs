@@ -6,7 +6,7 @@ use crate::integrators::catching_up::CatchingUpSettings;
 use crate::integrators::event_driven::{event_driven, EventDrivenSettings};
 use crate::linear::step_map::InputHold;
 use crate::rate::lyapunov_exponent::regression_slope;
-use crate::trajectory::simulate_catching_up;
+use crate::trajectory::{simulate_catching_up, Trajectory};
 use serde::Serialize;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,9 +34,6 @@ pub struct ConvergenceStudy {
 /// simulator against itself at the finest step halved once more (`events = 0`).
 pub fn convergence_study(sys: &model::System, st: &ConvergenceSettings) -> Result<ConvergenceStudy, DynamicsError> {
     crate::error::check_dt(st.h0)?;
-    if !sys.effects.list.is_empty() {
-        return self_convergence(sys, st);
-    }
     if st.levels < 2 {
         return Err(DynamicsError::BadSetting {
             name: "levels",
@@ -46,14 +43,35 @@ pub fn convergence_study(sys: &model::System, st: &ConvergenceSettings) -> Resul
     }
     let n0 = (st.t_end / st.h0).ceil() as usize;
     let h0 = st.t_end / n0 as f64;
-    let (reference, events) =
-        event_driven(sys, &EventDrivenSettings { dt_out: h0, t_end: st.t_end, ..Default::default() })?;
+    if sys.effects.list.is_empty() {
+        let (reference, events) =
+            event_driven(sys, &EventDrivenSettings { dt_out: h0, t_end: st.t_end, ..Default::default() })?;
+        ladder(st, h0, events, &reference, |h, steps, every| {
+            simulate_catching_up(sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, steps, every)
+        })
+    } else {
+        let rr = 1usize << st.levels;
+        let reference = crate::extended::simulate_trajectory(sys, h0 / rr as f64, n0 * rr, rr)?;
+        ladder(st, h0, 0, &reference, |h, steps, every| crate::extended::simulate_trajectory(sys, h, steps, every))
+    }
+}
+
+/// Errors `max |(x, z)_h - (x, z)_ref|_inf` on the grid of `h0` for `h = h0 / 2^l`,
+/// `l < levels`, and the fitted order.
+fn ladder(
+    st: &ConvergenceSettings,
+    h0: f64,
+    events: usize,
+    reference: &Trajectory,
+    simulate: impl Fn(f64, usize, usize) -> Result<Trajectory, DynamicsError>,
+) -> Result<ConvergenceStudy, DynamicsError> {
+    let n0 = (st.t_end / h0).round() as usize;
     let mut hs = Vec::new();
     let mut errs = Vec::new();
     for l in 0..st.levels {
         let r = 1usize << l;
         let h = h0 / r as f64;
-        let tr = simulate_catching_up(sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, n0 * r, r)?;
+        let tr = simulate(h, n0 * r, r)?;
         let mut e: f64 = 0.0;
         for i in 0..reference.len().min(tr.len()) {
             for (u, v) in reference.x_at(i).iter().chain(reference.z_at(i)).zip(tr.x_at(i).iter().chain(tr.z_at(i))) {
@@ -67,39 +85,6 @@ pub fn convergence_study(sys: &model::System, st: &ConvergenceSettings) -> Resul
     let le: Vec<f64> = errs.iter().map(|e| e.max(1e-300).ln()).collect();
     let (order, _) = regression_slope(&lh, &le);
     Ok(ConvergenceStudy { t_end: st.t_end, h: hs, error: errs, order, events })
-}
-
-fn self_convergence(sys: &model::System, st: &ConvergenceSettings) -> Result<ConvergenceStudy, DynamicsError> {
-    if st.levels < 2 {
-        return Err(DynamicsError::BadSetting {
-            name: "levels",
-            value: st.levels as f64,
-            reason: "needs at least 2 steps to fit an order",
-        });
-    }
-    let n0 = (st.t_end / st.h0).ceil() as usize;
-    let h0 = st.t_end / n0 as f64;
-    let rr = 1usize << st.levels;
-    let reference = crate::extended::simulate_trajectory(sys, h0 / rr as f64, n0 * rr, rr)?;
-    let mut hs = Vec::new();
-    let mut errs = Vec::new();
-    for l in 0..st.levels {
-        let r = 1usize << l;
-        let h = h0 / r as f64;
-        let tr = crate::extended::simulate_trajectory(sys, h, n0 * r, r)?;
-        let mut e: f64 = 0.0;
-        for i in 0..reference.len().min(tr.len()) {
-            for (u, v) in reference.x_at(i).iter().chain(reference.z_at(i)).zip(tr.x_at(i).iter().chain(tr.z_at(i))) {
-                e = e.max((u - v).abs());
-            }
-        }
-        hs.push(h);
-        errs.push(e);
-    }
-    let lh: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
-    let le: Vec<f64> = errs.iter().map(|e| e.max(1e-300).ln()).collect();
-    let (order, _) = regression_slope(&lh, &le);
-    Ok(ConvergenceStudy { t_end: st.t_end, h: hs, error: errs, order, events: 0 })
 }
 
 #[cfg(test)]

@@ -218,10 +218,9 @@ impl ConicProgram {
         let mut rowval = Vec::new();
         let mut nzval = Vec::new();
         colptr.push(0);
+        // Rows are appended in increasing order, so each column is already sorted (CSC).
         for col in &self.cols {
-            let mut col = col.clone();
-            col.sort_by_key(|&(r, _)| r);
-            for (r, v) in col {
+            for &(r, v) in col {
                 rowval.push(r);
                 nzval.push(v);
             }
