@@ -145,6 +145,14 @@ pub mod defs {
         Upper,
         "eq. (theta) with gamma_1* (beyond the paper, proofs-notes/theta-star.md)",
     );
+    pub const THETA_PROFILE: QuantityDef = q(
+        "theta_profile",
+        "theta_profile",
+        "$\\theta_{\\mathrm{prof}}$",
+        "(theta),(ydot),(diffs1)",
+        Upper,
+        "chord of eq. (theta) per cell of a speed profile (beyond the paper, proofs-notes/theta-profile.md)",
+    );
     pub const PATH_BOUND: QuantityDef =
         q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");
     pub const PATH1_BOUND: QuantityDef =
@@ -181,7 +189,7 @@ pub mod defs {
     );
 
     /// All of them, in report order.
-    pub const ALL: [&QuantityDef; 28] = [
+    pub const ALL: [&QuantityDef; 29] = [
         &PERIOD,
         &MU,
         &R,
@@ -202,6 +210,7 @@ pub mod defs {
         &THETA,
         &GAMMA_1_STAR,
         &THETA_STAR,
+        &THETA_PROFILE,
         &PATH_BOUND,
         &PATH1_BOUND,
         &PATH2_BOUND,

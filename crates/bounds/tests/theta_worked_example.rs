@@ -103,6 +103,7 @@ fn bad_inputs_give_named_errors_or_reported_cases() {
     assert!(r.R.is_infinite() && r.gamma_1 == 0.0 && r.gamma_inf == 0.0);
     assert_eq!(r.theta, r.psi_0);
     assert!(r.theta > 0.0 && !r.convergence_guaranteed, "alpha = 0 gives psi(0) > 0");
+    assert!(r.theta_profile == r.theta_star && r.profile_intervals == 0, "no profile without strong convexity");
     assert!(r.notes.iter().any(|n| n.contains("not strongly convex")));
 }
 
@@ -134,10 +135,28 @@ fn theta_star_is_sharper_and_verified_on_the_worked_example() {
     let r = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
     assert!((r.theta + 0.017232).abs() < 1e-5, "paper's theta unchanged: {}", r.theta);
     assert!(r.theta_star <= -0.095 && r.theta_star_verified, "theta* = {}", r.theta_star);
-    assert_eq!(r.theta_best_method, "theta_star");
     assert!(r.gamma_1_star >= r.gamma_1 && r.kappa_star <= 1.0);
+    // theta_profile (time-resolved chord, beyond the paper): at least as sharp as theta*, and
+    // the best verified bound.
+    assert!(r.theta_profile_verified && r.theta_profile <= r.theta_star, "{} vs {}", r.theta_profile, r.theta_star);
+    assert!(r.theta_profile <= -0.11, "theta_profile = {}", r.theta_profile);
+    assert_eq!((r.theta_best_method, r.theta_best), ("theta_profile", r.theta_profile));
     // Negative control: an overestimated path (d ignored) gives a smaller, invalid theta*.
     let psi = bounds::theta::Psi { alpha: r.alpha.lower, lambda: r.lambda_star, beta: r.beta_star };
     let too_long = (r.osc * 2.0) / (r.period * r.R);
     assert!(psi.theta(too_long, r.gamma_inf) < r.theta_star);
+}
+
+/// psi(0) >= 0 for every admissible Pi (proofs-notes/psi0.md): the tool's psi(0), evaluated at
+/// b_hat >= beta and alpha_lower <= alpha and rounded up, is never negative on the examples.
+#[test]
+fn psi_at_zero_is_never_negative_on_the_examples() {
+    for name in ["worked-example.toml", "worked-example-a5.toml", "ellipse-p2.toml", "lens-p2.toml", "polytope-p2.toml"] {
+        let r = assemble(&load(name), &ThetaSettings::bound_only()).unwrap();
+        assert!(r.psi_0 >= 0.0, "{name}: psi(0) = {}", r.psi_0);
+        for &(l, b, _) in &r.curve {
+            let psi = bounds::theta::Psi { alpha: r.alpha.lower, lambda: l, beta: b };
+            assert!(psi.at_zero() >= 0.0, "{name}: psi(0) = {} at lambda = {l}", psi.at_zero());
+        }
+    }
 }

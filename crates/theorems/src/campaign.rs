@@ -72,6 +72,7 @@ pub fn registry() -> Vec<Box<dyn Property>> {
         Box::new(properties::theorem2::property_path()),
         Box::new(properties::theorem2::property_zinf()),
         Box::new(properties::qzdot::property()),
+        Box::new(properties::psi0::property()),
     ]
 }
 

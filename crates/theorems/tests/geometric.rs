@@ -4,7 +4,7 @@
 //! control must be caught by proptest with a shrunk counterexample.
 use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence, TestCaseError, TestError, TestRunner};
-use theorems::properties::{lemma_a1, lemma_a2, lemma_b, pp, rr, zy, Eval, Variant};
+use theorems::properties::{lemma_a1, lemma_a2, lemma_b, pp, psi0, rr, zy, Eval, Variant};
 
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(2_000).max(2_000)
@@ -59,6 +59,9 @@ proptest! {
 
     #[test]
     fn lemma_b_spectral_formula(c in lemma_b::strategy()) { holds(lemma_b::eval(&c, Variant::Claim))?; }
+
+    #[test]
+    fn psi0_is_nonnegative(c in psi0::strategy()) { holds(psi0::eval(&c, Variant::Claim))?; }
 }
 
 #[test]
@@ -85,6 +88,35 @@ fn rr_negative_control_fails() {
 fn lemma_b_negative_control_fails() {
     let c = negative_control(lemma_b::strategy(), lemma_b::eval);
     assert!(c.n >= 2 && c.p >= 2, "Frobenius = spectral norm for rank one g: {c:?}");
+}
+
+#[test]
+fn psi0_negative_control_fails() {
+    let c = negative_control(psi0::strategy(), psi0::eval);
+    let d = c.data().expect("a checked case has data");
+    let (alpha, _, _) = psi0::alpha_beta(&d).unwrap();
+    assert!(alpha > 0.0, "the claim has content only for alpha > 0: {alpha}");
+}
+
+/// `psi(0) >= 0` is attained (up to a factor below 4) on the checked cases: the minimum of
+/// `beta / (alpha lambda)` over cases with `alpha > 0` is reported and lies in `[1, 4)`.
+#[test]
+fn psi0_claim_is_nearly_tight() {
+    let strat = psi0::strategy();
+    let mut runner = TestRunner::deterministic();
+    let mut ratio = f64::INFINITY;
+    let mut positive = 0;
+    for _ in 0..2000 {
+        let c = strat.new_tree(&mut runner).unwrap().current();
+        let Some(d) = c.data() else { continue };
+        let Some((alpha, beta, _)) = psi0::alpha_beta(&d) else { continue };
+        if alpha > 0.0 {
+            positive += 1;
+            ratio = ratio.min(beta / (alpha * d.lambda));
+        }
+    }
+    eprintln!("psi0: {positive} cases with alpha > 0, min beta / (alpha lambda) = {ratio:.4}");
+    assert!(positive > 100 && ratio >= 1.0 - 1e-9 && ratio < 4.0, "{positive} {ratio}");
 }
 
 /// Lemma A2 is tight on balls: the minimum slack over balls is ~0, so a constant even 1%

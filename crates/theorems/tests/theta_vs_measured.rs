@@ -4,7 +4,8 @@
 //! plus the worked example; `theta` is assembled by `bounds::theta::assemble` (bound only,
 //! cheap) and, for the candidates with `theta < 0` verified, the measured side (pairs of
 //! catching-up trajectories) is added. Claim: `ci_high <= theta` (the whole 95% CI of the
-//! measured exponent lies below the bound). Negative control: the too-small bound `theta - 1`
+//! measured exponent lies below the bound), for theta, theta* and theta_profile (the bounds
+//! beyond the paper). Negative control: the too-small bound `theta - 1`
 //! must be caught (`ci_low > theta - 1`) on some case.
 //!
 //! Default: at most `4` verified random cases (drawn from at most 40 candidates); raise with
@@ -58,6 +59,9 @@ fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
         out.push((format!("case {i} (n = {}, mu = {:.3})", sys.n(), full.mu), full.theta, m.ci_low, m.ci_high));
         if full.theta_star_verified {
             out.push((format!("case {i} theta* (n = {})", sys.n()), full.theta_star, m.ci_low, m.ci_high));
+        }
+        if full.theta_profile_verified {
+            out.push((format!("case {i} theta_profile (n = {})", sys.n()), full.theta_profile, m.ci_low, m.ci_high));
         }
     }
     (out, tried)

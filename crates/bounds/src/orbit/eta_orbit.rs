@@ -44,6 +44,11 @@ pub struct EtaOrbit {
     pub osc: f64,
     /// Upper bound (or estimate) of `||eta_T'||_inf`, eq. (zinf).
     pub eta_dot_inf: f64,
+    /// Lipschitz constant of `eta_T'` (`omega ||eta_T'||_inf`, from above, for a sine; the
+    /// largest sampled difference quotient otherwise, an estimate).
+    pub deta_lipschitz: f64,
+    /// Relative rounding margin of the closed-form samples (`0` for grid samples).
+    pub rel_margin: f64,
     /// True when `osc` is a lower and `eta_dot_inf` an upper bound (closed form).
     pub verified: bool,
     /// How they were obtained.
@@ -74,6 +79,12 @@ impl EtaOrbit {
                     linearised_periodic(sys, &LinearisedSettings { samples: settings.samples, ..Default::default() })?;
                 let osc = lp.osc_lower();
                 let eta_dot_inf = lp.deta_inf_sampled();
+                let deta_lipschitz = lp
+                    .deta
+                    .windows(2)
+                    .zip(lp.t.windows(2))
+                    .map(|(d, t)| geometry::linalg::dist(&d[1], &d[0]) / (t[1] - t[0]))
+                    .fold(0.0, f64::max);
                 Ok(Self {
                     period: T,
                     t: lp.t,
@@ -81,6 +92,8 @@ impl EtaOrbit {
                     deta: lp.deta,
                     osc,
                     eta_dot_inf,
+                    deta_lipschitz,
+                    rel_margin: 0.0,
                     verified: false,
                     method: "grid samples (first-order-hold step map); sampled max of |eta_T'| is not an upper bound",
                 })
@@ -121,6 +134,9 @@ impl EtaOrbit {
             deta,
             osc: 2.0 * rho * (1.0 - margin),
             eta_dot_inf: omega * rho * (1.0 + margin),
+            // eta_T'' = -omega^2 eta_T, |eta_T| <= rho.
+            deta_lipschitz: omega * omega * rho * (1.0 + margin),
+            rel_margin: margin,
             verified: ok,
             method: "closed form (sine input: eta_T is an ellipse, osc = 2 rho, ||eta_T'|| = omega rho)",
         }
@@ -141,6 +157,31 @@ impl EtaOrbit {
     /// Sampled maximum of `|eta_T'|` (a lower estimate of `||eta_T'||_inf`).
     pub fn eta_dot_sampled(&self) -> f64 {
         self.deta.iter().map(|d| geometry::linalg::norm(d)).fold(0.0, f64::max)
+    }
+
+    /// Upper bounds of `|eta_T'|` on `cells` equal cells of the period (`cells` must divide the
+    /// number of sample intervals): the largest sampled `|eta_T'|` in the cell plus the
+    /// Lipschitz constant times half the sample spacing plus the samples' rounding margin (a
+    /// bound when `verified`), and the
+    /// samples of `eta_T` at the cell boundaries. `None` if `cells` does not divide it.
+    pub fn eta_dot_cells(&self, cells: usize) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
+        let K = self.t.len() - 1;
+        if cells == 0 || K % cells != 0 {
+            return None;
+        }
+        let per = K / cells;
+        let dt = self.period / K as f64;
+        let slack = 0.5 * dt * self.deta_lipschitz * (1.0 + 1e-12);
+        let bounds = (0..cells)
+            .map(|c| {
+                let m = (c * per..=(c + 1) * per)
+                    .map(|k| geometry::linalg::norm(&self.deta[k]))
+                    .fold(0.0, f64::max);
+                (m + slack + 2.0 * self.rel_margin * self.eta_dot_inf) * (1.0 + 1e-12)
+            })
+            .collect();
+        let nodes = (0..=cells).map(|c| self.eta[c * per].clone()).collect();
+        Some((bounds, nodes))
     }
 
     /// Every `stride`-th sample index, always including the last (`t = T`).

@@ -17,6 +17,7 @@ use crate::report::{BoundKind, Quantity};
 use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
+use crate::theta::speed_profile::SpeedProfile;
 use crate::tube::{tube_diameters, TubeSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
 use geometry::{ConvexSet, SphereMaxSettings};
@@ -42,6 +43,12 @@ pub struct ThetaSettings {
     pub path1_points: usize,
     /// Number of `eps` values of the (path2) packing search. Default `64`.
     pub packing_eps: usize,
+    /// Cells of the time-resolved speed profile of `theta_profile` (must divide
+    /// `orbit.samples`; otherwise the largest divisor below it is used). Default `400`.
+    pub profile_cells: usize,
+    /// Every `profile_stride`-th cell boundary is a candidate partition point of the
+    /// `theta_profile` dynamic programme (`O((cells/stride)^2)` intervals). Default `4`.
+    pub profile_stride: usize,
     /// Stationary set of Theorem 1; `None` skips it. Default `Some(RestSetSettings::default())`.
     pub stationary: Option<RestSetSettings>,
     /// Measured side (pairs of simulated trajectories); `None` skips it. Default:
@@ -58,6 +65,8 @@ impl Default for ThetaSettings {
             orbit: OrbitSettings::default(),
             path1_points: 600,
             packing_eps: 64,
+            profile_cells: 400,
+            profile_stride: 4,
             stationary: Some(RestSetSettings::default()),
             measure: Some(RateSettings { periods: 40, transient_periods: 10, pairs: 2, ..Default::default() }),
         }
@@ -156,12 +165,21 @@ pub struct ThetaReport {
     /// The certified `(lambda, b_hat)` at which `theta*` is attained.
     pub lambda_star: f64,
     pub beta_star: f64,
+    /// `theta_profile`: the chord argument resolved in time (beyond the paper,
+    /// [`crate::theta::speed_profile`], proofs-notes/theta-profile.md), `<= theta*` up to the
+    /// partition chosen.
+    pub theta_profile: f64,
+    pub theta_profile_verified: bool,
+    /// The certified `lambda` at which `theta_profile` is attained, and the partition size.
+    pub lambda_profile: f64,
+    pub profile_intervals: usize,
+    pub profile_cells: usize,
     /// Which path bound gives `gamma_1*`: `(path)`, `(path1)` or `(path2)`.
     pub path_best_method: &'static str,
     /// The smallest verified bound of the exponent (`theta` or `theta*`), or `theta` when none
     /// is verified.
     pub theta_best: f64,
-    /// `"theta"` or `"theta_star"`.
+    /// `"theta"`, `"theta_star"` or `"theta_profile"`.
     pub theta_best_method: &'static str,
     pub theta_best_verified: bool,
     pub path_bound: f64,
@@ -227,7 +245,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         if strongly_convex { ((osc - d).max(0.0) / (T * R), zdot_bound / R) } else { (0.0, 0.0) };
     if !strongly_convex {
         notes.push(format!(
-            "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0), and convergence is guaranteed only if psi(0) < 0, i.e. alpha > beta / lambda"
+            "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0) >= 0 for every admissible Pi (proofs-notes/psi0.md), so eq. (theta) cannot certify convergence here"
         ));
     }
     let kappa = if gamma_inf > 0.0 { (gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
@@ -300,11 +318,41 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         .fold((theta, opt.value.lambda, opt.value.beta), |a, c| if c.0 < a.0 { c } else { a });
     // The same proof obligations as theta (the path bounds use the same d and orbit samples).
     let theta_star_verified = theta_verified;
-    let (theta_best, theta_best_method, theta_best_verified) = if theta_star_verified && theta_star < theta {
-        (theta_star, "theta_star", true)
-    } else {
-        (theta, "theta", theta_verified)
+
+    // theta_profile (beyond the paper): pointwise speed bounds per cell and path bounds per
+    // interval of a partition chosen by dynamic programming at (lambda*, b_hat*), then the best
+    // certified (lambda, b_hat) of the curve for that partition.
+    let cells = largest_divisor_at_most(orbit.t.len() - 1, settings.profile_cells.max(1));
+    let profile = match (strongly_convex, orbit.eta_dot_cells(cells)) {
+        (true, Some((edot, nodes))) => Some(SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R)),
+        _ => None,
     };
+    let (theta_profile, lambda_profile, profile_intervals) = match &profile {
+        Some(prof) => {
+            let nodes =
+                prof.best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
+            let (v, l) = curve
+                .iter()
+                .map(|&(l, b, _)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
+                .fold((f64::INFINITY, f64::NAN), |a, c| if c.0 < a.0 { c } else { a });
+            (v.min(theta_star), if v <= theta_star { l } else { lambda_star }, nodes.len() - 1)
+        }
+        None => (theta_star, lambda_star, 0),
+    };
+    let theta_profile_verified = theta_verified && profile.is_some();
+    let candidates = [
+        (theta, "theta", theta_verified),
+        (theta_star, "theta_star", theta_star_verified),
+        (theta_profile, "theta_profile", theta_profile_verified),
+    ];
+    let (theta_best, theta_best_method, theta_best_verified) = candidates
+        .iter()
+        .filter(|c| c.2)
+        .fold(None, |a: Option<(f64, &'static str, bool)>, c| match a {
+            Some(b) if b.0 <= c.0 => Some(b),
+            _ => Some(*c),
+        })
+        .unwrap_or((theta, "theta", theta_verified));
 
     // Stationary set (Theorem 1).
     let stationary = match &settings.stationary {
@@ -356,7 +404,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             notes.push(format!("measured exponent {:.4} exceeds theta {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta));
         }
         if theta_best < 0.0 && m.rate > theta_best && theta_best < theta {
-            notes.push(format!("measured exponent {:.4} exceeds theta_star {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta_best));
+            notes.push(format!("measured exponent {:.4} exceeds {theta_best_method} {:.4}: the bound is violated (or the measurement has not converged)", m.rate, theta_best));
         }
     }
 
@@ -408,6 +456,11 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         theta_best,
         theta_best_method,
         theta_best_verified,
+        theta_profile,
+        theta_profile_verified,
+        lambda_profile,
+        profile_intervals,
+        profile_cells: if profile.is_some() { cells } else { 0 },
         path_bound: path_b,
         path1_bound: path1,
         path1_grid: sub.len(),
@@ -461,6 +514,10 @@ impl ThetaReport {
             THETA_STAR
                 .with(self.theta_star, self.theta_star_verified)
                 .note(format!("eq. (theta) with gamma_1*, at lambda = {:.6}", self.lambda_star)),
+            THETA_PROFILE.with(self.theta_profile, self.theta_profile_verified).note(format!(
+                "time-resolved chord: {} cells, {} intervals, lambda = {:.6}",
+                self.profile_cells, self.profile_intervals, self.lambda_profile
+            )),
             PATH_BOUND.with(self.path_bound, orb && self.d_verified),
             PATH1_BOUND
                 .with(self.path1_bound, orb && self.d_verified)
@@ -532,6 +589,7 @@ impl ThetaReport {
         m.insert("d_verified".into(), json!(self.d_verified));
         m.insert("theta_verified".into(), json!(self.theta_verified));
         m.insert("theta_star_verified".into(), json!(self.theta_star_verified));
+        m.insert("theta_profile_verified".into(), json!(self.theta_profile_verified));
         m.insert("theta_best".into(), json!(f(self.theta_best)));
         m.insert("theta_best_method".into(), json!(self.theta_best_method));
         m.insert("theta_best_verified".into(), json!(self.theta_best_verified));
@@ -552,6 +610,11 @@ impl ThetaReport {
         m.insert("quantities".into(), json!(qs));
         serde_json::Value::Object(m)
     }
+}
+
+/// The largest divisor of `k` that is at most `at_most` (at least 1).
+fn largest_divisor_at_most(k: usize, at_most: usize) -> usize {
+    (1..=at_most.min(k).max(1)).rev().find(|d| k % d == 0).unwrap_or(1)
 }
 
 /// The largest float below `x` (for values that must be rounded down; `x` finite).

@@ -6,6 +6,8 @@
 pub mod alpha;
 pub mod assemble;
 pub mod psi;
+pub mod speed_profile;
 
 pub use assemble::{assemble, MeasuredSide, ThetaReport, ThetaSettings};
 pub use psi::Psi;
+pub use speed_profile::SpeedProfile;

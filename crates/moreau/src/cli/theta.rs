@@ -63,11 +63,12 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
             fmt_value(rep.theta),
             rep.effects.join(", ")
         )
-    } else if rep.convergence_guaranteed && rep.theta_best_method == "theta_star" {
+    } else if rep.convergence_guaranteed && rep.theta_best_method != "theta" {
         format!(
-            "theta* = {} < 0 (verified; paper's theta = {}): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= theta*.",
+            "{m} = {} < 0 (verified; paper's theta = {}): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= {m}.",
             fmt_value(rep.theta_best),
-            fmt_value(rep.theta)
+            fmt_value(rep.theta),
+            m = rep.theta_best_method
         )
     } else if rep.convergence_guaranteed {
         format!(
@@ -76,6 +77,11 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
         )
     } else if rep.theta < 0.0 {
         format!("theta = {} < 0 but NOT verified (see the flags above): no guarantee.", fmt_value(rep.theta))
+    } else if rep.R.is_infinite() {
+        format!(
+            "theta = psi(0) = {} >= 0: Theta is not strongly convex, and then no certificate of this kind exists (psi(0) >= 0 for every admissible Pi, proofs-notes/psi0.md).",
+            fmt_value(rep.theta)
+        )
     } else {
         format!(
             "theta = {} >= 0: the bound does not guarantee convergence (psi(0) = {}; kappa = gamma_1/gamma_inf = {}; theta < 0 needs psi(0) < kappa lambda/(1 - kappa)).",

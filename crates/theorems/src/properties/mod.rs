@@ -17,6 +17,7 @@ pub mod lemma_a1;
 pub mod lemma_a2;
 pub mod lemma_b;
 pub mod pp;
+pub mod psi0;
 pub mod qzdot;
 pub mod rr;
 pub mod simulation;

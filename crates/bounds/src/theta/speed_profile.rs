@@ -1,0 +1,213 @@
+//! `theta_profile`: eq. (theta)'s chord argument made time-resolved (beyond the paper,
+//! proofs-notes/theta-profile.md).
+//!
+//! Eq. (theta) uses two numbers about the backlash speed `u(t) = |z'(t)| / R` of each
+//! trajectory: its mean over a period is at least `gamma_1` and it never exceeds `gamma_inf`.
+//! Theorem 2's proof gives more, pointwise in time (asymptotically, up to terms that vanish):
+//! - the speed bound (ydot): `y'(t) in eta_T'(t) + C(F Xi_inf + E Theta)`, so with (zy)
+//!   `u(t) <= g(t) := (|eta_T'(t)| + D(C(F Xi_inf + E Theta), {0})) / R`;
+//! - the path bound (diffs1) on every interval: `int_a^b u >= (|eta_T(b) - eta_T(a)| - d)_+ / R`.
+//!
+//! On a cell `c` of the period where `g <= g_c`, the convex nonincreasing `psi` lies below its
+//! chord over `[0, g_c]`: `psi(u) <= psi(0) - s_c u`, `s_c = (psi(0) - psi(g_c)) / g_c`. The
+//! chord is steeper where the speed bound is lower. For a partition of the period into intervals
+//! `I_k` (unions of cells) with path bounds `M_k`, the mean of `psi(u)` over a period is at most
+//!
+//! `psi(0) - (1/T) sum_k L_k`,  `L_k = min { sum_{c in I_k} s_c U_c : sum U_c >= M_k, 0 <= U_c <= g_c h }`,
+//!
+//! and `L_k` is the greedy fill of the cells of `I_k` by increasing `s_c` (a fractional knapsack).
+//! With the Jensen step (Jen) over the two trajectories this bounds the Lyapunov exponent like
+//! eq. (theta). Any partition gives a valid bound; the one used is chosen by dynamic programming
+//! over a grid of cell boundaries. With a single cell (`g_c = gamma_inf` everywhere) and the
+//! partition of (path1) the bound is `theta*`; it is never larger than `theta*` for the same
+//! partition, since every `s_c` is at least the global chord's slope.
+use crate::theta::psi::Psi;
+use geometry::linalg::dist;
+
+/// Time-resolved data of one period: cell speed bounds and the orbit at the cell boundaries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpeedProfile {
+    /// Cell length `h = T / cells`.
+    pub h: f64,
+    /// `g_c`: upper bound of `u = |z'| / R` on cell `c` (asymptotically).
+    pub g: Vec<f64>,
+    /// `eta_T` at the cell boundaries `c h`, `c = 0..=cells`.
+    pub eta: Vec<Vec<f64>>,
+    /// `d` of eq. (d) divided by `R` (upper bound / upper bound of R: see [`SpeedProfile::new`]).
+    pub d: f64,
+    /// `R` (upper bound) used to scale the path bounds.
+    pub R: f64,
+}
+
+impl SpeedProfile {
+    /// `eta`: `cells + 1` samples of `eta_T` at `c h`; `eta_dot_cell[c]`: an upper bound of
+    /// `|eta_T'|` on cell `c`; `d_ftheta`: `D(C(F Xi_inf + E Theta), {0})` from above; `d` from
+    /// above; `R` from above (a set strongly convex with constant `R` is so with any larger one,
+    /// so (QZdot) holds with `u = |z'| / R_upper` and every bound below is in those units).
+    pub fn new(T: f64, eta: Vec<Vec<f64>>, eta_dot_cell: &[f64], d_ftheta: f64, d: f64, R: f64) -> Self {
+        let cells = eta_dot_cell.len();
+        assert_eq!(eta.len(), cells + 1, "one more boundary than cells");
+        let g = eta_dot_cell.iter().map(|e| up((e + d_ftheta) / R)).collect();
+        Self { h: T / cells as f64, g, eta, d, R }
+    }
+
+    pub fn cells(&self) -> usize {
+        self.g.len()
+    }
+
+    /// `M` of the interval between boundaries `i < j`: `(|eta(j) - eta(i)| - d)_+ / R`, rounded
+    /// down.
+    pub fn path_lower(&self, i: usize, j: usize) -> f64 {
+        let m = (dist(&self.eta[j], &self.eta[i]) - self.d).max(0.0) / self.R;
+        (m * (1.0 - 1e-12)).max(0.0)
+    }
+
+    /// Chord slopes `s_c` for `psi`, rounded down (`psi` values are rounded up, and a smaller
+    /// slope gives a larger, still valid, upper chord).
+    pub fn slopes(&self, psi: &Psi) -> Vec<f64> {
+        let p0 = psi.at_zero();
+        self.g
+            .iter()
+            .map(|&g| if g > 0.0 { ((p0 - psi.eval(g)) / g * (1.0 - 1e-12)).max(0.0) } else { 0.0 })
+            .collect()
+    }
+
+    /// `L` of the cells `i..j` (boundaries `i < j`) with path bound `m`: greedy fill by
+    /// increasing slope. `scratch` is reused between calls.
+    fn interval_loss(&self, s: &[f64], i: usize, j: usize, m: f64, scratch: &mut Vec<usize>) -> f64 {
+        if m <= 0.0 {
+            return 0.0;
+        }
+        scratch.clear();
+        scratch.extend(i..j);
+        scratch.sort_unstable_by(|&a, &b| s[a].total_cmp(&s[b]));
+        let mut left = m;
+        let mut loss = 0.0;
+        for &c in scratch.iter() {
+            let cap = self.g[c] * self.h;
+            let take = cap.min(left);
+            loss += s[c] * take;
+            left -= take;
+            if left <= 0.0 {
+                break;
+            }
+        }
+        // Cells cannot carry the path bound only through the rounding of the enclosures; the
+        // loss of the full capacity is then used (smaller than the true minimum: still valid).
+        loss * (1.0 - 1e-12)
+    }
+
+    /// The bound `psi(0) - (1/T) sum_k L_k` for the partition given by boundary indices
+    /// `nodes` (increasing, from `0` to `cells`), rounded up.
+    pub fn bound(&self, psi: &Psi, nodes: &[usize]) -> f64 {
+        let s = self.slopes(psi);
+        let mut scratch = Vec::new();
+        let total: f64 = nodes
+            .windows(2)
+            .map(|w| self.interval_loss(&s, w[0], w[1], self.path_lower(w[0], w[1]), &mut scratch))
+            .sum();
+        let T = self.h * self.cells() as f64;
+        let v = psi.at_zero() - total / T;
+        v + 4.0 * f64::EPSILON * (psi.at_zero().abs() + (total / T).abs())
+    }
+
+    /// The partition (boundary indices from `0` to `cells`) maximising the total loss, by
+    /// dynamic programming over every `stride`-th boundary (`O((cells/stride)^2)` intervals).
+    pub fn best_partition(&self, psi: &Psi, stride: usize) -> Vec<usize> {
+        let K = self.cells();
+        let stride = stride.clamp(1, K.max(1));
+        let mut grid: Vec<usize> = (0..K).step_by(stride).collect();
+        grid.push(K);
+        let s = self.slopes(psi);
+        let mut scratch = Vec::new();
+        let n = grid.len();
+        let mut best = vec![0.0f64; n];
+        let mut prev = vec![0usize; n];
+        for b in 1..n {
+            let (mut v, mut arg) = (f64::NEG_INFINITY, 0);
+            for a in 0..b {
+                let (i, j) = (grid[a], grid[b]);
+                let l = best[a] + self.interval_loss(&s, i, j, self.path_lower(i, j), &mut scratch);
+                if l > v {
+                    v = l;
+                    arg = a;
+                }
+            }
+            best[b] = v;
+            prev[b] = arg;
+        }
+        let mut nodes = vec![K];
+        let mut b = n - 1;
+        while b > 0 {
+            b = prev[b];
+            nodes.push(grid[b]);
+        }
+        nodes.reverse();
+        nodes
+    }
+}
+
+/// Rounds a positive finite value up by a relative `1e-12` (enclosure margins).
+fn up(x: f64) -> f64 {
+    if x.is_finite() {
+        x * (1.0 + 1e-12) + f64::MIN_POSITIVE
+    } else {
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle_profile(cells: usize, amp: f64, D: f64, d: f64, R: f64) -> SpeedProfile {
+        let T = std::f64::consts::TAU;
+        let h = T / cells as f64;
+        let eta: Vec<Vec<f64>> = (0..=cells).map(|c| vec![amp * (c as f64 * h).sin()]).collect();
+        // |eta'| = amp |cos t| <= max at the cell ends + amp h (Lipschitz constant amp).
+        let edot: Vec<f64> = (0..cells)
+            .map(|c| {
+                let (a, b) = ((c as f64 * h).cos().abs(), ((c + 1) as f64 * h).cos().abs());
+                amp * (a.max(b) + h)
+            })
+            .collect();
+        SpeedProfile::new(T, eta, &edot, D, d, R)
+    }
+
+    #[test]
+    fn never_above_the_global_chord_and_constant_speed_recovers_it() {
+        let psi = Psi { alpha: 0.0, lambda: 0.3, beta: 0.024 };
+        let prof = circle_profile(400, 1.667, 0.214, 0.637, 0.1);
+        let nodes = prof.best_partition(&psi, 4);
+        let b = prof.bound(&psi, &nodes);
+        // Global chord with the same partition's total path.
+        let total: f64 = nodes.windows(2).map(|w| prof.path_lower(w[0], w[1])).sum();
+        let gmax = prof.g.iter().copied().fold(0.0, f64::max);
+        let T = prof.h * prof.cells() as f64;
+        let global = psi.theta(total / T, gmax);
+        assert!(b <= global + 1e-12, "{b} > {global}");
+        assert!(b < global - 0.01, "the profile must help on a sine: {b} vs {global}");
+        // With a flat profile every slope equals the global one: the two coincide.
+        let mut flat = prof.clone();
+        flat.g.iter_mut().for_each(|g| *g = gmax);
+        let bf = flat.bound(&psi, &nodes);
+        assert!((bf - global).abs() < 1e-9, "{bf} vs {global}");
+    }
+
+    #[test]
+    fn negative_control_a_speed_bound_too_low_makes_the_cells_infeasible() {
+        // Halving the speed bounds below what the path needs: the greedy fill runs out of
+        // capacity, and the loss of a feasible problem is not reachable - the bound moves up
+        // relative to the honest one only through the steeper slopes, which is the effect an
+        // unsound speed bound would have: detected by comparing with the measured motion in
+        // crates/theorems/tests/theta_vs_measured.rs. Here: the bound decreases when g is
+        // (wrongly) lowered, so a wrong g gives a wrong, too optimistic, bound.
+        let psi = Psi { alpha: 0.0, lambda: 0.3, beta: 0.024 };
+        let prof = circle_profile(400, 1.667, 0.214, 0.637, 0.1);
+        let nodes = prof.best_partition(&psi, 4);
+        let honest = prof.bound(&psi, &nodes);
+        let mut wrong = prof.clone();
+        wrong.g.iter_mut().for_each(|g| *g *= 0.7);
+        assert!(wrong.bound(&psi, &nodes) < honest - 1e-3);
+    }
+}
