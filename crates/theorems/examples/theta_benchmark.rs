@@ -1,0 +1,159 @@
+//! Certified bounds against measured exponents on random convergent systems (issue 15's
+//! benchmark): `cargo run --release -p theorems --example theta_benchmark -- [systems] [seed]`.
+//!
+//! Systems from `theorems::strategies::systems` (n = 2..4, p = 1..3, intervals, balls and
+//! ellipsoids, sine inputs); each is assembled with the measured side (pairs of catching-up
+//! trajectories, 30 periods after 10 of transient). A system counts as convergent when the
+//! measured exponent's 95 % interval lies below 0. For every bound (the paper's `theta`,
+//! `theta_star`, `theta_profile`, `theta_best`) it reports how many systems it certifies
+//! (verified `< 0`), the median of bound / measured over the certified ones, and violations
+//! (a certified bound below the measured interval's upper end). Prints a Markdown table.
+use bounds::theta::{assemble, ThetaReport, ThetaSettings};
+use dynamics::rate::lyapunov_exponent::RateSettings;
+use rayon::prelude::*;
+use theorems::strategies::inputs::InputStrategyConfig;
+use theorems::strategies::sets::{SetKind, SetStrategyConfig};
+use theorems::strategies::systems::{system_params, SystemStrategyConfig};
+
+fn config() -> SystemStrategyConfig {
+    SystemStrategyConfig {
+        max_n: 4,
+        max_p: 3,
+        mu: (-2.0, -0.3),
+        theta: SetStrategyConfig {
+            kinds: vec![SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid],
+            max_dim: 3,
+            max_cond: 4.0,
+            scale_exp: 0.75,
+        },
+        input: InputStrategyConfig { amp_exp: (0.0, 1.5), ..Default::default() },
+        ..Default::default()
+    }
+}
+
+struct Row {
+    n: usize,
+    p: usize,
+    rep: ThetaReport,
+    rate: f64,
+    hi: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let k = v.len();
+    if k % 2 == 1 {
+        v[k / 2]
+    } else {
+        0.5 * (v[k / 2 - 1] + v[k / 2])
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
+    let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
+    let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
+    let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
+    let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
+    let start = std::time::Instant::now();
+    // Draw until `want` convergent systems and `want` certified by the paper's theta (capped at
+    // 60 `want` candidates). Table A: all convergent systems drawn; table B: those certified by
+    // the paper's theta (the bounds' ratios compared on the same systems).
+    let mut rows: Vec<Row> = Vec::new();
+    let mut paper_certified = 0;
+    let mut drawn = 0;
+    for chunk in params.chunks(32) {
+        if rows.len() >= want && paper_certified >= want {
+            break;
+        }
+        drawn += chunk.len();
+        let got: Vec<Row> = chunk
+            .par_iter()
+            .filter(|c| c.n >= 2)
+            .filter_map(|c| {
+                let sys = c.build();
+                let rep = assemble(&sys, &settings).ok()?;
+                let m = rep.measured.clone()?;
+                (m.ci_high < 0.0).then(|| Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep })
+            })
+            .collect();
+        paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
+        rows.extend(got);
+    }
+    let secs = start.elapsed().as_secs_f64();
+
+    let table_a: Vec<&Row> = rows.iter().collect();
+    let table_b: Vec<&Row> = rows.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).collect();
+    if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
+        println!("| # | n | p | Theta | measured | theta | theta* | theta_profile | best |");
+        println!("|---|---|---|---|---|---|---|---|---|");
+        for (i, r) in table_a.iter().enumerate() {
+            let f = |v: f64, ok: bool| if ok && v < 0.0 { format!("{v:.4}") } else { format!("({v:.3})") };
+            println!(
+                "| {i} | {} | {} | {} | {:.4} | {} | {} | {} | {} |",
+                r.n,
+                r.p,
+                kind(r),
+                r.rate,
+                f(r.rep.theta, r.rep.theta_verified),
+                f(r.rep.theta_star, r.rep.theta_star_verified),
+                f(r.rep.theta_profile, r.rep.theta_profile_verified),
+                r.rep.theta_best_method
+            );
+        }
+        println!();
+    }
+    type Get = fn(&ThetaReport) -> (f64, bool);
+    let bounds: [(&str, Get); 4] = [
+        ("theta (paper)", |r| (r.theta, r.theta_verified)),
+        ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
+        ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
+        ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
+    ];
+    let summary = |title: &str, set: &[&Row]| {
+        println!("{title}");
+        println!();
+        println!("| bound | certified (verified < 0) | median bound / measured | min | max | violations |");
+        println!("|---|---|---|---|---|---|");
+        for (name, get) in bounds {
+            let cert: Vec<&&Row> = set.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
+            let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
+            let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
+            let (lo, hi) = ratios.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+            println!(
+                "| {name} | {} of {} | {:.3} | {:.3} | {:.3} | {violations} |",
+                cert.len(),
+                set.len(),
+                median(ratios.clone()),
+                lo,
+                hi
+            );
+        }
+        println!();
+    };
+    println!(
+        "Seed {seed}: {drawn} systems drawn, {} convergent (measured 95 % interval below 0), {} of them certified by the paper's theta; {secs:.0} s on this machine.",
+        rows.len(),
+        table_b.len()
+    );
+    println!();
+    summary(&format!("A. All {} convergent systems:", table_a.len()), &table_a);
+    summary(&format!("B. The {} convergent systems certified by the paper's theta:", table_b.len()), &table_b);
+    let all_viol = rows
+        .iter()
+        .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
+        .count();
+    println!("Violations over all {} convergent systems and all bounds: {all_viol}.", rows.len());
+}
+
+fn kind(r: &Row) -> &'static str {
+    match (r.p, r.rep.R.is_finite()) {
+        (1, _) => "interval",
+        (_, true) => "ball/ellipsoid",
+        _ => "other",
+    }
+}
