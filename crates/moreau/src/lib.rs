@@ -6,6 +6,7 @@
 
 pub mod cli;
 pub mod figures;
+pub mod guidance;
 pub mod output;
 pub mod plot;
 pub mod sweep;

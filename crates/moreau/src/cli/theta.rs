@@ -24,6 +24,10 @@ pub struct Args {
     /// Skip the stationary set of Theorem 1.
     #[arg(long)]
     pub no_stationary: bool,
+    /// Skip the design guidance printed when nothing is certified (which term blocks,
+    /// sensitivities, smallest certifying amplitude: a few dozen bound computations).
+    #[arg(long)]
+    pub no_guidance: bool,
 }
 
 /// The readable report.
@@ -121,7 +125,13 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         settings.stationary = None;
     }
     let rep = assemble(&sys, &settings).with_context(|| a.file.display().to_string())?;
-    let json = serde_json::to_string_pretty(&rep.to_json())?;
+    let guide = (!a.no_guidance && !rep.convergence_guaranteed && rep.effects.is_empty())
+        .then(|| crate::guidance::guidance(&sys, &rep, &Default::default()));
+    let mut obj = rep.to_json();
+    if let (Some(g), Some(m)) = (&guide, obj.as_object_mut()) {
+        m.insert("guidance".into(), serde_json::to_value(g)?);
+    }
+    let json = serde_json::to_string_pretty(&obj)?;
     if let Some(out) = &a.out {
         crate::output::write_atomic(out, json.as_bytes())?;
     }
@@ -129,6 +139,9 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         println!("{json}");
     } else {
         print!("{}", render(&rep, &sys.theta.describe()));
+        if let Some(g) = &guide {
+            print!("{}", g.render());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
