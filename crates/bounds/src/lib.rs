@@ -39,6 +39,7 @@
 //! ```
 #![allow(non_snake_case)]
 
+pub mod equations;
 pub mod error;
 pub mod orbit;
 pub mod report;

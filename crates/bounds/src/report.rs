@@ -55,6 +55,7 @@ impl QuantityDef {
             key: self.key,
             symbol: self.symbol,
             label: self.label,
+            equation: crate::equations::numbered(self.label),
             value,
             kind: self.kind,
             verified,
@@ -235,8 +236,10 @@ pub struct Quantity {
     pub key: &'static str,
     /// The paper's symbol in ASCII.
     pub symbol: &'static str,
-    /// Equation label(s) in the paper.
+    /// Equation label(s) in the paper's source.
     pub label: &'static str,
+    /// The same equations by their printed numbers (`(84),(56)`; [`crate::equations`]).
+    pub equation: String,
     pub value: f64,
     pub kind: BoundKind,
     /// True when the bound in `kind` is proven (up to floating-point rounding of closed forms).
@@ -275,19 +278,22 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
-/// A plain-text table: symbol, label, value, kind, verified.
+/// A plain-text table: symbol, equation number(s) as printed in the paper, source label(s),
+/// value, kind, verified, how.
 pub fn render_table(rows: &[Quantity]) -> String {
     let mut s = String::new();
     let w_sym = rows.iter().map(|q| q.symbol.len()).max().unwrap_or(6).max(6);
+    let w_eq = rows.iter().map(|q| q.equation.len()).max().unwrap_or(3).max(3);
     let w_lab = rows.iter().map(|q| q.label.len()).max().unwrap_or(5).max(5);
     s.push_str(&format!(
-        "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
-        "symbol", "eq.", "value", "kind", "verified", "how"
+        "{:<w_sym$}  {:<w_eq$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
+        "symbol", "eq.", "label", "value", "kind", "verified", "how"
     ));
     for q in rows {
         s.push_str(&format!(
-            "{:<w_sym$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
+            "{:<w_sym$}  {:<w_eq$}  {:<w_lab$}  {:>14}  {:<12}  {:<8}  {}\n",
             q.symbol,
+            q.equation,
             q.label,
             fmt_value(q.value),
             q.kind.as_str(),

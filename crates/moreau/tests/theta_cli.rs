@@ -22,8 +22,11 @@ fn readable_report_and_json() {
         "(path1)",
         "(path2)",
         "(stat1)",
-        "Verdict: theta* = ",
+        "Verdict: theta_profile = ",
         "theta*",
+        "theta_profile",
+        // the paper's printed equation numbers next to the source labels
+        "(84)",
     ] {
         assert!(s.contains(needle), "missing {needle} in\n{s}");
     }
