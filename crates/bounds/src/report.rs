@@ -303,3 +303,40 @@ pub fn render_table(rows: &[Quantity]) -> String {
     }
     s
 }
+
+/// What a reader should take from each quantity, in plain words (`moreau theta --explain`).
+/// Every key of [`defs::ALL`] has an entry (a test checks it).
+pub fn glossary(key: &str) -> Option<&'static str> {
+    Some(match key {
+        "period" => "T, the period of the input w. Everything below is per period or per unit time.",
+        "mu" => "mu, the largest real part of the eigenvalues of F = A + E C (the loop linearised with the backlash moving with its input). Theorem 2 needs mu < 0; the certified decay rate lambda lies in (0, |mu|).",
+        "r" => "R, the strong-convexity constant of Theta: Theta is an intersection of balls of radius R (an interval or a ball: its half-width or radius). Small R = strongly curved; R = inf (a polytope) means no certificate of this kind can exist.",
+        "alpha" => "alpha, the smallest eigenvalue of the symmetric part of C E: how the backlash output feeds back into its own input. It enters psi; often 0.",
+        "lambda" => "lambda, the decay rate of the Lyapunov matrix Pi found by semidefinite programming and proven by a rounding-aware check (Rump's test): Pi F + F^T Pi <= -2 lambda Pi.",
+        "beta" => "beta, the coupling between the plant and the backlash seen through Pi (an upper bound b_hat proven for the same Pi). psi(0) >= 0 always; beta sets how large it is.",
+        "osc" => "osc, the diameter of the periodic output eta_T of the linearised loop (closed form for sine inputs): how far the backlash input swings over a period.",
+        "d" => "d, the diameter of C Xi_inf + Theta: how far the backlash output can sit from eta_T once transients are gone. The backlash must move at least osc - d per period.",
+        "eta_dot_inf" => "The largest speed of eta_T over a period.",
+        "d_ftheta" => "The largest extra speed the tube adds to the backlash input (D(C(F Xi_inf + E Theta), {0})). With the previous row it bounds |z'| from above.",
+        "zdot_bound" => "An upper bound of the backlash speed |z'| after transients, Theorem 2's (zinf). Compare with the measured limsup |z'| below.",
+        "gamma_1" => "gamma_1, the paper's lower bound of the mean backlash speed per period divided by R, from (osc - d)_+.",
+        "gamma_inf" => "gamma_inf, the upper bound of the backlash speed divided by R. The chord of psi over [0, gamma_inf] gives theta.",
+        "kappa" => "kappa = gamma_1 / gamma_inf in [0, 1]: the weight of psi(gamma_inf) in theta. theta < 0 needs kappa > psi(0) / (psi(0) - psi(gamma_inf)).",
+        "psi_0" => "psi(0), the growth rate the Lyapunov bound allows while the backlash rests. Always >= 0 (proven), so convergence comes only from backlash motion.",
+        "psi_inf" => "psi(gamma_inf), the decay rate the bound allows while the backlash moves at its top speed.",
+        "psi_limit" => "-lambda, the limit of psi at infinite speed: no bound of this kind goes below it.",
+        "theta" => "theta, the paper's bound of the exponential rate at which any two trajectories approach each other. theta < 0 and verified: a unique periodic regime attracts every trajectory at least at this rate. theta >= 0: a valid bound, no convergence guaranteed.",
+        "gamma_1_star" => "gamma_1*, gamma_1 from the strongest proven path bound per period ((path1) or (path2) instead of (path)).",
+        "theta_star" => "theta*, eq. (theta) with gamma_1* and the best certified (lambda, beta): a proven bound beyond the paper (proofs-notes/theta-star.md).",
+        "theta_profile" => "theta_profile, the chord of theta applied cell by cell of the speed bound |eta_T'(t)| + D, with path bounds per interval: a proven bound beyond the paper, never above theta* (proofs-notes/theta-profile.md).",
+        "path_bound" => "(path), the paper's lower bound of the backlash path per period: (osc - d)_+.",
+        "path1_bound" => "(path1), the path bound over a partition of the period (sum of (|eta_T jumps| - d)_+), computed on a grid: at least (path).",
+        "path2_bound" => "(path2), the path bound from a packing of the orbit by balls of radius eps > d/2.",
+        "phi_first_singular" => "The first time in [0, T] at which Theorem 1's matrix Phi(t) = I - t C Psi(tA) E is singular (none: Theorem 1's representation holds on the whole period).",
+        "stationary_slack" => "Theorem 1: slack of the SDP deciding whether some initial state stays at rest for a whole period (the stationary set R(T)); > 0 means R(T) is empty.",
+        "measured_rate" => "The measured exponent: half the slope of ln V along simulated pairs of trajectories, with its 95 % interval. A verified bound must lie above it.",
+        "path_measured" => "The measured path length of the backlash output per period (compare with the path bounds).",
+        "zdot_measured" => "The measured limsup of the backlash speed |z'| (compare with the (zinf) bound).",
+        _ => return None,
+    })
+}

@@ -71,3 +71,20 @@ fn bad_input_one_line_error_nonzero_exit() {
     assert!(out.status.success());
     assert!(String::from_utf8(out.stdout).unwrap().contains("not strongly convex"));
 }
+
+#[test]
+fn explain_prints_a_glossary_row_for_every_quantity() {
+    let out = moreau()
+        .args(["theta", &example("worked-example.toml"), "--no-measure", "--no-stationary", "--explain"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8(out.stdout).unwrap();
+    let glossary = s.split("What the rows mean").nth(1).expect("glossary printed");
+    assert!(glossary.contains("- theta (84) [(theta)]: "), "{glossary}");
+    assert!(glossary.contains("psi(0)") && glossary.contains("Always >= 0"));
+    // one row per reported quantity
+    let rows = glossary.lines().filter(|l| l.starts_with("- ")).count();
+    let table_rows = s.split("What the rows mean").next().unwrap().lines().filter(|l| l.contains(" yes ") || l.contains(" no ")).count();
+    assert!(rows >= 20 && rows >= table_rows, "{rows} glossary rows for {table_rows} table rows");
+}

@@ -24,6 +24,9 @@ pub struct Args {
     /// Skip the stationary set of Theorem 1.
     #[arg(long)]
     pub no_stationary: bool,
+    /// After the report, explain every row in plain words (what it is, what to conclude).
+    #[arg(long)]
+    pub explain: bool,
     /// Skip the design guidance printed when nothing is certified (which term blocks,
     /// sensitivities, smallest certifying amplitude: a few dozen bound computations).
     #[arg(long)]
@@ -115,6 +118,18 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
     s
 }
 
+/// The glossary of `--explain`: one paragraph per reported row.
+pub fn explain(rep: &ThetaReport) -> String {
+    let mut s = String::from("\nWhat the rows mean (equation numbers as printed in the paper, source labels in brackets):\n");
+    for q in rep.quantities() {
+        if let Some(g) = bounds::report::glossary(q.key) {
+            s.push_str(&format!("- {} {} [{}]: {g}\n", q.symbol, q.equation, q.label));
+        }
+    }
+    s.push_str("A row is 'verified' when the number is a proven bound in the stated direction (rounding included); 'estimate' rows are measured or sampled and bound nothing.\n");
+    s
+}
+
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let sys = model::load(&a.file).with_context(|| a.file.display().to_string())?;
     let mut settings = ThetaSettings::default();
@@ -141,6 +156,9 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         print!("{}", render(&rep, &sys.theta.describe()));
         if let Some(g) = &guide {
             print!("{}", g.render());
+        }
+        if a.explain {
+            print!("{}", explain(&rep));
         }
     }
     Ok(ExitCode::SUCCESS)
