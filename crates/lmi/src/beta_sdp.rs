@@ -171,7 +171,9 @@ fn validate_problem(
 }
 
 /// [`solve_beta_sdp`] followed by [`certify`]; [`LmiError::NotVerified`] when no proof
-/// could be obtained.
+/// could be obtained. With the default [`VerifySettings::f_from_product`] the certificate holds
+/// for every `F` in the entrywise enclosure of `fl(A + fl(E C))`
+/// ([`crate::verify::f_enclosure_radius`]), so the exact `A + E C` is covered.
 pub fn certified_beta(
     F: &DMatrix<f64>,
     E: &DMatrix<f64>,

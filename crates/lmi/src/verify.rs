@@ -31,6 +31,17 @@
 //!
 //! The Cholesky routine below is the textbook algorithm (no FMA contraction: Rust does
 //! not contract `a * b + c`), which is what the error analysis assumes.
+//!
+//! # The rounded `F`
+//! `F = A + E C` (eq. (F)) reaches this module already rounded, `F_hat = fl(A + fl(E C))`. With
+//! `VerifySettings::f_from_product` (the default) the three inequalities are proved for *every*
+//! `F` in the entrywise enclosure `|F - F_hat| <= r_F`,
+//! `r_F = 2 (gamma_1 |F_hat| + gamma_p |E| |C|)` ([`f_enclosure_radius`]; `p` the inner
+//! dimension; `|fl(EC) - EC| <= gamma_p |E||C|` for any summation order or FMA use, and the
+//! final addition adds `u |A + fl(EC)| <= gamma_1 |F_hat|`), in particular for the exact
+//! `A + E C`. The enclosure enters the same entrywise error matrix `Err` as the rounding:
+//! `|Delta N| <= (|Pi| r_F + (|Pi| r_F)^T) / 2` in (ALI) and `|Delta H| <= r_F^T |C|^T / 2` in
+//! (bet), so the Rump margin covers it.
 
 use crate::error::{LmiError, Result};
 use crate::spectral_abscissa::{check_scalar, check_shape, check_system};
@@ -174,10 +185,43 @@ pub fn symmetrize_upper(Pi: &DMatrix<f64>) -> DMatrix<f64> {
     DMatrix::from_fn(n, n, |i, j| if i <= j { Pi[(i, j)] } else { Pi[(j, i)] })
 }
 
+/// Entrywise radius `r_F = 2 (gamma_1 |F_hat| + gamma_p |E| |C|)` of an enclosure of the exact
+/// `F = A + E C` around `F_hat = fl(A + fl(E C))` (module docs, "The rounded `F`"). It does not
+/// depend on `A`. The evaluation of the bound itself is covered by the factor 2.
+pub fn f_enclosure_radius(F: &DMatrix<f64>, E: &DMatrix<f64>, C: &DMatrix<f64>) -> DMatrix<f64> {
+    let p = E.ncols();
+    let (g1, gp) = (gamma(1), gamma(p.max(1)));
+    DMatrix::from_fn(F.nrows(), F.ncols(), |i, j| {
+        let ec: f64 = (0..p).map(|k| (E[(i, k)] * C[(k, j)]).abs()).sum();
+        2.0 * (g1 * F[(i, j)].abs() + gp * ec) + UNDERFLOW_SLACK
+    })
+}
+
 /// `N = -(S(Pi F) + lambda Pi)` of eq. (ALI), computed in floating point, with
-/// `r >= ||N_exact - N||_2`. `Pi` must be symmetric.
+/// `r >= ||N_exact - N||_2`. `Pi` must be symmetric. `F` is taken as exact; see
+/// [`lyapunov_matrix_enclosed`] for an `F` known only up to an entrywise radius.
 pub fn lyapunov_matrix(F: &DMatrix<f64>, Pi: &DMatrix<f64>, lambda: f64) -> (DMatrix<f64>, f64) {
+    lyapunov_matrix_enclosed(F, None, Pi, lambda)
+}
+
+/// `(|Pi| r_F)_ij` (the perturbation of `Pi F` over the enclosure), rounded up by the factor
+/// `1 + 2 gamma_{n+1}`.
+fn abs_pi_times(Pi: &DMatrix<f64>, Fr: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = Pi.nrows();
+    let g = 1.0 + 2.0 * gamma(n + 1);
+    DMatrix::from_fn(n, Fr.ncols(), |i, j| (0..n).map(|k| Pi[(i, k)].abs() * Fr[(k, j)]).sum::<f64>() * g)
+}
+
+/// [`lyapunov_matrix`] for every `F` with `|F - F_hat| <= Fr` entrywise (`Fr = None`: exact `F`):
+/// `r >= sup ||N_exact(F) - N||_2` over the enclosure.
+pub fn lyapunov_matrix_enclosed(
+    F: &DMatrix<f64>,
+    Fr: Option<&DMatrix<f64>>,
+    Pi: &DMatrix<f64>,
+    lambda: f64,
+) -> (DMatrix<f64>, f64) {
     let n = F.nrows();
+    let PFr = Fr.map(|Fr| abs_pi_times(Pi, Fr));
     let gN = 2.0 * gamma(2 * n + 1);
     let mut N = DMatrix::zeros(n, n);
     let mut ErrB = DMatrix::zeros(n, n);
@@ -195,7 +239,10 @@ pub fn lyapunov_matrix(F: &DMatrix<f64>, Pi: &DMatrix<f64>, lambda: f64) -> (DMa
             let t3 = -lambda * Pi[(i, j)];
             s += t3;
             a += t3.abs();
-            let e = gN * a + UNDERFLOW_SLACK * (2 * n + 2) as f64;
+            let mut e = gN * a + UNDERFLOW_SLACK * (2 * n + 2) as f64;
+            if let Some(P) = &PFr {
+                e += 0.5 * (P[(i, j)] + P[(j, i)]) * (1.0 + 4.0 * UNIT_ROUNDOFF);
+            }
             N[(i, j)] = s;
             N[(j, i)] = s;
             ErrB[(i, j)] = e;
@@ -211,9 +258,23 @@ pub fn h_matrix(F: &DMatrix<f64>, E: &DMatrix<f64>, C: &DMatrix<f64>, Pi: &DMatr
 }
 
 /// `K = [[Pi, H], [H^T, b I_p]]` (eq. (bet) via the Schur complement), computed in
-/// floating point, with `r >= ||K_exact - K||_2` (only the `H` blocks carry rounding).
+/// floating point, with `r >= ||K_exact - K||_2` (only the `H` blocks carry rounding). `F` is
+/// taken as exact; see [`schur_block_enclosed`].
 pub fn schur_block(
     F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    Pi: &DMatrix<f64>,
+    b: f64,
+) -> (DMatrix<f64>, f64) {
+    schur_block_enclosed(F, None, E, C, Pi, b)
+}
+
+/// [`schur_block`] for every `F` with `|F - F_hat| <= Fr` entrywise (`Fr = None`: exact `F`):
+/// `H` moves by at most `(r_F^T |C|^T)_ij / 2` per entry.
+pub fn schur_block_enclosed(
+    F: &DMatrix<f64>,
+    Fr: Option<&DMatrix<f64>>,
     E: &DMatrix<f64>,
     C: &DMatrix<f64>,
     Pi: &DMatrix<f64>,
@@ -237,7 +298,11 @@ pub fn schur_block(
                 s += t2;
                 a += t1.abs() + t2.abs();
             }
-            let e = gN * a + UNDERFLOW_SLACK * (2 * n + 1) as f64;
+            let mut e = gN * a + UNDERFLOW_SLACK * (2 * n + 1) as f64;
+            if let Some(Fr) = Fr {
+                let d: f64 = (0..n).map(|k| Fr[(k, i)] * C[(j, k)].abs()).sum();
+                e += 0.5 * d * (1.0 + 2.0 * gamma(n + 1));
+            }
             K[(i, n + j)] = s;
             K[(n + j, i)] = s;
             ErrB[(i, n + j)] = e;
@@ -295,11 +360,15 @@ pub struct VerifySettings {
     /// Maximum number of back-off / inflation attempts each. Default `24`
     /// (`4^24 * 1e-12 ~ 0.28` relative at most).
     pub max_adjust_steps: usize,
+    /// `F` was computed as `fl(A + fl(E C))`: prove the inequalities for every `F` in the
+    /// enclosure of [`f_enclosure_radius`] (module docs, "The rounded `F`"). `false` treats the
+    /// `F` handed in as exact. Default `true`.
+    pub f_from_product: bool,
 }
 
 impl Default for VerifySettings {
     fn default() -> Self {
-        Self { tol_backoff_rel: 1e-12, tol_inflate_rel: 1e-12, max_adjust_steps: 24 }
+        Self { tol_backoff_rel: 1e-12, tol_inflate_rel: 1e-12, max_adjust_steps: 24, f_from_product: true }
     }
 }
 
@@ -339,6 +408,10 @@ pub struct Certificate {
     pub schur: Margin,
     /// The certified matrix (symmetric, from the upper triangle of the input).
     pub Pi: DMatrix<f64>,
+    /// Frobenius norm of the entrywise radius `r_F` of the enclosure of `F` that the
+    /// certificate covers (0 when `F` was taken as exact).
+    #[serde(default)]
+    pub f_radius: f64,
 }
 
 fn check_inputs(
@@ -357,7 +430,17 @@ fn check_inputs(
     Ok(())
 }
 
-/// Check the three inequalities exactly at the given `lambda` and `b_hat` (no adjustment).
+/// The enclosure radius of `F` that [`certify`] covers under `settings`.
+fn f_radius_for(F: &DMatrix<f64>, E: &DMatrix<f64>, C: &DMatrix<f64>, f_from_product: bool) -> Option<DMatrix<f64>> {
+    f_from_product.then(|| f_enclosure_radius(F, E, C))
+}
+
+fn frobenius_opt(Fr: &Option<DMatrix<f64>>) -> f64 {
+    Fr.as_ref().map_or(0.0, |r| r.iter().map(|e| e * e).sum::<f64>().sqrt())
+}
+
+/// Check the three inequalities exactly at the given `lambda` and `b_hat` (no adjustment), for
+/// every `F` in the enclosure of `fl(A + fl(E C))` ([`f_enclosure_radius`]).
 pub fn check_certificate(
     F: &DMatrix<f64>,
     E: &DMatrix<f64>,
@@ -366,15 +449,31 @@ pub fn check_certificate(
     lambda: f64,
     b_hat: f64,
 ) -> Result<Certificate> {
+    check_certificate_with(F, E, C, Pi, lambda, b_hat, true)
+}
+
+/// [`check_certificate`] with the choice of [`VerifySettings::f_from_product`]: `false` takes `F`
+/// as exact.
+pub fn check_certificate_with(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    Pi: &DMatrix<f64>,
+    lambda: f64,
+    b_hat: f64,
+    f_from_product: bool,
+) -> Result<Certificate> {
     check_inputs(F, E, C, Pi, lambda, b_hat)?;
+    let Fr = f_radius_for(F, E, C, f_from_product);
     let Pi = symmetrize_upper(Pi);
     let pi_positive = psd_margin(&Pi, 0.0);
     let pi_positive = Margin { verified: pi_positive.verified && pi_positive.lower_bound > 0.0, ..pi_positive };
-    let (N, rN) = lyapunov_matrix(F, &Pi, lambda);
+    let (N, rN) = lyapunov_matrix_enclosed(F, Fr.as_ref(), &Pi, lambda);
     let lyapunov = psd_margin(&N, rN);
-    let (K, rK) = schur_block(F, E, C, &Pi, b_hat);
+    let (K, rK) = schur_block_enclosed(F, Fr.as_ref(), E, C, &Pi, b_hat);
     let schur = psd_margin(&K, rK);
     Ok(Certificate {
+        f_radius: frobenius_opt(&Fr),
         verified: pi_positive.verified && lyapunov.verified && schur.verified,
         lambda_requested: lambda,
         lambda,
@@ -404,6 +503,8 @@ pub fn certify(
 ) -> Result<Certificate> {
     settings.validate()?;
     check_inputs(F, E, C, Pi, lambda, b)?;
+    let Fr = f_radius_for(F, E, C, settings.f_from_product);
+    let Fr_ref = Fr.as_ref();
     let Pi = symmetrize_upper(Pi);
     let n = Pi.nrows();
     let pi_positive = psd_margin(&Pi, 0.0);
@@ -411,7 +512,7 @@ pub fn certify(
     let pi_positive = Margin { verified: pi_ok, ..pi_positive };
 
     // (ALI): lambda first as asked, then backed off below the floating-point lambda(Pi).
-    let (N, rN) = lyapunov_matrix(F, &Pi, lambda);
+    let (N, rN) = lyapunov_matrix_enclosed(F, Fr_ref, &Pi, lambda);
     let mut lyapunov = psd_margin(&N, rN);
     let mut lambda_v = lambda;
     if !lyapunov.verified {
@@ -424,7 +525,7 @@ pub fn certify(
             if !(l > 0.0) {
                 break;
             }
-            let (N, rN) = lyapunov_matrix(F, &Pi, l);
+            let (N, rN) = lyapunov_matrix_enclosed(F, Fr_ref, &Pi, l);
             let m = psd_margin(&N, rN);
             if m.verified {
                 lyapunov = m;
@@ -436,7 +537,7 @@ pub fn certify(
 
     // (bet): b as asked, then inflated above the floating-point beta(Pi).
     let beta_est = beta_estimate(F, E, C, &Pi);
-    let (K, rK) = schur_block(F, E, C, &Pi, b);
+    let (K, rK) = schur_block_enclosed(F, Fr_ref, E, C, &Pi, b);
     let mut schur = psd_margin(&K, rK);
     let mut b_hat = b;
     if !schur.verified && beta_est.is_finite() {
@@ -446,7 +547,7 @@ pub fn certify(
         for _ in 0..settings.max_adjust_steps {
             let bb = start + step;
             step *= 4.0;
-            let (K, rK) = schur_block(F, E, C, &Pi, bb);
+            let (K, rK) = schur_block_enclosed(F, Fr_ref, E, C, &Pi, bb);
             let m = psd_margin(&K, rK);
             if m.verified {
                 schur = m;
@@ -456,6 +557,7 @@ pub fn certify(
         }
     }
     Ok(Certificate {
+        f_radius: frobenius_opt(&Fr),
         verified: pi_ok && lyapunov.verified && schur.verified,
         lambda_requested: lambda,
         lambda: lambda_v,

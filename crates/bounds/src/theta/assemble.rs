@@ -226,7 +226,12 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let R_verified = sc.is_verified_upper() || R == f64::INFINITY;
 
     // Tubes C Xi_inf and C F Xi_inf and their diameters (eqs. (d), (zinf)).
-    let diam = tube_diameters(C, &F, E, &theta_set, &settings.tube, &settings.sphere)?;
+    // (issue 15) the tube covers every F in the enclosure of fl(A + fl(E C)).
+    let tube = crate::tube::TubeSettings {
+        f_radius: lmi::verify::f_enclosure_radius(&F, E, C).norm() * (1.0 + 1e-10),
+        ..settings.tube
+    };
+    let diam = tube_diameters(C, &F, E, &theta_set, &tube, &settings.sphere)?;
     let (d, d_lower) = (diam.d.upper, diam.d.lower);
     let (d_ftheta, d_ftheta_lower) = (diam.d_ftheta.upper, diam.d_ftheta.lower);
     let d_ok = diam.verified;
@@ -241,14 +246,22 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
 
     // gamma_1, gamma_inf, eqs. (g1), (ginf), at the upper bound of R.
     let strongly_convex = R.is_finite() && R > 0.0;
-    let (gamma_1, gamma_inf) =
-        if strongly_convex { ((osc - d).max(0.0) / (T * R), zdot_bound / R) } else { (0.0, 0.0) };
+    // (issue 15) rounded safely: gamma_1 down, gamma_inf up (theta increases with gamma_inf), by
+    // 8u relative on top of the <= 3 roundings of each formula.
+    let (gamma_1, gamma_inf) = if strongly_convex {
+        (
+            down((osc - d).max(0.0) / (T * R) * (1.0 - 4.0 * f64::EPSILON)),
+            (zdot_bound / R * (1.0 + 4.0 * f64::EPSILON)).next_up(),
+        )
+    } else {
+        (0.0, 0.0)
+    };
     if !strongly_convex {
         notes.push(format!(
             "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0) >= 0 for every admissible Pi (proofs-notes/psi0.md), so eq. (theta) cannot certify convergence here"
         ));
     }
-    let kappa = if gamma_inf > 0.0 { (gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
+    let kappa = if gamma_inf > 0.0 { down(gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
 
     // alpha, eq. (alpha), and the lambda search (eqs. (ALI), (bet), (theta)).
     let al = alpha(C, E);

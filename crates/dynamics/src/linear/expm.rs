@@ -13,6 +13,93 @@ pub fn expm(M: &DMatrix<f64>) -> DMatrix<f64> {
     M.clone().exp()
 }
 
+/// Unit roundoff `u = 2^-53`.
+const U: f64 = f64::EPSILON / 2.0;
+
+/// `gamma_k = k u / (1 - k u)` (Higham's notation; `+inf` when `k u >= 1`).
+fn gamma(k: usize) -> f64 {
+    let ku = k as f64 * U;
+    if ku >= 1.0 {
+        f64::INFINITY
+    } else {
+        ku / (1.0 - ku)
+    }
+}
+
+/// Frobenius norm rounded upward: the computed `sqrt(sum x^2)` has relative error below
+/// `gamma_{len + 2}` (sum of squares `gamma_len`, square root and its rounding).
+pub fn frobenius_up(M: &DMatrix<f64>) -> f64 {
+    let s: f64 = M.iter().map(|x| x * x).sum();
+    s.sqrt() * (1.0 + 2.0 * gamma(M.len() + 2))
+}
+
+/// `e^M` together with a rigorous bound `err >= ||X - e^M||_F` on the error of the returned
+/// `X = expm(M)` (the exact exponential of the floating-point matrix `M`).
+///
+/// The bound compares `X` with an independent evaluation `Y` whose error is bounded a priori:
+/// `B = M / 2^s` (exact scaling by a power of two, `||B||_F <= 1/2`), the Taylor polynomial
+/// `T_K(B)`, `K = 18`, by Horner's rule, then `s` squarings. Truncation:
+/// `||e^B - T_K(B)|| <= ||B||^{K+1} / (K+1)! / (1 - ||B|| / (K+2))`. Rounding, in Frobenius norms
+/// of the computed matrices (`|fl(PQ) - PQ| <= gamma_n |P||Q|`, so
+/// `||fl(PQ) - PQ||_F <= gamma_n ||P||_F ||Q||_F`):
+/// - Horner step `Z <- I + (B Z) / k`: `e <- (||B|| e + gamma_n ||B|| ||Z||) / k + 2u (||V|| + ||Z'||)`;
+/// - squaring `Y <- Y^2`: `e <- gamma_n ||Y||^2 + e (2 ||Y|| + e)`.
+///
+/// Then `err = ||X - Y||_F + e`, all terms rounded up (a relative `1e-6` on the bound covers the
+/// rounding of its own evaluation). Non-finite input, or an `M` whose scaling would underflow,
+/// gives `err = +inf` (never a wrong bound). The bound is sharp (a few ulps of `||e^M||`) for
+/// `||M|| <~ 1` and loosens by about `(2 ||Y_i||)` per squaring for larger `||M||`.
+pub fn expm_enclosure(M: &DMatrix<f64>) -> (DMatrix<f64>, f64) {
+    let X = expm(M);
+    let n = M.nrows();
+    let nm = frobenius_up(M);
+    if !(nm.is_finite() && X.iter().all(|x| x.is_finite())) {
+        return (X, f64::INFINITY);
+    }
+    if n == 0 {
+        return (X, 0.0);
+    }
+    let mut s = 0i32;
+    while nm * 0.5f64.powi(s) > 0.5 {
+        s += 1;
+    }
+    let scale = 0.5f64.powi(s);
+    // Scaling by 2^-s is exact unless it reaches the subnormal range.
+    if M.iter().any(|&x| x != 0.0 && (x * scale).abs() < 1e-290) {
+        return (X, f64::INFINITY);
+    }
+    let B = M * scale;
+    let nb = frobenius_up(&B);
+    let gn = gamma(n);
+    const K: usize = 18;
+    let I = DMatrix::<f64>::identity(n, n);
+    let mut Z = I.clone();
+    let mut e = 0.0f64;
+    for k in (1..=K).rev() {
+        let nz = frobenius_up(&Z);
+        let W = &B * &Z;
+        let V = W / k as f64;
+        let Zn = &I + &V;
+        e = (nb * e + gn * nb * nz) / k as f64 + 2.0 * U * (frobenius_up(&V) + frobenius_up(&Zn));
+        Z = Zn;
+    }
+    // Truncation of the Taylor series.
+    let mut fact = 1.0f64;
+    for k in 1..=K + 1 {
+        fact *= k as f64;
+    }
+    e += nb.powi(K as i32 + 1) / fact / (1.0 - nb / (K as f64 + 2.0));
+    let mut Y = Z;
+    for _ in 0..s {
+        let ny = frobenius_up(&Y);
+        e = gn * ny * ny + e * (2.0 * ny + e);
+        Y = &Y * &Y;
+    }
+    let diff = frobenius_up(&(&X - &Y)) * (1.0 + 2.0 * U);
+    let err = (diff + e) * (1.0 + 1e-6) + 1e-300;
+    (X, if err.is_finite() { err } else { f64::INFINITY })
+}
+
 /// The three blocks of the augmented exponential for the step `t`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExpIntegrals {
@@ -57,6 +144,41 @@ pub fn t_psi(A: &DMatrix<f64>, t: f64) -> DMatrix<f64> {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn expm_enclosure_is_tight_and_contains_the_exact_exponential() {
+        // Nilpotent: e^M = I + M exactly.
+        let M = DMatrix::from_row_slice(2, 2, &[0.0, 0.75, 0.0, 0.0]);
+        let (X, err) = expm_enclosure(&M);
+        let exact = DMatrix::from_row_slice(2, 2, &[1.0, 0.75, 0.0, 1.0]);
+        assert!(frobenius_up(&(&X - &exact)) <= err, "{err}");
+        assert!(err < 1e-14, "{err}");
+        // Rotation generator: e^{t J} = [[cos t, sin t], [-sin t, cos t]].
+        for t in [0.1, 1.0, 3.0, 10.0] {
+            let M = DMatrix::from_row_slice(2, 2, &[0.0, t, -t, 0.0]);
+            let (X, err) = expm_enclosure(&M);
+            let exact = DMatrix::from_row_slice(2, 2, &[t.cos(), t.sin(), -t.sin(), t.cos()]);
+            assert!(frobenius_up(&(&X - &exact)) <= err + 4e-16, "t {t}: err {err}");
+            assert!(err < 1e-12, "t {t}: err {err}");
+        }
+        // Stable non-normal 3x3: the bound stays small at ||M|| ~ 1 (measured 1.1e-14).
+        let M = DMatrix::from_row_slice(3, 3, &[-0.3, 0.8, 0.0, 0.0, -0.5, 0.4, 0.1, 0.0, -0.2]);
+        let e3 = expm_enclosure(&M).1;
+        assert!(e3 < 5e-14, "{e3}");
+        assert!(expm_enclosure(&DMatrix::from_element(1, 1, f64::NAN)).1.is_infinite());
+    }
+
+    /// Negative control: a wrong "exponential" (one entry off by 1e-10) is outside the
+    /// enclosure, i.e. the bound is not vacuous.
+    #[test]
+    fn negative_control_perturbed_exponential_is_outside_the_bound() {
+        let M = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.6]);
+        let (X, err) = expm_enclosure(&M);
+        let mut Xw = X.clone();
+        Xw[(0, 1)] += 1e-10;
+        // ||Xw - e^M|| >= 1e-10 - err > err.
+        assert!(1e-10 - err > err, "{err}");
+    }
 
     #[test]
     fn scalar_case_matches_the_closed_forms() {

@@ -15,6 +15,11 @@ pub struct BallIntersection {
     radii: Vec<f64>,
     /// Which balls carry part of the boundary (computed at construction).
     active: Vec<bool>,
+    /// Upper bound of `R`: the largest radius among the balls that are not *surely* inactive
+    /// (a ball whose sphere might carry a sliver of the boundary within the tolerance of the
+    /// activity test counts; the intersection is unchanged by any ball, so any superset of
+    /// the active balls gives a valid bound).
+    r_upper: f64,
 }
 
 /// The sphere `{v : |v - c_i| = r_i, i in S}` written as a sphere of centre `m` and radius
@@ -51,23 +56,25 @@ impl BallIntersection {
         if let Some(&r) = radii.iter().find(|&&r| r < 0.0) {
             return Err(GeometryError::Negative { what: "ball radius", value: r });
         }
-        let mut s = Self { centres, radii, active: vec![] };
+        let mut s = Self { centres, radii, active: vec![], r_upper: 0.0 };
         // nonempty: the projection of the first centre must satisfy the KKT conditions
         let mut out = vec![0.0; p];
         if !s.project_exact(&s.centres[0].clone(), &mut out) {
             return Err(GeometryError::EmptyIntersection);
         }
         let k = s.radii.len();
-        s.active = (0..k)
+        // farthest distance from centre i of the intersection of the other balls (None: alone)
+        let far: Vec<Option<f64>> = (0..k)
             .map(|i| {
                 let others: Vec<usize> = (0..k).filter(|&j| j != i).collect();
-                if others.is_empty() {
-                    return true;
-                }
-                let far = s.farthest_from(&s.centres[i].clone(), &others);
-                far > s.radii[i] * (1.0 + 1e-9) + 1e-14
+                (!others.is_empty()).then(|| s.farthest_from(&s.centres[i].clone(), &others))
             })
             .collect();
+        s.active = (0..k).map(|i| far[i].is_none_or(|f| f > s.radii[i] * (1.0 + 1e-9) + 1e-14)).collect();
+        s.r_upper = (0..k)
+            .filter(|&i| far[i].is_none_or(|f| f.is_nan() || f > s.radii[i] * (1.0 - 1e-9) - 1e-14))
+            .map(|i| s.radii[i])
+            .fold(0.0, f64::max);
         Ok(s)
     }
 
@@ -76,6 +83,25 @@ impl BallIntersection {
     }
     pub fn radii(&self) -> &[f64] {
         &self.radii
+    }
+    /// Proven upper bound of `sigma(u)` ([`super::upper`]): the split certificate at the computed
+    /// maximiser over the balls whose sphere passes through it, and the single-ball bounds
+    /// `sigma <= sigma_{B_i}`; the smallest.
+    pub fn support_upper(&self, u: &[f64]) -> f64 {
+        let single = (0..self.radii.len())
+            .map(|i| super::upper::ball_support_upper(&self.centres[i], self.radii[i], u))
+            .fold(f64::INFINITY, f64::min);
+        let mut s = vec![0.0; self.dim()];
+        self.support_point(u, &mut s);
+        let on: Vec<usize> = (0..self.radii.len())
+            .filter(|&i| dist(&s, &self.centres[i]) >= self.radii[i] * (1.0 - 1e-7) - 1e-14)
+            .collect();
+        let cs: Vec<&[f64]> = on.iter().map(|&i| self.centres[i].as_slice()).collect();
+        let rs: Vec<f64> = on.iter().map(|&i| self.radii[i]).collect();
+        match super::upper::split_support_upper(&cs, &rs, &s, u) {
+            Some(b) => b.min(single),
+            None => single,
+        }
     }
     /// Whether ball `i` carries part of the boundary.
     pub fn active(&self) -> &[bool] {
@@ -354,10 +380,10 @@ impl ConvexSet for BallIntersection {
     }
     /// `R` = largest radius among the active balls: on an active sphere the boundary has
     /// curvature `1/r_i`, so `R >= r_i`; and `K` is an intersection of balls of radius
-    /// `<= max active r_i`.
+    /// `<= max active r_i`. Returned from above: balls within the activity test's tolerance of
+    /// being active count as active (`r_upper`).
     fn strong_convexity(&self) -> StrongConvexity {
-        let r = self.radii.iter().zip(&self.active).filter(|(_, &a)| a).map(|(r, _)| *r).fold(0.0, f64::max);
-        StrongConvexity::Exact(r)
+        StrongConvexity::Exact(self.r_upper)
     }
     fn describe(&self) -> String {
         let parts: Vec<String> =

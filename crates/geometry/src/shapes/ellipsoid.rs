@@ -2,6 +2,7 @@
 //! matrix `M`; its semi-axes are `a_i = sqrt(eig_i(M))`.
 use super::{check_finite, fmt_vec};
 use crate::linalg::norm;
+use crate::strong_convexity::{div_up, sqrt_down, sqrt_up, symmetric_eigen_enclosure, EigenEnclosure};
 use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
 use nalgebra::DMatrix;
 
@@ -10,7 +11,9 @@ pub const MAX_DIM: usize = 16;
 
 /// Ellipsoid with centre `c` and shape matrix `M` (SPD). Support function
 /// `sigma(u) = c^T u + sqrt(u^T M u)`; strong-convexity constant `R = max a_i^2 / min a_i`
-/// (eq. (R), NOTES.md).
+/// (eq. (R), NOTES.md), bounded from above with verified bounds of the extreme eigenvalues of `M`
+/// (exact for a diagonal `M`; Rump's Cholesky test otherwise,
+/// [`crate::strong_convexity::symmetric_eigen_enclosure`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ellipsoid {
     centre: Vec<f64>,
@@ -22,6 +25,9 @@ pub struct Ellipsoid {
     v: Vec<f64>,
     /// `M^{-1}`, row-major.
     m_inv: Vec<f64>,
+    /// Proven enclosure of `lambda_min(M)` from below and `lambda_max(M)` from above (`None` when
+    /// the verification failed: `R` is then only a numerical estimate).
+    enclosure: Option<EigenEnclosure>,
 }
 
 impl Ellipsoid {
@@ -66,8 +72,9 @@ impl Ellipsoid {
                 m_inv[i * p + j] = (0..p).map(|k| v[i * p + k] * v[j * p + k] / lam[k]).sum();
             }
         }
-        let m = (0..p * p).map(|ij| sym[(ij / p, ij % p)]).collect();
-        Ok(Self { centre, m, lam, v, m_inv })
+        let m: Vec<f64> = (0..p * p).map(|ij| sym[(ij / p, ij % p)]).collect();
+        let enclosure = symmetric_eigen_enclosure(&m, p, lam[0], lam[p - 1]);
+        Ok(Self { centre, m, lam, v, m_inv, enclosure })
     }
 
     /// Axis-aligned ellipsoid with the given semi-axes.
@@ -88,6 +95,19 @@ impl Ellipsoid {
     /// Shape matrix `M` (row-major).
     pub fn matrix(&self) -> &[f64] {
         &self.m
+    }
+    /// Proven bounds `lambda_min(M) >= min_lower`, `lambda_max(M) <= max_upper` (`None` when the
+    /// verification failed).
+    pub fn eigen_enclosure(&self) -> Option<EigenEnclosure> {
+        self.enclosure
+    }
+    /// Upper bound of the longest semi-axis `a_max = sqrt(lambda_max(M))`: proven when the eigenvalue
+    /// enclosure is verified, otherwise the estimate with a relative `1e-8` added.
+    fn a_max_upper(&self) -> f64 {
+        match self.enclosure {
+            Some(e) => sqrt_up(e.max_upper),
+            None => self.lam[self.lam.len() - 1].sqrt() * (1.0 + 1e-8),
+        }
     }
 
     /// Coordinates of `x - c` in the eigenbasis.
@@ -302,22 +322,39 @@ impl ConvexSet for Ellipsoid {
             out[i] = s * n[i];
         }
     }
+    /// `2 a_max`, from above with the verified bound of `lambda_max(M)`.
     fn diameter(&self) -> Bounds {
-        Bounds::exact(2.0 * self.lam[self.lam.len() - 1].sqrt())
+        let up = 2.0 * self.a_max_upper();
+        Bounds::new((2.0 * self.lam[self.lam.len() - 1].sqrt()).min(up), up)
     }
-    /// `max_{|u|=1} c^T u + sqrt(u^T M u)`; exact when `c = 0`, otherwise certified by
-    /// [`crate::sphere_max`].
+    /// `max_{|u|=1} c^T u + sqrt(u^T M u)`; `a_max` (from above) when `c = 0`, otherwise
+    /// certified by [`crate::sphere_max`].
     fn deviation_from_origin(&self) -> Bounds {
-        let amax = self.lam[self.lam.len() - 1].sqrt();
+        let up = self.a_max_upper();
         let cn = norm(&self.centre);
         if cn == 0.0 {
-            return Bounds::exact(amax);
+            return Bounds::new(self.lam[self.lam.len() - 1].sqrt().min(up), up);
         }
-        crate::sphere_max(self.dim(), |u| self.support(u), cn + amax, &Default::default())
+        crate::sphere_max(self.dim(), |u| self.support(u), (cn + up) * (1.0 + 1e-12), &Default::default())
     }
+    /// `R = lambda_max / sqrt(lambda_min)` from the verified eigenvalue enclosure, rounded upward:
+    /// `Exact` for a diagonal `M` (exact eigenvalues), `UpperBound` otherwise; `Numerical` (not a
+    /// verified upper bound) when the enclosure could not be proved.
     fn strong_convexity(&self) -> StrongConvexity {
-        let amax2 = self.lam[self.lam.len() - 1];
-        StrongConvexity::Exact(amax2 / self.lam[0].sqrt())
+        match self.enclosure {
+            Some(e) if e.min_lower > 0.0 => {
+                let r = div_up(e.max_upper, sqrt_down(e.min_lower));
+                if e.exact {
+                    StrongConvexity::Exact(r)
+                } else {
+                    StrongConvexity::UpperBound(r)
+                }
+            }
+            _ => {
+                let value = self.lam[self.lam.len() - 1] / self.lam[0].sqrt();
+                StrongConvexity::Numerical { value, error: 1e-8 * value }
+            }
+        }
     }
     fn describe(&self) -> String {
         format!("ellipsoid(centre={}, semi-axes={})", fmt_vec(&self.centre), fmt_vec(&self.semi_axes()))

@@ -66,14 +66,17 @@ impl ConvexSet for Interval {
             (false, false) => 0.0,
         };
     }
+    /// `hi - lo`, rounded upward (the lower end rounded to nearest).
     fn diameter(&self) -> Bounds {
-        Bounds::exact(self.hi - self.lo)
+        let up = crate::strong_convexity::add_up(self.hi, -self.lo);
+        Bounds::new((self.hi - self.lo).min(up), up)
     }
     fn deviation_from_origin(&self) -> Bounds {
         Bounds::exact(self.lo.abs().max(self.hi.abs()))
     }
+    /// `R = (hi - lo)/2`, the difference rounded upward (TwoSum), the halving exact.
     fn strong_convexity(&self) -> StrongConvexity {
-        StrongConvexity::Exact(0.5 * (self.hi - self.lo))
+        StrongConvexity::Exact(0.5 * crate::strong_convexity::add_up(self.hi, -self.lo))
     }
     fn describe(&self) -> String {
         format!("interval [{}, {}]", self.lo, self.hi)

@@ -6,6 +6,7 @@ pub mod interval;
 pub mod polytope;
 pub mod shape;
 pub mod support_set;
+pub mod upper;
 
 pub use ball::Ball;
 pub use ball_intersection::BallIntersection;

@@ -11,6 +11,10 @@ pub struct Polytope {
     normals: Vec<Vec<f64>>,
     offsets: Vec<f64>,
     vertices: Vec<Vec<f64>>,
+    /// `|a_i|` of every row and `max |vertex|` enlarged by a relative `1e-9` (for
+    /// [`Polytope::support_upper`]).
+    row_norms: Vec<f64>,
+    dev_upper: f64,
 }
 
 impl Polytope {
@@ -103,7 +107,9 @@ impl Polytope {
         if vertices.is_empty() {
             return Err(GeometryError::EmptyPolytope);
         }
-        Ok(Self { normals, offsets, vertices })
+        let row_norms = normals.iter().map(|a| norm(a)).collect();
+        let dev_upper = vertices.iter().map(|v| norm(v)).fold(0.0, f64::max) * (1.0 + 1e-9);
+        Ok(Self { normals, offsets, vertices, row_norms, dev_upper })
     }
 
     /// The box `prod_i [lower_i, upper_i]`.
@@ -142,6 +148,16 @@ impl Polytope {
 
     fn feasible(&self, v: &[f64]) -> bool {
         self.normals.iter().zip(&self.offsets).all(|(a, b)| dot(a, v) <= b + 1e-12 * (1.0 + b.abs()) * norm(a).max(1.0))
+    }
+}
+
+impl Polytope {
+    /// Proven upper bound of `sigma(u)` by the Lagrangian certificate at the computed maximising
+    /// vertex ([`super::upper::polytope_support_upper`]), with `D(S,{0})` from the vertices
+    /// enlarged by a relative `1e-9` (it only multiplies the certificate's residual).
+    pub fn support_upper(&self, u: &[f64]) -> f64 {
+        let best = self.vertices.iter().max_by(|a, b| dot(u, a).total_cmp(&dot(u, b))).unwrap();
+        super::upper::polytope_support_upper(&self.normals, &self.row_norms, &self.offsets, best, self.dev_upper, u)
     }
 }
 
@@ -240,7 +256,10 @@ impl ConvexSet for Polytope {
     }
     fn strong_convexity(&self) -> StrongConvexity {
         if self.dim() == 1 {
-            StrongConvexity::Exact(0.5 * self.diameter().upper)
+            // Half the length, the difference rounded upward.
+            let hi = self.vertices.iter().map(|v| v[0]).fold(f64::NEG_INFINITY, f64::max);
+            let lo = self.vertices.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min);
+            StrongConvexity::Exact(0.5 * crate::strong_convexity::add_up(hi, -lo))
         } else {
             StrongConvexity::Infinite
         }

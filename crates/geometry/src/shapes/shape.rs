@@ -27,6 +27,18 @@ impl Shape {
     pub fn origin(p: usize) -> Self {
         Shape::Ball(Ball { centre: vec![0.0; p], radius: 0.0 })
     }
+    /// A proven upper bound of `sigma(u)` for the exact `u` handed in, the rounding of the
+    /// evaluation included ([`super::upper`]): closed forms with `gamma_k` bounds for intervals,
+    /// balls and ellipsoids, dual certificates for intersections of balls and polytopes.
+    pub fn support_upper(&self, u: &[f64]) -> f64 {
+        match self {
+            Shape::Interval(i) => super::upper::mul_up(u[0], if u[0] >= 0.0 { i.hi } else { i.lo }),
+            Shape::Ball(b) => super::upper::ball_support_upper(&b.centre, b.radius, u),
+            Shape::Ellipsoid(e) => super::upper::ellipsoid_support_upper(e.centre(), e.matrix(), u),
+            Shape::BallIntersection(bi) => bi.support_upper(u),
+            Shape::Polytope(pt) => pt.support_upper(u),
+        }
+    }
 }
 
 macro_rules! dispatch {

@@ -165,7 +165,9 @@ impl ConvexSet for SupportSet {
     }
     fn strong_convexity(&self) -> StrongConvexity {
         match self.dim {
-            1 => StrongConvexity::Exact(0.5 * (self.support(&[1.0]) + self.support(&[-1.0]))),
+            1 => StrongConvexity::Exact(
+                0.5 * crate::strong_convexity::add_up(self.support(&[1.0]), self.support(&[-1.0])),
+            ),
             2 => planar_strong_convexity(|u| self.support(u)),
             _ => StrongConvexity::Unknown,
         }
