@@ -37,4 +37,24 @@ pub enum ModelError {
     CsvValue { path: String, row: usize, column: String, value: String },
     #[error("key `{key}`: unknown key (known here: {known})")]
     UnknownKey { key: String, known: &'static str },
+    #[error("cannot read {path}: {kind}, not a regular file (input files must be regular files)")]
+    NotRegularFile { path: String, kind: &'static str },
+    #[error("cannot read {path}: {bytes} bytes, more than the limit of {limit} bytes")]
+    FileTooLarge { path: String, bytes: u64, limit: u64 },
+    #[error("keys `{a}` and `{b}` exclude each other: give only one")]
+    ExclusiveKeys { a: String, b: String },
+    #[error("key `{key}`: {reason} (value {})", fmt_num(*value))]
+    Invalid { key: String, value: f64, reason: String },
+    #[error("key `theta`: the intersection of the balls has an empty interior ({reason}); projections onto it do not converge")]
+    EmptyInterior { reason: String },
+}
+
+/// A number for an error message: plain decimals for ordinary magnitudes, scientific
+/// notation for very large or small ones.
+pub fn fmt_num(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }

@@ -105,16 +105,20 @@ impl Input {
     /// non-numeric cells, NaN/inf, and time stamps that do not increase strictly.
     pub fn from_csv(path: &Path, period: Option<f64>) -> Result<Self, ModelError> {
         let ps = path.display().to_string();
-        let mut rdr = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(|e| ModelError::Csv { path: ps.clone(), reason: e.to_string() })?;
+        let text = crate::files::read_regular(path, crate::files::MAX_CSV_BYTES)?;
+        let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
         let headers = rdr.headers().map_err(|e| ModelError::Csv { path: ps.clone(), reason: e.to_string() })?.clone();
         let names: Vec<String> = headers.iter().map(|h| h.to_string()).collect();
         if names.len() < 2 || names[0] != "t" || !names[1..].iter().all(|h| h.starts_with('w')) {
             return Err(ModelError::Csv {
                 path: ps,
                 reason: format!("header must be `t,w` or `t,w1,...,wm`, found `{}`", names.join(",")),
+            });
+        }
+        if let Some((j, dup)) = names.iter().enumerate().find(|(j, n)| names[..*j].contains(n)) {
+            return Err(ModelError::Csv {
+                path: ps,
+                reason: format!("duplicate column `{dup}` (column {}) in header `{}`", j + 1, names.join(",")),
             });
         }
         let mut t = Vec::new();
@@ -131,7 +135,17 @@ impl Input {
             let mut vals = Vec::with_capacity(names.len());
             for (j, cell) in rec.iter().enumerate() {
                 match cell.parse::<f64>() {
-                    Ok(x) if x.is_finite() => vals.push(x),
+                    Ok(x) if x.is_finite() && x.abs() <= crate::MAX_MAGNITUDE => vals.push(x),
+                    Ok(x) if x.is_finite() => {
+                        return Err(ModelError::Csv {
+                            path: ps,
+                            reason: format!(
+                                "row {row}, column `{}`: value {x:e} has a magnitude above {:e}",
+                                names[j],
+                                crate::MAX_MAGNITUDE
+                            ),
+                        })
+                    }
                     _ => {
                         return Err(ModelError::CsvValue {
                             path: ps,
@@ -145,6 +159,17 @@ impl Input {
             if let Some(&prev) = t.last() {
                 if vals[0] <= prev {
                     return Err(ModelError::UnsortedTimes { path: ps, row, t: vals[0], prev });
+                }
+                // steps lost in rounding: t so large that neighbouring stamps barely differ
+                if vals[0] - prev <= 1e-12 * vals[0].abs().max(prev.abs()) {
+                    return Err(ModelError::Csv {
+                        path: ps,
+                        reason: format!(
+                            "row {row}: time step {} at t = {} is below the resolution of double precision",
+                            vals[0] - prev,
+                            vals[0]
+                        ),
+                    });
                 }
             }
             t.push(vals[0]);

@@ -5,12 +5,14 @@
 //! - [`system`]: the validated [`System`] and its linearisation `F = A + E C` (eq. (F)).
 //! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, samples from a CSV).
 //! - [`model_file`]: reading and writing model files with errors that name key and value.
+//! - [`files`]: regular files only, with a size limit (no FIFO or device blocks a load).
 //! - [`effects`]: optional physics extensions (friction, delay, ...) used by `discovery`;
 //!   all equal to the nominal model at zero.
 #![allow(non_snake_case)]
 
 pub mod effects;
 pub mod error;
+pub mod files;
 pub mod input;
 pub mod model_file;
 pub mod system;
@@ -20,4 +22,5 @@ pub use effects::Effects;
 pub use error::ModelError;
 pub use input::Input;
 pub use model_file::{load, parse_str, to_toml_string};
-pub use system::{SimDefaults, System, SystemBuilder};
+pub use system::{check_step, SimDefaults, System, SystemBuilder, MIN_STEPS_PER_PERIOD};
+pub use toml_access::MAX_MAGNITUDE;

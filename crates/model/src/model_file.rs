@@ -37,8 +37,7 @@ use toml::{Table, Value};
 
 /// Reads and validates a model file.
 pub fn load(path: &Path) -> Result<System, ModelError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|source| ModelError::Io { path: path.display().to_string(), source })?;
+    let text = crate::files::read_regular(path, crate::files::MAX_MODEL_BYTES)?;
     parse_str_with(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 
@@ -99,6 +98,9 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
         }
         "ellipsoid" => {
             check_keys(t, pre, "shape, centre, matrix, semi_axes")?;
+            if t.contains_key("semi_axes") && t.contains_key("matrix") {
+                return Err(ModelError::ExclusiveKeys { a: "theta.semi_axes".into(), b: "theta.matrix".into() });
+            }
             let c = centre(t)?;
             if t.contains_key("semi_axes") {
                 let a = vec_at(t, pre, "semi_axes")?;
@@ -126,6 +128,7 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
             check_keys(t, pre, "shape, centres, radii")?;
             let centres = rows_at(t, pre, "centres")?;
             let radii = vec_at(t, pre, "radii")?;
+            check_ball_interior(&centres, &radii)?;
             Shape::BallIntersection(BallIntersection::new(centres, radii).map_err(geo("theta"))?)
         }
         "polytope" => {
@@ -141,6 +144,69 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
             )
         }
         other => return Err(ModelError::UnknownShape { value: other.to_string() }),
+    })
+}
+
+/// Inscribed radius, relative to the largest radius, below which an intersection of balls
+/// counts as having an empty interior.
+pub const MIN_RELATIVE_INTERIOR: f64 = 1e-6;
+
+/// Rejects an intersection of balls whose interior is empty or thinner than
+/// [`MIN_RELATIVE_INTERIOR`] times the largest radius (balls touching at a point, disjoint
+/// balls): the projection onto such a set never converges to its tolerance. Pairs are
+/// checked exactly (the lens of two balls has inscribed radius `(r_i + r_j - |c_i - c_j|)/2`);
+/// more balls by cyclic projections onto the balls shrunk by the margin, which find a point
+/// at depth at least half the margin whenever the shrunk balls intersect with interior.
+fn check_ball_interior(centres: &[Vec<f64>], radii: &[f64]) -> Result<(), ModelError> {
+    let k = centres.len().min(radii.len());
+    if k < 2 || centres.iter().any(|c| c.len() != centres[0].len()) {
+        return Ok(()); // dimension errors are reported by the geometry crate
+    }
+    let rmax = radii.iter().copied().fold(0.0, f64::max);
+    let t = MIN_RELATIVE_INTERIOR * rmax;
+    let dist = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+    for i in 0..k {
+        if radii[i] <= t {
+            return Err(ModelError::EmptyInterior { reason: format!("ball {i} has radius {}", radii[i]) });
+        }
+        for j in i + 1..k {
+            let d = dist(&centres[i], &centres[j]);
+            if radii[i] + radii[j] - d < 2.0 * t {
+                return Err(ModelError::EmptyInterior {
+                    reason: format!(
+                        "balls {i} and {j}: distance of the centres {d} against radii {} + {} = {}",
+                        radii[i],
+                        radii[j],
+                        radii[i] + radii[j]
+                    ),
+                });
+            }
+        }
+    }
+    if k == 2 {
+        return Ok(());
+    }
+    let p = centres[0].len();
+    let mut x: Vec<f64> = (0..p).map(|d| centres.iter().map(|c| c[d]).sum::<f64>() / k as f64).collect();
+    for _ in 0..20_000 {
+        let worst = (0..k).map(|i| dist(&x, &centres[i]) - (radii[i] - t)).fold(f64::NEG_INFINITY, f64::max);
+        if worst <= 0.5 * t {
+            return Ok(());
+        }
+        for i in 0..k {
+            let d = dist(&x, &centres[i]);
+            let r = radii[i] - t;
+            if d > r {
+                for (xd, cd) in x.iter_mut().zip(&centres[i]) {
+                    *xd = cd + (*xd - cd) * (r / d);
+                }
+            }
+        }
+    }
+    Err(ModelError::EmptyInterior {
+        reason: format!(
+            "no point lies at depth {t:e} ({MIN_RELATIVE_INTERIOR:e} x the largest radius {rmax}) inside all {k} balls"
+        ),
     })
 }
 
@@ -187,17 +253,31 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
                     });
                 }
             }
-            Input::from_csv(&dir.join(file), period)?
+            let input = Input::from_csv(&dir.join(file), period)?;
+            if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
+                let span = t[t.len() - 1] - t[0];
+                if per < span * (1.0 - 1e-12) {
+                    return Err(ModelError::Invalid {
+                        key: "input.period".into(),
+                        value: per,
+                        reason: format!(
+                            "shorter than the data in `{file}` (samples span {span} from t = {} to t = {}): the rest would be cut silently",
+                            t[0],
+                            t[t.len() - 1]
+                        ),
+                    });
+                }
+            }
+            input
         }
         other => return Err(ModelError::UnknownInput { value: other.to_string() }),
     })
 }
 
 fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
-    let root: Table = text.parse::<Table>().map_err(|e| ModelError::Syntax {
-        path: origin.to_string(),
-        message: e.to_string().lines().next().unwrap_or("").to_string(),
-    })?;
+    let root: Table = text
+        .parse::<Table>()
+        .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
     check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects")?;
     let name = match root.get("name") {
         Some(Value::String(s)) => s.clone(),
@@ -256,9 +336,33 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
             sim.periods = per as usize;
         }
         sim.t_end = opt_f64(t, "simulation", "t_end")?;
+        if let Some(te) = sim.t_end {
+            if te <= 0.0 {
+                return Err(ModelError::OutOfRange {
+                    key: "simulation.t_end".into(),
+                    value: te,
+                    reason: "must be positive",
+                });
+            }
+        }
     }
     let effects = Effects::parse(root.get("effects"), n, p)?;
-    System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)
+    let sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
+    crate::system::check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
+    Ok(sys)
+}
+
+/// One line from a TOML error: the reason (its last line) and where (its first line).
+fn toml_message(full: &str) -> String {
+    let lines: Vec<&str> = full.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    let first = lines.first().copied().unwrap_or("");
+    let last = lines.last().copied().unwrap_or("");
+    let place = first.strip_prefix("TOML parse error at ").unwrap_or(first);
+    if lines.len() <= 1 || last == first {
+        place.to_string()
+    } else {
+        format!("{last} ({place})")
+    }
 }
 
 fn shape_table(s: &Shape) -> Option<Table> {

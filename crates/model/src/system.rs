@@ -153,6 +153,41 @@ impl SystemBuilder {
     }
 }
 
+/// Fewest steps per input period accepted by [`check_step`]: with fewer, a sine is sampled
+/// at too few phases (with `dt = T` or `T/2` at its zeros only) and every result is wrong.
+pub const MIN_STEPS_PER_PERIOD: f64 = 4.0;
+
+/// Checks a time step against the input period and the final time: at least
+/// [`MIN_STEPS_PER_PERIOD`] steps per period, and no step longer than `t_end`. `key` names
+/// the setting in the error (`simulation.dt`, `--dt`).
+pub fn check_step(dt: f64, period: Option<f64>, t_end: Option<f64>, key: &str) -> Result<(), ModelError> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(ModelError::Invalid { key: key.into(), value: dt, reason: "must be positive and finite".into() });
+    }
+    if let Some(T) = period {
+        let limit = T / MIN_STEPS_PER_PERIOD;
+        if dt > limit * (1.0 + 1e-12) {
+            return Err(ModelError::Invalid {
+                key: key.into(),
+                value: dt,
+                reason: format!(
+                    "the step must be at most T/{MIN_STEPS_PER_PERIOD} = {limit} (input period T = {T}); a coarser step samples the input at too few phases"
+                ),
+            });
+        }
+    }
+    if let Some(te) = t_end {
+        if dt > te {
+            return Err(ModelError::Invalid {
+                key: key.into(),
+                value: dt,
+                reason: format!("the step is longer than the final time t_end = {te}"),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl System {
     /// Named-field construction ([`SystemBuilder`]).
     pub fn builder() -> SystemBuilder {

@@ -23,6 +23,9 @@ pub(crate) fn key(prefix: &str, k: &str) -> String {
     }
 }
 
+/// Largest magnitude of a number in a model file or a CSV input.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+
 pub(crate) fn number(v: &Value, key: &str) -> Result<f64, ModelError> {
     let x = match v {
         Value::Float(f) => *f,
@@ -31,6 +34,13 @@ pub(crate) fn number(v: &Value, key: &str) -> Result<f64, ModelError> {
     };
     if !x.is_finite() {
         return Err(ModelError::NotFinite { key: key.into(), value: x });
+    }
+    if x.abs() > MAX_MAGNITUDE {
+        return Err(ModelError::Invalid {
+            key: key.into(),
+            value: x,
+            reason: format!("magnitude above {MAX_MAGNITUDE:e}: products of such numbers overflow"),
+        });
     }
     Ok(x)
 }

@@ -4,7 +4,9 @@
 //! from the library crates (`bounds`, `dynamics`, `lmi`, `theorems`, `discovery`).
 #![allow(non_snake_case)]
 
+pub mod budget;
 pub mod cli;
+pub mod csv_check;
 pub mod figures;
 pub mod guidance;
 pub mod output;

@@ -65,6 +65,9 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if a.cases == Some(0) {
         anyhow::bail!("--cases must be at least 1, got 0");
     }
+    if let Some(c) = a.cases {
+        crate::budget::cases(c)?;
+    }
     let variant = if a.negative_control { Variant::NegativeControl } else { Variant::Claim };
     let settings = CampaignSettings { cases: a.cases, seed: a.seed, only: a.only.clone(), variant };
     let props = theorems::campaign::select(theorems::registry(), a.only.as_deref())?;

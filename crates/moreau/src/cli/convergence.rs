@@ -1,6 +1,7 @@
 //! `moreau convergence FILE [--h0 H] [--levels L] [--periods N]`: error of the catching-up
 //! scheme against the event-driven reference for a ladder of steps, and the fitted order (a
 //! model with `[[effects]]`: the extended-model simulator against its own finest step).
+use crate::budget::num;
 use anyhow::{bail, Context};
 use dynamics::convergence::{convergence_study, ConvergenceSettings};
 use std::path::PathBuf;
@@ -29,10 +30,28 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if a.periods == Some(0) {
         bail!("--periods must be at least 1, got 0");
     }
+    if a.levels > crate::budget::MAX_LEVELS {
+        bail!("--levels {}: more than {} levels (each halves the step)", a.levels, crate::budget::MAX_LEVELS);
+    }
     let t_end = match sys.period() {
         Some(T) => a.periods.unwrap_or(sys.sim.periods) as f64 * T,
         None => sys.sim.t_end.unwrap_or(20.0),
     };
+    crate::budget::step(a.h0, &sys, Some(t_end), "--h0")?;
+    // the ladder: t_end / h0 steps at the coarsest level, doubling per level, plus a reference
+    // as fine as the finest level; every level stores t_end / h0 samples
+    let n0 = (t_end / a.h0).ceil();
+    let levels = a.levels as i32;
+    crate::budget::steps(
+        "convergence",
+        n0 * (2f64.powi(levels) - 1.0 + 2f64.powi(levels)),
+        &format!("t_end = {}, h0 = {}, {} levels", num(t_end), num(a.h0), a.levels),
+    )?;
+    crate::budget::samples(
+        "convergence",
+        n0 * (a.levels + 1) as f64 * (sys.n() + sys.p()) as f64,
+        "numbers stored per level",
+    )?;
     let s = convergence_study(&sys, &ConvergenceSettings { h0: a.h0, levels: a.levels, t_end })?;
     if sys.effects.list.is_empty() {
         println!("{}: catching-up vs event-driven reference over [0, {:.6}] ({} events)", sys.name, s.t_end, s.events);

@@ -57,8 +57,26 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         }
         _ => {
             let sys = model::load(&a.input).with_context(|| a.input.display().to_string())?;
+            if matches!(a.kind, Kind::Psi | Kind::Tube) {
+                crate::budget::theta_size("figure", sys.n(), sys.p())?;
+            }
             match a.kind {
                 Kind::Trajectory => {
+                    let dt = a.dt.unwrap_or(sys.sim.dt);
+                    let t_end = a.t_end.unwrap_or_else(|| match sys.period() {
+                        Some(T) => T * sys.sim.periods as f64,
+                        None => sys.sim.t_end.unwrap_or(100.0),
+                    });
+                    if a.dt.is_some() {
+                        crate::budget::step(dt, &sys, Some(t_end), "--dt")?;
+                    } else if a.t_end.is_some() && dt > t_end {
+                        crate::budget::step(dt, &sys, Some(t_end), "--t-end")?;
+                    }
+                    crate::budget::steps(
+                        "figure trajectory",
+                        (t_end / dt).ceil(),
+                        &format!("t_end = {} at dt = {}", crate::budget::num(t_end), crate::budget::num(dt)),
+                    )?;
                     let (yz, x) = figures::trajectory::trajectory_figures(
                         &sys,
                         &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() },

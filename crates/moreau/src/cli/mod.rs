@@ -21,6 +21,10 @@ pub mod validate;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Lift the soft work limits (integration steps, stored samples, check cases, sweep
+    /// points, theta's n and p) deliberately; see `moreau::budget`.
+    #[arg(long, global = true)]
+    pub allow_large: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -59,9 +63,28 @@ pub enum Command {
 
 /// Runs the CLI: prints errors on one line (`error: ...`) and returns a non-zero exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help, --version, and a bare `moreau` (the command list)
+        Err(e) if !e.use_stderr() || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            e.exit()
+        }
+        Err(e) => {
+            // clap's message, usage and tips on one line, exit code 2 like every bad input
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("").trim();
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            match text.lines().find_map(|l| l.trim().strip_prefix("Usage: ")) {
+                Some(usage) => eprintln!("error: {first} (usage: {usage})"),
+                None => eprintln!("error: {first} (see --help)"),
+            }
+            return ExitCode::from(2);
+        }
+    };
+    crate::budget::set_allow_large(cli.allow_large);
+    crate::output::install_interrupt_cleanup();
     let result = match cli.command {
-        Command::Theta(a) => theta::run(&a),
+        Command::Theta(a) => crate::budget::theta_size_of_file("theta", &a.file).and_then(|_| theta::run(&a)),
         Command::Validate(a) => validate::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Simulate(a) => simulate::run(&a),
@@ -85,17 +108,20 @@ pub fn main() -> ExitCode {
 
 /// The error and its causes on one line; a cause whose text an outer message already carries
 /// (thiserror variants that format their `source`) is not repeated.
+/// A context that the next cause repeats (`f.toml` then `f.toml: TOML syntax error ...` or
+/// `cannot read f.toml: ...`) is replaced by that cause, so the path is printed once; line breaks inside a
+/// message are folded.
 pub(crate) fn one_line(e: &anyhow::Error) -> String {
-    let mut msg = String::new();
+    let mut parts: Vec<String> = Vec::new();
     for cause in e.chain() {
-        let text = cause.to_string();
-        if msg.contains(&text) {
+        let text = cause.to_string().lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ");
+        if parts.iter().any(|p| p.contains(&text)) {
             continue;
         }
-        if !msg.is_empty() {
-            msg.push_str(": ");
+        match parts.last_mut() {
+            Some(last) if text.contains(last.as_str()) => *last = text,
+            _ => parts.push(text),
         }
-        msg.push_str(&text);
     }
-    msg
+    parts.join(": ")
 }

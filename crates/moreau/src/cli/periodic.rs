@@ -1,6 +1,7 @@
 //! `moreau periodic FILE [--dt H] [--periods N] [--json]`: the periodic regime (fixed point of
 //! the Poincare map), its residual and the (loc) check, the measured convergence exponent with
 //! its 95% interval, and the path length of z per period.
+use crate::budget::num;
 use anyhow::{bail, Context};
 use bounds::tube::localisation::{check_localisation, LocalisationSettings};
 use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
@@ -36,13 +37,26 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if a.periods == 0 {
         bail!("--periods must be at least 1, got 0");
     }
-    if sys.period().is_none() {
+    let Some(T) = sys.period() else {
         bail!(
             "`{}` has a non-periodic input (`{}`): the periodic regime needs a T-periodic w",
             a.file.display(),
             sys.input.kind()
         );
+    };
+    if a.pairs == 0 {
+        bail!("--pairs must be at least 1, got 0");
     }
+    if a.dt.is_some() {
+        crate::budget::step(dt, &sys, None, "--dt")?;
+    }
+    // rate: `periods` periods of 2 trajectories per pair and a reference; Poincare iteration
+    // typically well under 100 periods
+    crate::budget::steps(
+        "periodic",
+        (T / dt).ceil() * (a.periods as f64 * (2 * a.pairs + 1) as f64 + 100.0),
+        &format!("{} periods, {} pairs, T = {}, dt = {}", a.periods, a.pairs, num(T), num(dt)),
+    )?;
     if !sys.effects.list.is_empty() {
         return run_with_effects(a, &sys, dt);
     }

@@ -28,10 +28,45 @@ pub struct Args {
     pub json: Option<PathBuf>,
 }
 
+/// Values of the stand configuration that make no sense: non-finite or negative tolerances,
+/// non-finite targets, both pullers on the same servo, the servo under test among them.
+fn check_config(c: &robonine::StandConfig) -> anyhow::Result<()> {
+    let lim = model::MAX_MAGNITUDE;
+    anyhow::ensure!(
+        c.home_position.is_finite() && c.home_position.abs() <= lim,
+        "home_position {} is not a finite position",
+        c.home_position
+    );
+    for (i, p) in c.actuated_motors.iter().enumerate() {
+        for (key, v) in [("relaxed_target", p.relaxed_target), ("stretched_target", p.stretched_target)] {
+            anyhow::ensure!(v.is_finite() && v.abs() <= lim, "actuated_motors[{i}].{key} {v} is not a finite position");
+        }
+        for (key, v) in [("relaxed_tolerance", p.relaxed_tolerance), ("stretched_tolerance", p.stretched_tolerance)] {
+            anyhow::ensure!(
+                v.is_finite() && v >= 0.0 && v <= lim,
+                "actuated_motors[{i}].{key} {v} must be a non-negative number"
+            );
+        }
+        anyhow::ensure!(
+            !c.report_motor_ids.contains(&p.motor_id),
+            "actuated_motors[{i}].motor_id {} is also in report_motor_ids (a puller cannot be the servo under test)",
+            p.motor_id
+        );
+    }
+    if let [a, b] = c.actuated_motors.as_slice() {
+        anyhow::ensure!(a.motor_id != b.motor_id, "both actuated_motors have motor_id {}", a.motor_id);
+    }
+    Ok(())
+}
+
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let text = std::fs::read_to_string(&a.data).with_context(|| format!("cannot read {}", a.data.display()))?;
-    let cfg_text = std::fs::read_to_string(&a.config).with_context(|| format!("cannot read {}", a.config.display()))?;
+    let text = crate::csv_check::read_checked(&a.data, "log", crate::csv_check::TimeColumn::Iso8601("timestamp"))?;
+    let cfg_text = model::files::read_regular(&a.config, model::files::MAX_MODEL_BYTES)?;
     let cfg = robonine::StandConfig::from_json_str(&cfg_text).with_context(|| a.config.display().to_string())?;
+    check_config(&cfg).with_context(|| a.config.display().to_string())?;
+    if a.min_segment_samples == 0 {
+        anyhow::bail!("--min-segment-samples must be at least 1, got 0");
+    }
     let s = PlayWidthSettings {
         min_segment_samples: a.min_segment_samples,
         skip_samples: a.skip_samples,

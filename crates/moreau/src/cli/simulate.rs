@@ -42,6 +42,9 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if !(dt > 0.0 && dt.is_finite()) {
         bail!("--dt must be positive and finite, got {dt}");
     }
+    if a.dt.is_some() {
+        crate::budget::step(dt, &sys, sys.sim.t_end.filter(|_| sys.period().is_none()), "--dt")?;
+    }
     let periods = a.periods.unwrap_or(sys.sim.periods);
     if periods == 0 {
         bail!("--periods must be at least 1, got 0");
@@ -51,6 +54,16 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let (t_end, h) = match sys.period() {
         Some(T) => {
+            crate::budget::steps(
+                "simulate",
+                periods as f64 * (T / dt).ceil(),
+                &format!(
+                    "{} periods of T = {} at dt = {}",
+                    crate::budget::num(periods as f64),
+                    crate::budget::num(T),
+                    crate::budget::num(dt)
+                ),
+            )?;
             let (n, h) = dynamics::periodic::steps_per_period(T, dt)?;
             (periods as f64 * n as f64 * h, h)
         }
@@ -65,7 +78,18 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             (sys.sim.t_end.unwrap_or(100.0), dt)
         }
     };
+    crate::budget::steps(
+        "simulate",
+        (t_end / h).round(),
+        &format!("t_end = {} at dt = {}", crate::budget::num(t_end), crate::budget::num(h)),
+    )?;
     let steps = (t_end / h).round().max(1.0) as usize;
+    let rows = (steps as f64).min(a.max_rows as f64);
+    crate::budget::samples(
+        "simulate",
+        rows * (1 + sys.n() + sys.m() + 2 * sys.p()) as f64,
+        "numbers in trajectory.csv, --max-rows",
+    )?;
     let every = steps.div_ceil(a.max_rows).max(1);
     let effects: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
     let (tr, what) = match a.integrator {

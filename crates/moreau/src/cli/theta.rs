@@ -120,7 +120,8 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
 
 /// The glossary of `--explain`: one paragraph per reported row.
 pub fn explain(rep: &ThetaReport) -> String {
-    let mut s = String::from("\nWhat the rows mean (equation numbers as printed in the paper, source labels in brackets):\n");
+    let mut s =
+        String::from("\nWhat the rows mean (equation numbers as printed in the paper, source labels in brackets):\n");
     for q in rep.quantities() {
         if let Some(g) = bounds::report::glossary(q.key) {
             s.push_str(&format!("- {} {} [{}]: {g}\n", q.symbol, q.equation, q.label));

@@ -240,7 +240,8 @@ pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
     draw(root, f)
 }
 
-/// Writes `stem.svg` and `stem.png` for every `(stem, figure)` into `out`, all or none.
+/// Writes `stem.svg`, `stem.png`, `stem.tex` (pgfplots) and `stem.csv` (data) for every
+/// `(stem, figure)` into `out`, all or none.
 pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf>, FigureError> {
     let werr =
         |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
@@ -251,8 +252,13 @@ pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf
         let p = staged.path(&format!("{stem}.svg"));
         std::fs::write(&p, svg).map_err(|e| werr(&p, &e))?;
         write_png(f, &staged.path(&format!("{stem}.png")))?;
-        files.push(out.join(format!("{stem}.svg")));
-        files.push(out.join(format!("{stem}.png")));
+        for (ext, text) in [("tex", super::pgf::to_pgf(f)), ("csv", super::pgf::to_csv(f))] {
+            let p = staged.path(&format!("{stem}.{ext}"));
+            std::fs::write(&p, text).map_err(|e| werr(&p, &e))?;
+        }
+        for ext in ["svg", "png", "tex", "csv"] {
+            files.push(out.join(format!("{stem}.{ext}")));
+        }
     }
     staged.commit().map_err(|e| werr(out, &e))?;
     Ok(files)

@@ -1,4 +1,5 @@
-//! Figures for papers (SVG and PNG, embedded DejaVu font, labelled axes):
+//! Figures for papers (SVG and PNG with an embedded DejaVu font, and pgfplots code + CSV data
+//! that LaTeX sets in the paper's own fonts, [`pgf`]; labelled axes):
 //! - [`psi`]: Fig. psi1, `psi(gamma)` of eq. (phipsi) with `psi(0)`, `psi(gamma_inf)`, the
 //!   limit `-lambda` and the chord whose value at `gamma_1` is `theta` (eq. (theta));
 //! - [`tube`]: Fig. loop, the orbit `eta_T` (eq. (etaT)), the tube `eta_T + C Xi_inf + Theta`
@@ -8,6 +9,7 @@
 //!
 //! Every figure is a [`canvas::Figure`] (data only) rendered by [`canvas::write_figure`].
 pub mod canvas;
+pub mod pgf;
 pub mod psi;
 pub mod sweep;
 pub mod trajectory;

@@ -322,6 +322,24 @@ pub enum Values {
 }
 
 impl Values {
+    /// Number of values [`Values::expand`] would produce, computed without building them
+    /// (an upper estimate for a malformed range, which `expand` then rejects).
+    pub fn len_before_expanding(&self) -> u128 {
+        match self {
+            Values::List(v) => v.len() as u128,
+            Values::Count { count, .. } => *count as u128,
+            Values::Step { from, to, step } => {
+                let n = (to - from) / step;
+                // malformed (step 0, non-finite, pointing away): `expand` names the problem
+                if n.is_finite() && n >= 0.0 {
+                    (n + 1e-9).floor().min(u64::MAX as f64) as u128 + 1
+                } else {
+                    1
+                }
+            }
+        }
+    }
+
     /// The values, or an error for an empty or malformed range.
     pub fn expand(&self, name: &str) -> Result<Vec<f64>, SweepError> {
         let nf = |value: f64| SweepError::NotFinite { name: name.to_string(), value };

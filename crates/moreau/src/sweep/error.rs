@@ -6,8 +6,18 @@ use thiserror::Error;
 pub enum SweepError {
     #[error("cannot read {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
-    #[error("{path}: not valid TOML: {source}")]
-    Toml { path: PathBuf, source: Box<toml::de::Error> },
+    #[error("{path}: not valid TOML: {message}")]
+    Toml { path: PathBuf, message: String },
+    #[error("{source}")]
+    File { source: model::ModelError },
+    #[error(
+        "{path} is in use by another sweep ({holder}; lock file {lock}): wait for it to finish or choose another --out"
+    )]
+    Locked { path: PathBuf, holder: String, lock: PathBuf },
+    #[error("cannot merge: {path}: {reason}")]
+    MergeGrid { path: PathBuf, reason: String },
+    #[error("[evaluate] {key}: {reason}")]
+    Evaluate { key: &'static str, reason: String },
     #[error("{path}: missing key `{key}`")]
     MissingKey { path: PathBuf, key: String },
     #[error("{path}: unknown key `{key}` (allowed: {allowed})")]

@@ -42,13 +42,23 @@ pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError
     let mut points: BTreeMap<usize, (PointRecord, PathBuf)> = BTreeMap::new();
     for f in files {
         let r = SweepResult::read(f)?;
+        check_grid(&r, f)?;
         if let Some((first, m)) = &merged {
             if m.spec_hash != r.spec_hash {
                 return Err(SweepError::MergeSpecMismatch {
                     a: first.clone(),
                     hash_a: m.spec_hash.clone(),
                     b: f.clone(),
-                    hash_b: r.spec_hash,
+                    hash_b: r.spec_hash.clone(),
+                });
+            }
+            if m.axes != r.axes || m.total_points != r.total_points {
+                return Err(SweepError::MergeGrid {
+                    path: f.clone(),
+                    reason: format!(
+                        "its axes differ from those of {} although the spec hash is the same",
+                        first.display()
+                    ),
                 });
             }
         }
@@ -76,6 +86,40 @@ pub fn merge(files: &[PathBuf], partial: bool) -> Result<SweepResult, SweepError
         return Err(SweepError::MergeIncomplete { missing: missing.len(), total: m.total_points, first: missing[0] });
     }
     Ok(m)
+}
+
+/// Checks a result file against its own grid: `total_points` is the product of the axis
+/// lengths (and within the sweep limit), every point's parameters are the grid's values at
+/// its index, and a shard holds only its own indices.
+fn check_grid(r: &SweepResult, path: &Path) -> Result<(), SweepError> {
+    let bad = |reason: String| SweepError::MergeGrid { path: path.to_path_buf(), reason };
+    let product = r.axes.iter().fold(1u128, |acc, a| acc.saturating_mul(a.values.len() as u128));
+    if product != r.total_points as u128 {
+        return Err(bad(format!("total_points {} is not the product {product} of the axis lengths", r.total_points)));
+    }
+    if r.total_points > super::spec::MAX_POINTS {
+        return Err(bad(format!("total_points {} exceeds the limit {}", r.total_points, super::spec::MAX_POINTS)));
+    }
+    for p in &r.points {
+        let mut rem = p.index;
+        let mut expected = vec![0.0; r.axes.len()];
+        for (k, a) in r.axes.iter().enumerate().rev() {
+            expected[k] = a.values[rem % a.values.len()];
+            rem /= a.values.len();
+        }
+        if p.params.len() != expected.len() || p.params.iter().zip(&expected).any(|(x, y)| x.to_bits() != y.to_bits()) {
+            return Err(bad(format!(
+                "point {} has parameters {:?}, but the grid has {:?} at that index",
+                p.index, p.params, expected
+            )));
+        }
+        if let Some(s) = r.shard {
+            if !s.contains(p.index) {
+                return Err(bad(format!("point {} does not belong to its shard {}/{}", p.index, s.k, s.n)));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Equal records (NaN equal to NaN).

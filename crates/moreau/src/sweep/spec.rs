@@ -84,15 +84,15 @@ fn check_keys(path: &Path, t: &Table, pre: &str, allowed: &'static str) -> Resul
 impl SweepSpec {
     /// Reads a spec file; the base model path is relative to the spec file.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
+        let text = model::files::read_regular(path, model::files::MAX_MODEL_BYTES)
+            .map_err(|source| SweepError::File { source })?;
         Self::parse(&text, path)
     }
 
     /// Parses spec text; `path` locates the base model and names the file in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, SweepError> {
-        let root: Table =
-            toml::from_str(text).map_err(|e| SweepError::Toml { path: path.to_path_buf(), source: Box::new(e) })?;
+        let root: Table = toml::from_str(text)
+            .map_err(|e| SweepError::Toml { path: path.to_path_buf(), message: toml_message(&e) })?;
         check_keys(path, &root, "", "name, model, axis, evaluate, table")?;
         let model_rel = match root.get("model") {
             Some(Value::String(s)) => s.clone(),
@@ -101,8 +101,8 @@ impl SweepSpec {
         };
         let dir = path.parent().unwrap_or(Path::new("."));
         let model_path = dir.join(&model_rel);
-        let model_text = std::fs::read_to_string(&model_path)
-            .map_err(|source| SweepError::Io { path: model_path.clone(), source })?;
+        let model_text = model::files::read_regular(&model_path, model::files::MAX_MODEL_BYTES)
+            .map_err(|source| SweepError::Model { path: model_path.clone(), source })?;
         let base = model::load(&model_path).map_err(|source| SweepError::Model { path: model_path.clone(), source })?;
         let name = match root.get("name") {
             Some(Value::String(s)) => s.clone(),
@@ -118,6 +118,9 @@ impl SweepSpec {
             return Err(SweepError::NoAxes);
         }
         let mut axes: Vec<Axis> = Vec::new();
+        // points of the axes so far: checked before each axis is expanded, so that no list
+        // longer than the limit is ever built
+        let mut total: u128 = 1;
         for (k, a) in axes_v.iter().enumerate() {
             let key = |s: &str| format!("axis[{k}].{s}");
             let Value::Table(t) = a else { return Err(wrong(path, &format!("axis[{k}]"), "a table")) };
@@ -196,6 +199,10 @@ impl SweepSpec {
                     return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("values (or range)") })
                 }
             };
+            total = total.saturating_mul(values.len_before_expanding());
+            if total > MAX_POINTS as u128 {
+                return Err(SweepError::TooManyPoints { points: total, limit: MAX_POINTS });
+            }
             let values = values.expand(&parameter.name())?;
             let label = match t.get("label") {
                 Some(Value::String(s)) => s.clone(),
@@ -309,6 +316,20 @@ impl SweepSpec {
         h.write(b"\0");
         h.write(evaluator_fingerprint.as_bytes());
         format!("{:016x}", h.0)
+    }
+}
+
+/// One line from a TOML error: the reason (its last line) and the place (its first line).
+fn toml_message(e: &toml::de::Error) -> String {
+    let full = e.to_string();
+    let lines: Vec<&str> = full.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    let first = lines.first().copied().unwrap_or("");
+    let last = lines.last().copied().unwrap_or("");
+    let place = first.strip_prefix("TOML parse error at ").unwrap_or(first);
+    if lines.len() <= 1 || last == first {
+        place.to_string()
+    } else {
+        format!("{last} ({place})")
     }
 }
 

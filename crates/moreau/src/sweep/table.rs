@@ -227,8 +227,8 @@ impl SweepResult {
 
     /// Reads a result file written by [`SweepResult::to_json_string`].
     pub fn read(path: &Path) -> Result<Self, SweepError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| SweepError::Io { path: path.to_path_buf(), source })?;
+        let text = model::files::read_regular(path, model::files::MAX_CSV_BYTES)
+            .map_err(|source| SweepError::File { source })?;
         let v: Value = serde_json::from_str(&text).map_err(|e| bad(path, &format!("invalid JSON: {e}")))?;
         let mut r = Self::header_from_json(&v, path)?;
         let pts = v.get("points").and_then(Value::as_array).ok_or_else(|| bad(path, "missing `points`"))?;

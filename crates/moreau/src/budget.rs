@@ -1,0 +1,169 @@
+//! Budgets checked before work starts: every command estimates its integration steps, grid
+//! points, property cases, stored samples and problem size from its inputs and refuses, in one
+//! line naming the value and the limit, before anything is allocated or started. The global
+//! flag `--allow-large` lifts the soft limits deliberately; the hard limits (where a larger
+//! value would overflow an index or exhaust memory whatever the machine) stay.
+//!
+//! | budget | soft limit | hard limit |
+//! |---|---|---|
+//! | integration steps of one command (one sweep point) | [`MAX_STEPS`] = 1e9 | [`HARD_MAX_STEPS`] = 1e15 |
+//! | stored trajectory samples | [`MAX_SAMPLES`] = 2e7 | [`HARD_MAX_SAMPLES`] = 1e9 |
+//! | cases per property of `moreau check` | [`MAX_CASES`] = 1e7 | [`HARD_MAX_CASES`] = 1e10 |
+//! | sweep grid points | [`MAX_SWEEP_POINTS`] = 1e6 | `sweep::spec::MAX_POINTS` = 1e7 |
+//! | `discover-bench` cases per class | [`MAX_BENCH_CASES`] = 1000 | 1e6 |
+//! | convergence ladder levels | - | [`MAX_LEVELS`] = 40 |
+//! | `theta` state dimension n / backlash dimension p | [`THETA_MAX_N`] / [`THETA_MAX_P`] | - |
+//! | worker threads | the machine's available parallelism (capped with a note) | |
+use anyhow::bail;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Integration steps one command (or one sweep point) may take without `--allow-large`
+/// (about 10 s to a few minutes of the catching-up scheme in a release build).
+pub const MAX_STEPS: f64 = 1e9;
+/// Integration steps beyond which nothing runs (step counters and time grids lose meaning).
+pub const HARD_MAX_STEPS: f64 = 1e15;
+/// Trajectory samples kept in memory without `--allow-large`.
+pub const MAX_SAMPLES: f64 = 2e7;
+/// Trajectory samples beyond which nothing runs.
+pub const HARD_MAX_SAMPLES: f64 = 1e9;
+/// Cases per property of `moreau check` without `--allow-large`.
+pub const MAX_CASES: u64 = 10_000_000;
+/// Cases per property beyond which `moreau check` refuses (the campaign keeps one record
+/// per 1,024 cases in memory).
+pub const HARD_MAX_CASES: u64 = 10_000_000_000;
+/// Grid points of a sweep without `--allow-large` (about 7 h of theta evaluations on 2 cores).
+pub const MAX_SWEEP_POINTS: usize = 1_000_000;
+/// Cases per class of `moreau discover-bench` without `--allow-large` (9 classes, seconds a
+/// case: about half a day).
+pub const MAX_BENCH_CASES: usize = 1000;
+/// Levels of the step ladder of `moreau convergence` (each halves the step).
+pub const MAX_LEVELS: usize = 40;
+/// Largest state dimension n for which `theta` (and figures and sweeps that assemble it) run
+/// without `--allow-large`: the SDPs and tube quadratures grow like n^4 to n^6.
+pub const THETA_MAX_N: usize = 12;
+/// Largest backlash dimension p for `theta` without `--allow-large`: the certified maxima over
+/// the unit sphere of R^p grow exponentially with p.
+pub const THETA_MAX_P: usize = 4;
+
+static ALLOW_LARGE: AtomicBool = AtomicBool::new(false);
+
+/// Sets the `--allow-large` flag for this process.
+pub fn set_allow_large(on: bool) {
+    ALLOW_LARGE.store(on, Ordering::Relaxed);
+}
+
+/// Whether `--allow-large` was given.
+pub fn allow_large() -> bool {
+    ALLOW_LARGE.load(Ordering::Relaxed)
+}
+
+/// A number for a message: integers as they are, other values in short scientific notation.
+pub fn num(x: f64) -> String {
+    if x.is_finite() && x.fract() == 0.0 && x.abs() < 1e15 {
+        return format!("{x}");
+    }
+    if x != 0.0 && (1e-3..1e6).contains(&x.abs()) {
+        return format!("{}", (x * 1e6).round() / 1e6);
+    }
+    let s = format!("{x:.4e}");
+    match s.split_once('e') {
+        Some((m, e)) if m.contains('.') => format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.')),
+        _ => s,
+    }
+}
+
+/// Refuses `value` above `soft` (unless `--allow-large`) or above `hard` (always).
+/// `what` names the quantity, `detail` how it was estimated.
+pub fn check(what: &str, value: f64, soft: f64, hard: f64, detail: &str) -> anyhow::Result<()> {
+    let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
+    if value.is_nan() || value > hard {
+        bail!("{what}: {}{detail} exceeds the hard limit {}", num(value), num(hard));
+    }
+    if value > soft && !allow_large() {
+        bail!("{what}: {}{detail} exceeds the limit {}; pass --allow-large to run it anyway", num(value), num(soft));
+    }
+    Ok(())
+}
+
+/// Integration steps of one command or sweep point.
+pub fn steps(command: &str, steps: f64, detail: &str) -> anyhow::Result<()> {
+    check(&format!("{command}: integration steps"), steps, MAX_STEPS, HARD_MAX_STEPS, detail)
+}
+
+/// Trajectory samples held in memory.
+pub fn samples(command: &str, samples: f64, detail: &str) -> anyhow::Result<()> {
+    check(&format!("{command}: stored samples"), samples, MAX_SAMPLES, HARD_MAX_SAMPLES, detail)
+}
+
+/// Cases per property of `moreau check`.
+pub fn cases(cases: u64) -> anyhow::Result<()> {
+    check("check: --cases", cases as f64, MAX_CASES as f64, HARD_MAX_CASES as f64, "per property")
+}
+
+/// Problem size of `theta` (state dimension `n`, backlash dimension `p`).
+pub fn theta_size(command: &str, n: usize, p: usize) -> anyhow::Result<()> {
+    if allow_large() {
+        return Ok(());
+    }
+    if n > THETA_MAX_N {
+        bail!(
+            "{command}: state dimension n = {n} exceeds the limit {THETA_MAX_N} for the theta bound (SDPs and tube quadratures grow like n^4 to n^6); pass --allow-large to run it anyway"
+        );
+    }
+    if p > THETA_MAX_P {
+        bail!(
+            "{command}: backlash dimension p = {p} exceeds the limit {THETA_MAX_P} for the theta bound (certified maxima over the unit sphere of R^p grow exponentially with p); pass --allow-large to run it anyway"
+        );
+    }
+    Ok(())
+}
+
+/// The size check of [`theta_size`] for a model file (the file is loaded once more; errors of
+/// the file itself are left to the command).
+pub fn theta_size_of_file(command: &str, path: &std::path::Path) -> anyhow::Result<()> {
+    match model::load(path) {
+        Ok(sys) => theta_size(command, sys.n(), sys.p()),
+        Err(_) => Ok(()),
+    }
+}
+
+/// Worker threads: at least 1, at most the machine's available parallelism (a larger request
+/// is capped, with a note on stderr).
+pub fn threads(requested: usize) -> anyhow::Result<usize> {
+    if requested == 0 {
+        bail!("--threads 0: need at least 1");
+    }
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    if requested > cores {
+        eprintln!("note: --threads {requested} capped at {cores} (the machine's available parallelism)");
+        return Ok(cores);
+    }
+    Ok(requested)
+}
+
+/// The step `dt` against the input period and final time ([`model::check_step`]) as a CLI error.
+pub fn step(dt: f64, sys: &model::System, t_end: Option<f64>, key: &str) -> anyhow::Result<()> {
+    model::check_step(dt, sys.period(), t_end, key)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_name_value_and_limit() {
+        let e = steps("simulate", 1e12, "t_end 1e9 / dt 1e-3").unwrap_err().to_string();
+        assert!(e.contains("1000000000000") && e.contains("limit 1000000000;") && e.contains("--allow-large"), "{e}");
+        assert_eq!(num(1.2566370614359173e302), "1.2566e302");
+        assert_eq!(num(0.001), "0.001");
+        let e = steps("simulate", 1e300, "").unwrap_err().to_string();
+        assert!(e.contains("hard limit"), "{e}");
+        assert!(steps("simulate", 1e6, "").is_ok());
+        assert!(cases(1_000_000).is_ok());
+        assert!(cases(1_000_000_000_000).is_err());
+        assert!(theta_size("theta", 200, 1).unwrap_err().to_string().contains("n = 200"));
+        assert!(threads(0).is_err());
+        assert!(threads(100_000).unwrap() >= 1);
+    }
+}

@@ -1,0 +1,226 @@
+//! A [`Figure`] as pgfplots code (`stem.tex`, to `\input` into a paper that loads `pgfplots`, so
+//! the figure is set in the paper's own fonts) and its data as CSV (`stem.csv`, long format:
+//! `element,label,x,y`). Greek letters and subscripts of the labels become math mode; LaTeX's
+//! special characters are escaped; the output is ASCII.
+use super::canvas::{Element, Figure};
+use plotters::style::RGBColor;
+
+/// Text of a label in LaTeX: Greek letters, sub/superscript digits, minus and infinity to math
+/// mode, specials escaped.
+pub fn tex_text(s: &str) -> String {
+    // "gamma infinity", "Xi infinity" as the labels write them: subscripts
+    let s = s.replace("γ∞", "γ\u{e000}").replace("Ξ∞", "Ξ\u{e000}");
+    let mut out = String::new();
+    let chars: Vec<char> = s.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        // `eta_T`-style subscripts: `_` before a letter or digit is a math subscript
+        // (a single character: `input_amplitude` keeps its underscore)
+        let single = |k: usize| {
+            chars.get(k).is_some_and(|n| n.is_ascii_alphanumeric())
+                && !chars.get(k + 1).is_some_and(|n| n.is_ascii_alphanumeric())
+        };
+        if c == '_' && single(i + 1) {
+            continue;
+        }
+        if i > 0 && chars[i - 1] == '_' && single(i) {
+            out.push_str(&format!("$_{{{c}}}$"));
+            continue;
+        }
+        let math = match c {
+            'α' => Some("\\alpha"),
+            'β' => Some("\\beta"),
+            'γ' => Some("\\gamma"),
+            'δ' => Some("\\delta"),
+            'ε' => Some("\\varepsilon"),
+            'η' => Some("\\eta"),
+            'θ' => Some("\\theta"),
+            'κ' => Some("\\kappa"),
+            'λ' => Some("\\lambda"),
+            'μ' => Some("\\mu"),
+            'ξ' => Some("\\xi"),
+            'π' => Some("\\pi"),
+            'ρ' => Some("\\rho"),
+            'σ' => Some("\\sigma"),
+            'τ' => Some("\\tau"),
+            'φ' => Some("\\varphi"),
+            'ψ' => Some("\\psi"),
+            'ω' => Some("\\omega"),
+            'Θ' => Some("\\Theta"),
+            'Ξ' => Some("\\Xi"),
+            'Φ' => Some("\\Phi"),
+            'Ψ' => Some("\\Psi"),
+            'Ω' => Some("\\Omega"),
+            '∞' => Some("\\infty"),
+            '\u{e000}' => Some("_\\infty"),
+            '−' => Some("-"),
+            '≤' => Some("\\le"),
+            '≥' => Some("\\ge"),
+            '·' => Some("\\cdot"),
+            '′' => Some("'"),
+            '₀' => Some("_0"),
+            '₁' => Some("_1"),
+            '₂' => Some("_2"),
+            '₃' => Some("_3"),
+            '²' => Some("^2"),
+            _ => None,
+        };
+        match math {
+            Some(m) => {
+                out.push('$');
+                out.push_str(m);
+                out.push('$');
+            }
+            None => match c {
+                '%' | '&' | '#' | '_' | '{' | '}' | '$' => {
+                    out.push('\\');
+                    out.push(c);
+                }
+                '\\' => out.push_str("\\textbackslash{}"),
+                '^' => out.push_str("\\^{}"),
+                '~' => out.push_str("\\~{}"),
+                c if c.is_ascii() => out.push(c),
+                _ => out.push('?'),
+            },
+        }
+    }
+    // adjacent math groups merge: "$\gamma$$_1$" -> "$\gamma_1$"
+    out.replace("$$", "")
+}
+
+fn colour(c: &RGBColor) -> String {
+    format!("{{rgb,255:red,{};green,{};blue,{}}}", c.0, c.1, c.2)
+}
+
+fn num(v: f64) -> String {
+    format!("{v:.9e}")
+}
+
+fn coords(pts: &[(f64, f64)]) -> String {
+    pts.iter()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| format!("({},{})", num(*x), num(*y)))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// pgfplots code of `f` (a `tikzpicture`).
+pub fn to_pgf(f: &Figure) -> String {
+    let mut s = String::new();
+    s.push_str(&format!("% {} -- written by moreau; needs \\usepackage{{pgfplots}} (compat >= 1.11)\n", tex_text(&f.title)));
+    s.push_str("\\begin{tikzpicture}\n\\begin{axis}[\n");
+    s.push_str("  width=0.9\\linewidth, height=0.55\\linewidth, clip=false,\n");
+    if let Some(((x0, x1), (y0, y1))) = f.ranges() {
+        s.push_str(&format!("  xmin={}, xmax={}, ymin={}, ymax={},\n", num(x0), num(x1), num(y0), num(y1)));
+    }
+    s.push_str(&format!("  xlabel={{{}}}, ylabel={{{}}},\n", tex_text(&f.x_label), tex_text(&f.y_label)));
+    // the legend below the axes, off the data
+    s.push_str("  legend cell align=left, legend columns=2,\n");
+    s.push_str("  legend style={font=\\small, at={(0.5,-0.18)}, anchor=north, draw=none},\n");
+    s.push_str("  scaled ticks=false, tick label style={font=\\small},\n]\n");
+    for e in &f.elements {
+        let (label, line) = match e {
+            Element::Line { label, pts, color, dashed } => (
+                label,
+                format!(
+                    "\\addplot[color={}, thick{}] coordinates {{{}}};",
+                    colour(color),
+                    if *dashed { ", dashed" } else { "" },
+                    coords(pts)
+                ),
+            ),
+            Element::Band { label, x, lo, hi, color } => {
+                let mut pts: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
+                pts.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
+                (
+                    label,
+                    format!(
+                        "\\addplot[fill={}, fill opacity=0.22, draw=none, area legend{}] coordinates {{{}}} -- cycle;",
+                        colour(color),
+                        if label.is_empty() { ", forget plot" } else { "" },
+                        coords(&pts)
+                    ),
+                )
+            }
+            Element::Polygon { label, pts, color } => (
+                label,
+                format!(
+                    "\\addplot[fill={}, fill opacity=0.12, draw=none, area legend{}] coordinates {{{}}} -- cycle;",
+                    colour(color),
+                    if label.is_empty() { ", forget plot" } else { "" },
+                    coords(pts)
+                ),
+            ),
+            Element::Markers { label, pts, color, .. } => (
+                label,
+                format!(
+                    "\\addplot[only marks, mark=*, color={}{}] coordinates {{{}}};",
+                    colour(color),
+                    if label.is_empty() { ", forget plot" } else { "" },
+                    coords(pts)
+                ),
+            ),
+        };
+        let line = match e {
+            Element::Line { .. } if label.is_empty() => line.replacen("thick", "thick, forget plot", 1),
+            _ => line,
+        };
+        s.push_str(&line);
+        s.push('\n');
+        if !label.is_empty() {
+            s.push_str(&format!("\\addlegendentry{{{}}}\n", tex_text(label)));
+        }
+        if let Element::Markers { pts, text, .. } = e {
+            for (p, t) in pts.iter().zip(text) {
+                if p.0.is_finite() && p.1.is_finite() && !t.is_empty() {
+                    s.push_str(&format!(
+                        "\\node[anchor=south west, font=\\small] at (axis cs:{},{}) {{{}}};\n",
+                        num(p.0),
+                        num(p.1),
+                        tex_text(t)
+                    ));
+                }
+            }
+        }
+    }
+    s.push_str("\\end{axis}\n\\end{tikzpicture}\n");
+    s
+}
+
+/// The data of `f` as CSV (`element,label,x,y`; bands as their closed outline).
+pub fn to_csv(f: &Figure) -> String {
+    let mut s = String::from("element,label,x,y\n");
+    for (i, e) in f.elements.iter().enumerate() {
+        let (label, pts): (&str, Vec<(f64, f64)>) = match e {
+            Element::Line { label, pts, .. } | Element::Polygon { label, pts, .. } | Element::Markers { label, pts, .. } => {
+                (label, pts.clone())
+            }
+            Element::Band { label, x, lo, hi, .. } => {
+                let mut p: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
+                p.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
+                (label, p)
+            }
+        };
+        let label = label.replace('"', "'");
+        for (x, y) in pts {
+            s.push_str(&format!("{i},\"{label}\",{},{}\n", num(x), num(y)));
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_become_ascii_latex() {
+        assert_eq!(tex_text("ψ(γ)"), "$\\psi$($\\gamma$)");
+        assert_eq!(tex_text("γ₁ = 4.3"), "$\\gamma_1$ = 4.3");
+        assert_eq!(tex_text("ψ(γ∞)"), "$\\psi$($\\gamma_\\infty$)");
+        assert_eq!(tex_text("η_T (orbit), C Ξ∞ + Θ"), "$\\eta_{T}$ (orbit), C $\\Xi_\\infty$ + $\\Theta$");
+        assert_eq!(tex_text("limit −λ = −0.3"), "limit $-\\lambda$ = $-$0.3");
+        assert_eq!(tex_text("50% of a_b & c"), "50\\% of a$_{b}$ \\& c");
+        assert_eq!(tex_text("input_amplitude"), "input\\_amplitude");
+        assert!(tex_text("‽").is_ascii());
+    }
+}
