@@ -7,6 +7,7 @@ pub mod convergence;
 pub mod diagnose;
 pub mod discover_bench;
 pub mod figure;
+pub mod import;
 pub mod merge;
 pub mod periodic;
 pub mod play_width;
@@ -34,6 +35,8 @@ pub enum Command {
     Theta(theta::Args),
     /// Parse and validate model files; print n, m, p, Theta and its R, eig(F) and mu.
     Validate(validate::Args),
+    /// A model file from a state space saved by MATLAB (.mat v5) or Python (.json).
+    Import(import::Args),
     /// Property campaign: every inequality of the paper on random cases (table of cases,
     /// minimum normalised slack, violations); exit 1 on a violation, counterexample files.
     Check(check::Args),
@@ -86,6 +89,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Theta(a) => crate::budget::theta_size_of_file("theta", &a.file).and_then(|_| theta::run(&a)),
         Command::Validate(a) => validate::run(&a),
+        Command::Import(a) => import::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Periodic(a) => periodic::run(&a),
