@@ -14,6 +14,10 @@ use std::process::ExitCode;
 use theorems::{CampaignSettings, PropertyReport, Variant};
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau check                                   # every result of the paper, default cases
+  moreau check --only lem1:2 --cases 100000 --seed 7
+  moreau check --only psi0 --negative-control    # the control must find counterexamples")]
 pub struct Args {
     /// Cases per property (default: each property's own default, thousands for the geometric
     /// lemmas, 2,000 for the simulation-based results).

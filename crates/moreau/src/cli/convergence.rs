@@ -8,6 +8,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau convergence examples/worked-example.toml --levels 6")]
 pub struct Args {
     /// Model file (TOML); Theta an interval, ball or ellipsoid; zero or sine input.
     pub file: PathBuf,

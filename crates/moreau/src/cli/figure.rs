@@ -18,6 +18,10 @@ pub enum Kind {
 }
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau figure psi examples/worked-example.toml --out out/figs     # fig-psi1.{svg,png,tex,csv}
+  moreau figure tube examples/ellipse-p2.toml --out out/figs        # fig-loop
+  moreau figure sweep out/amplitude --columns theta,measured_rate --out out/figs")]
 pub struct Args {
     /// Which figure.
     #[arg(value_enum)]

@@ -3,6 +3,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau merge out/shard1 out/shard2 out/shard3 out/shard4 --out out/amplitude")]
 pub struct Args {
     /// Shard result files (sweep-shard-K-of-N.json) or directories holding them.
     #[arg(required = true)]

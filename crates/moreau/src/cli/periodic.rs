@@ -11,6 +11,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau periodic examples/worked-example.toml
+  moreau periodic examples/ellipse-p2.toml --periods 100 --pairs 4 --json")]
 pub struct Args {
     /// Model file (TOML) with a periodic input.
     pub file: PathBuf,

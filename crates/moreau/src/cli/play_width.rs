@@ -9,6 +9,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau play-width --data log.csv --config stand.toml --json play.json")]
 pub struct Args {
     /// Telemetry CSV (columns `target pos (ID)`, `pos (ID)` in encoder counts).
     #[arg(long)]

@@ -17,6 +17,9 @@ pub enum Integrator {
 }
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau simulate examples/worked-example.toml --out out/sim      # trajectory.csv + plots
+  moreau simulate examples/lens-p2.toml --periods 5 --dt 1e-4 --out out/lens")]
 pub struct Args {
     /// Model file (TOML).
     pub file: PathBuf,

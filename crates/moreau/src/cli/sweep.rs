@@ -6,6 +6,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau sweep examples/sweeps/amplitude.toml --out out/amplitude
+  moreau sweep examples/sweeps/amplitude.toml --out out/shard1 --shard 1/4   # one task of a job array
+  moreau merge out/shard* --out out/amplitude                                  # then join the shards")]
 pub struct Args {
     /// Sweep specification (TOML): base model, axes, [evaluate], [table].
     pub spec: PathBuf,

@@ -9,6 +9,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau theta examples/worked-example.toml              # readable report, verdict, guidance
+  moreau theta examples/worked-example.toml --explain    # plus what every row means
+  moreau theta examples/ellipse-p2.toml --json --out theta.json --no-measure")]
 pub struct Args {
     /// Model file (TOML) with a periodic input.
     pub file: PathBuf,

@@ -5,6 +5,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:
+  moreau validate examples/*.toml")]
 pub struct Args {
     /// Model files (TOML).
     #[arg(required = true)]
