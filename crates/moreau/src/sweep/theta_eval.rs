@@ -73,7 +73,7 @@ impl ThetaEvaluator {
 /// The report quantities that are sweep columns (keys of `bounds::report::defs`), in order;
 /// their names and LaTeX headers come from the declarations. The derived columns
 /// ([`DERIVED`]) follow `theta` and `path2_bound`.
-pub const QUANTITY_COLUMNS: [&str; 15] = [
+pub const QUANTITY_COLUMNS: [&str; 17] = [
     "mu",
     "r",
     "alpha",
@@ -89,15 +89,23 @@ pub const QUANTITY_COLUMNS: [&str; 15] = [
     "psi_0",
     "psi_inf",
     "theta",
+    "theta_star",
+    "theta_profile",
 ];
 
-/// Columns that are not report quantities: verified flag, the measured side and ratios.
-pub const DERIVED: [(&str, &str); 5] = [
+/// Columns that are not report quantities: verified flags, the best verified bound, the
+/// measured side and ratios. `ratio` (`theta / measured`) and `best_ratio` (`theta_best /
+/// measured`) are left empty unless the bound certifies (verified and `< 0`): a ratio of a
+/// bound that certifies nothing means nothing.
+pub const DERIVED: [(&str, &str); 8] = [
     ("theta_verified", "verified"),
+    ("theta_best", "$\\theta_{\\mathrm{best}}$"),
+    ("certified", "certified"),
     ("measured_rate", "measured"),
     ("measured_rate_ci_low", "CI low"),
     ("measured_rate_ci_high", "CI high"),
     ("ratio", "$\\theta/\\mathrm{measured}$"),
+    ("best_ratio", "$\\theta_{\\mathrm{best}}/\\mathrm{measured}$"),
 ];
 
 /// Path-length columns (report quantities, then the measured path and the ratio).
@@ -132,7 +140,9 @@ impl Evaluator for ThetaEvaluator {
         let n = Column::number;
         let mut c: Vec<Column> = QUANTITY_COLUMNS.iter().map(|k| n(k, def(k).tex)).collect();
         c.push(Column::flag(DERIVED[0].0, DERIVED[0].1));
-        c.extend(DERIVED[1..].iter().map(|(k, t)| n(k, t)));
+        c.push(n(DERIVED[1].0, DERIVED[1].1));
+        c.push(Column::flag(DERIVED[2].0, DERIVED[2].1));
+        c.extend(DERIVED[3..].iter().map(|(k, t)| n(k, t)));
         c.extend(PATH_COLUMNS.iter().map(|k| n(k, def(k).tex)));
         c.push(n("path_measured", bounds::report::defs::PATH_MEASURED.tex));
         c.push(n("path_ratio", "bound/path"));
@@ -146,9 +156,14 @@ impl Evaluator for ThetaEvaluator {
             Some(m) => (num(m.rate), num(m.ci_low), num(m.ci_high), num(m.path_length_per_period)),
             None => (Cell::Empty, Cell::Empty, Cell::Empty, Cell::Empty),
         };
+        let certified = r.theta_best_verified && r.theta_best < 0.0;
         let ratio = match &r.measured {
-            Some(m) => num(r.theta / m.rate),
-            None => Cell::Empty,
+            Some(m) if r.theta_verified && r.theta < 0.0 => num(r.theta / m.rate),
+            _ => Cell::Empty,
+        };
+        let best_ratio = match &r.measured {
+            Some(m) if certified => num(r.theta_best / m.rate),
+            _ => Cell::Empty,
         };
         let best_path = r.path_bound.max(r.path1_bound).max(r.path2.value);
         let path_ratio = match &r.measured {
@@ -159,7 +174,16 @@ impl Evaluator for ThetaEvaluator {
         let q = r.quantities();
         let val = |k: &str| q.iter().find(|x| x.key == k).map(|x| num(x.value)).unwrap_or(Cell::Empty);
         let mut cells: Vec<Cell> = QUANTITY_COLUMNS.iter().map(|k| val(k)).collect();
-        cells.extend([Cell::Flag(r.theta_verified), rate, lo, hi, ratio]);
+        cells.extend([
+            Cell::Flag(r.theta_verified),
+            num(r.theta_best),
+            Cell::Flag(certified),
+            rate,
+            lo,
+            hi,
+            ratio,
+            best_ratio,
+        ]);
         cells.extend(PATH_COLUMNS.iter().map(|k| val(k)));
         cells.extend([path, path_ratio]);
         Ok(cells)
