@@ -92,7 +92,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                     eprintln!(
                         "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
                         r.theta,
-                        if r.theta_verified { "verified" } else { "not verified" },
+                        match (r.theta_verified, r.theta < 0.0) {
+                            (true, true) => "verified: certifies convergence",
+                            (true, false) => "a valid bound, no convergence guaranteed",
+                            (false, _) => "not verified",
+                        },
                         r.psi_0,
                         r.psi_inf,
                         -r.lambda
