@@ -21,7 +21,8 @@ pub enum Kind {
 #[command(after_help = "Examples:
   moreau figure psi examples/worked-example.toml --out out/figs     # fig-psi1.{svg,png,tex,csv}
   moreau figure tube examples/ellipse-p2.toml --out out/figs        # fig-loop
-  moreau figure sweep out/amplitude --columns theta,measured_rate --out out/figs")]
+  moreau figure sweep out/amplitude --columns theta,measured_rate --out out/figs
+  moreau figure psi examples/worked-example.toml --format pgf --no-title --out paper/figs")]
 pub struct Args {
     /// Which figure.
     #[arg(value_enum)]
@@ -40,6 +41,17 @@ pub struct Args {
     /// trajectory: final time (default: the model's periods, or t_end).
     #[arg(allow_negative_numbers = true, long)]
     pub t_end: Option<f64>,
+    /// Output formats (comma separated): svg, png, pgf (pgfplots .tex + data .csv). Default: all.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "svg,png,pgf")]
+    pub format: Vec<figures::Format>,
+    /// Width and height in pixels of the SVG and PNG (the pgf code takes the paper's line width).
+    #[arg(long, default_value_t = 900)]
+    pub width: u32,
+    #[arg(long, default_value_t = 600)]
+    pub height: u32,
+    /// No title above the plot (a paper's caption replaces it).
+    #[arg(long)]
+    pub no_title: bool,
     /// trajectory: time step (default: the model's dt).
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
@@ -114,7 +126,23 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             }
         }
     };
-    for f in figures::write_figure(&figs, &a.out)? {
+    anyhow::ensure!(
+        (200..=8000).contains(&a.width) && (150..=8000).contains(&a.height),
+        "--width {} --height {}: must be within 200..8000 x 150..8000 pixels",
+        a.width,
+        a.height
+    );
+    let figs: Vec<(String, Figure)> = figs
+        .into_iter()
+        .map(|(stem, mut f)| {
+            f.size = (a.width, a.height);
+            if a.no_title {
+                f.title.clear();
+            }
+            (stem, f)
+        })
+        .collect();
+    for f in figures::write_figure_as(&figs, &a.out, &a.format)? {
         println!("{}", f.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -4,12 +4,13 @@ use super::FigureError;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
-/// Colours used by the figures (colour-blind friendly "tab10" subset).
-pub const BLUE: RGBColor = RGBColor(31, 119, 180);
-pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
-pub const GREEN: RGBColor = RGBColor(44, 160, 44);
-pub const RED: RGBColor = RGBColor(214, 39, 40);
-pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
+/// Colours used by the figures: the Okabe-Ito palette, distinguishable with every common form
+/// of colour-vision deficiency (names kept for what they are closest to).
+pub const BLUE: RGBColor = RGBColor(0, 114, 178);
+pub const ORANGE: RGBColor = RGBColor(230, 159, 0);
+pub const GREEN: RGBColor = RGBColor(0, 158, 115);
+pub const RED: RGBColor = RGBColor(213, 94, 0);
+pub const PURPLE: RGBColor = RGBColor(204, 121, 167);
 pub const GREY: RGBColor = RGBColor(110, 110, 110);
 /// Colour number `i` of the palette.
 pub fn palette(i: usize) -> RGBColor {
@@ -109,8 +110,11 @@ where
     let err = |e: &dyn std::fmt::Debug| FigureError::Draw { figure: f.title.clone(), reason: format!("{e:?}") };
     let ((x0, x1), (y0, y1)) = f.ranges().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&f.title, ("sans-serif", 22))
+    let mut builder = ChartBuilder::on(&root);
+    if !f.title.is_empty() {
+        builder.caption(&f.title, ("sans-serif", 22));
+    }
+    let mut chart = builder
         .margin(14)
         .x_label_area_size(48)
         .y_label_area_size(72)
@@ -240,24 +244,46 @@ pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
     draw(root, f)
 }
 
+/// Output formats of [`write_figure_as`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// SVG with the DejaVu font embedded.
+    Svg,
+    /// PNG (`size` pixels).
+    Png,
+    /// pgfplots code (`.tex`) and its data (`.csv`), set in the paper's fonts by LaTeX.
+    Pgf,
+}
+
 /// Writes `stem.svg`, `stem.png`, `stem.tex` (pgfplots) and `stem.csv` (data) for every
 /// `(stem, figure)` into `out`, all or none.
 pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf>, FigureError> {
+    write_figure_as(figs, out, &[Format::Svg, Format::Png, Format::Pgf])
+}
+
+/// [`write_figure`] for the chosen formats only.
+pub fn write_figure_as(figs: &[(String, Figure)], out: &Path, formats: &[Format]) -> Result<Vec<PathBuf>, FigureError> {
     let werr =
         |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
     let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
     let mut files = vec![];
     for (stem, f) in figs {
-        let svg = to_svg(f)?;
-        let p = staged.path(&format!("{stem}.svg"));
-        std::fs::write(&p, svg).map_err(|e| werr(&p, &e))?;
-        write_png(f, &staged.path(&format!("{stem}.png")))?;
-        for (ext, text) in [("tex", super::pgf::to_pgf(f)), ("csv", super::pgf::to_csv(f))] {
-            let p = staged.path(&format!("{stem}.{ext}"));
-            std::fs::write(&p, text).map_err(|e| werr(&p, &e))?;
+        if formats.contains(&Format::Svg) {
+            let svg = to_svg(f)?;
+            let p = staged.path(&format!("{stem}.svg"));
+            std::fs::write(&p, svg).map_err(|e| werr(&p, &e))?;
+            files.push(out.join(format!("{stem}.svg")));
         }
-        for ext in ["svg", "png", "tex", "csv"] {
-            files.push(out.join(format!("{stem}.{ext}")));
+        if formats.contains(&Format::Png) {
+            write_png(f, &staged.path(&format!("{stem}.png")))?;
+            files.push(out.join(format!("{stem}.png")));
+        }
+        if formats.contains(&Format::Pgf) {
+            for (ext, text) in [("tex", super::pgf::to_pgf(f)), ("csv", super::pgf::to_csv(f))] {
+                let p = staged.path(&format!("{stem}.{ext}"));
+                std::fs::write(&p, text).map_err(|e| werr(&p, &e))?;
+                files.push(out.join(format!("{stem}.{ext}")));
+            }
         }
     }
     staged.commit().map_err(|e| werr(out, &e))?;

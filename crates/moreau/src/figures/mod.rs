@@ -15,7 +15,7 @@ pub mod sweep;
 pub mod trajectory;
 pub mod tube;
 
-pub use canvas::{write_figure, Element, Figure};
+pub use canvas::{write_figure, write_figure_as, Element, Figure, Format};
 
 use thiserror::Error;
 
