@@ -325,9 +325,27 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let path_safe = path_best * (1.0 - 1e-10);
     let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
     let kappa_star = if gamma_inf > 0.0 { down(gamma_1_star / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
-    let (theta_star, lambda_star, beta_star) = curve
+    // Certified (lambda, b_hat) points for theta*: the paper's curve, plus a second lambda search
+    // with theta* as its objective when gamma_1* > gamma_1 (theta*'s best lambda differs from
+    // theta's); every point is a verified certificate, so the minimum over all is a bound.
+    let mut star_points: Vec<(f64, f64)> = curve.iter().map(|&(l, b, _)| (l, b)).collect();
+    if strongly_convex && gamma_1_star > gamma_1 {
+        match optimise_lambda(
+            &F,
+            E,
+            C,
+            |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf),
+            &settings.lambda,
+        ) {
+            Ok(s2) => star_points.extend(
+                s2.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))),
+            ),
+            Err(e) => notes.push(format!("second lambda search (for theta*) failed: {e}")),
+        }
+    }
+    let (theta_star, lambda_star, beta_star) = star_points
         .iter()
-        .map(|&(l, b, _)| (Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf), l, b))
+        .map(|&(l, b)| (Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf), l, b))
         .fold((theta, opt.value.lambda, opt.value.beta), |a, c| if c.0 < a.0 { c } else { a });
     // The same proof obligations as theta (the path bounds use the same d and orbit samples).
     let theta_star_verified = theta_verified;
@@ -344,9 +362,9 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         Some(prof) => {
             let nodes =
                 prof.best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
-            let (v, l) = curve
+            let (v, l) = star_points
                 .iter()
-                .map(|&(l, b, _)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
+                .map(|&(l, b)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
                 .fold((f64::INFINITY, f64::NAN), |a, c| if c.0 < a.0 { c } else { a });
             (v.min(theta_star), if v <= theta_star { l } else { lambda_star }, nodes.len() - 1)
         }
