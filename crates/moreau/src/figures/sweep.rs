@@ -1,6 +1,8 @@
 //! theta (eq. (theta)) and the measured exponent against a swept parameter, from a sweep
 //! result file (`moreau sweep`). With several axes, one curve per combination of the others.
-use super::canvas::{palette, Element, Figure};
+//! When the sweep has the `certified` column, the points where the best verified bound
+//! certifies convergence are drawn in the curve's colour and the others grey.
+use super::canvas::{palette, Element, Figure, GREY};
 use super::FigureError;
 use crate::sweep::{Cell, ColumnKind, SweepResult};
 use std::collections::BTreeMap;
@@ -43,6 +45,8 @@ pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Resul
     }
     let multi = groups.len() > 1;
     let mut colour = 0;
+    let cert_idx = r.columns.iter().position(|k| k.name == "certified");
+    let mut grey_labelled = false;
     for (key_bits, pts) in &groups {
         let suffix = if multi {
             let others: Vec<String> = r
@@ -69,7 +73,24 @@ pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Resul
                 color: palette(colour),
                 dashed: false,
             });
-            f.elements.push(Element::Markers { label: String::new(), pts: xy, text: vec![], color: palette(colour) });
+            // certified points (the `certified` column of the sweep, when present) filled in the
+            // curve's colour, the others grey
+            let certified = |x: f64| {
+                cert_idx.is_some_and(|ci| {
+                    pts.iter().any(|p| p.params[xi] == x && matches!(p.cells[ci], Cell::Flag(true)))
+                })
+            };
+            let (yes, no): (Vec<(f64, f64)>, Vec<(f64, f64)>) = xy.iter().partition(|(x, _)| certified(*x));
+            if cert_idx.is_some() {
+                f.elements.push(Element::Markers { label: String::new(), pts: yes, text: vec![], color: palette(colour) });
+                if !no.is_empty() {
+                    let label = if grey_labelled { String::new() } else { "not certified".to_string() };
+                    grey_labelled = true;
+                    f.elements.push(Element::Markers { label, pts: no, text: vec![], color: GREY });
+                }
+            } else {
+                f.elements.push(Element::Markers { label: String::new(), pts: xy, text: vec![], color: palette(colour) });
+            }
             colour += 1;
         }
     }
