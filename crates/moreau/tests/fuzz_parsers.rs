@@ -218,3 +218,14 @@ fn a_panicking_parser_is_caught() {
     });
     assert!(r.is_err(), "the harness missed a panic");
 }
+
+/// Regression from the 10^6 campaign: an axis of 1.3 M values (`to = 1e6, step = 0.75`) was
+/// validated value by value (2.9 s) before the soft point limit refused it; it is now refused
+/// before the values are built.
+#[test]
+fn found_large_axis_is_refused_before_expansion() {
+    let at = root().join("examples/sweeps/fuzz.toml");
+    let spec = "name = \"x\"\nmodel = \"../worked-example.toml\"\n[[axis]]\nparameter = \"plant.A[1][0]\"\nrange = { from = -3.0, to = 1e6, step = 0.75 }\n";
+    let e = moreau::sweep::spec::SweepSpec::parse(spec, &at).unwrap_err();
+    assert!(e.to_string().contains("more than the limit 1000000"), "{e}");
+}

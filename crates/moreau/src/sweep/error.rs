@@ -46,7 +46,7 @@ pub enum SweepError {
     NotFinite { name: String, value: f64 },
     #[error("axis `{name}`: value {value} gives an invalid model: {source}")]
     InvalidPoint { name: String, value: f64, source: model::ModelError },
-    #[error("the grid has {points} points, more than the limit {limit}")]
+    #[error("the grid has {points} points, more than the limit {limit} (--allow-large raises it to 10^7)")]
     TooManyPoints { points: u128, limit: usize },
     #[error("bad shard `{text}`: expected K/N with 0 <= K < N (K counts from 0, e.g. $SLURM_ARRAY_TASK_ID)")]
     BadShard { text: String },
