@@ -1,6 +1,6 @@
 //! Development aid: one benchmark case, its ranking, and a profile of the estimation cost
 //! along the true effect's main parameter (initial state refitted at each point).
-//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3`.
+//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital] [profile]`.
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
@@ -9,27 +9,66 @@ use model::effects::Effect;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    if a.len() != 4 {
-        eprintln!("usage: cargo run --release -p discovery --example probe CLASS SEED INDEX");
+    if a.len() < 4 {
+        eprintln!(
+            "usage: cargo run --release -p discovery --example probe CLASS SEED INDEX [classic|digital] [profile]"
+        );
         std::process::exit(2);
     }
     let class: &'static str = Box::leak(a[1].clone().into_boxed_str());
     let seed: u64 = a[2].parse().unwrap();
     let idx: usize = a[3].parse().unwrap();
-    let case = bench_gen::generate(class, seed, idx);
+    let profile = a.get(4).and_then(|s| bench_gen::Profile::parse(s)).unwrap_or(bench_gen::Profile::Classic);
+    let case = bench_gen::generate_profile(class, seed, idx, profile);
     println!("{} truth {:?}", case.description, case.truth);
-    let rep = discovery::diagnose(&case.nominal, &case.recording, &Default::default()).unwrap();
-    println!("selected {} ties {:?}", rep.selected(), rep.ties);
+    let s = discovery::DiagnoseSettings {
+        initial_state: Some(discovery::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        }),
+        ..Default::default()
+    };
+    let rep = discovery::diagnose(&case.nominal, &case.recording, &s).unwrap();
+    println!("selected {} ties {:?}; verdict {}", rep.selected(), rep.ties, rep.verdict);
+    println!(
+        "hold {:?}; substeps {} ladder {:?} err {:.3e} tol {:.3e}; final {:?}; dBIC_disc {:.1}; noise {:?}; x0 {:?}",
+        rep.hold,
+        rep.substeps,
+        rep.discretisation.ladder,
+        rep.discretisation.error_rms,
+        rep.discretisation.tolerance,
+        rep.discretisation_final.as_ref().map(|d| (d.substeps, d.error_rms, d.ladder.clone())),
+        rep.delta_bic_discretisation,
+        rep.noise_level,
+        rep.initial_state
+    );
+    println!(
+        "residual nominal white {} unc {} zm {} Q {:.1}",
+        rep.residual_nominal.white,
+        rep.residual_nominal.uncorrelated,
+        rep.residual_nominal.zero_mean,
+        rep.residual_nominal.q_auto
+    );
+    for n in &rep.notes {
+        println!("  note: {n}");
+    }
     for e in &rep.effects {
         println!("  {} {:?} +- {:?}", e.label, e.params, e.uncertainty);
     }
-    for r in rep.ranking.iter().take(8) {
+    for r in rep.ranking.iter().take(12) {
         println!(
-            "  {:40} {:?} std {:?} dBIC {:.1} vr {:.3} {:?}",
-            r.label, r.params, r.std, r.delta_bic, r.validation_ratio, r.status
+            "  {:40} {:?} std {:?} dBIC {:.1} vr {:.3} {:?} {} cv {:?}",
+            r.label,
+            r.params,
+            r.std,
+            r.delta_bic,
+            r.validation_ratio,
+            r.status,
+            r.evidence,
+            r.cv.as_ref().map(|c| (c.ratio, c.max_fold_share, c.status))
         );
     }
-    if a.len() > 4 {
+    if a.len() > 5 {
         // Profile: scale factors of the truth.
         let sys = &case.nominal;
         let rec = &case.recording;
@@ -79,6 +118,9 @@ fn main() {
                 weights: vec![1.0 / sd],
                 maps: maps.clone(),
                 substeps: sub,
+                hold: discovery::simulate::InputHold::Foh,
+                z0: None,
+                exclude: None,
             };
             let r = fit::fit(&pb, &x0, &xs, None, &FitSettings::default());
             println!("  f {f:.2}: sse {:.4}", r.sse);

@@ -2,15 +2,24 @@
 //! fitted model and report.
 //!
 //! Segments: the first `estimation_fraction` (default 70 %) of the record is the estimation
-//! segment (all fitting, initial state included, uses only it); the rest is the validation
-//! segment, simulated free-running from the start of the record and never fitted.
+//! segment (every hypothesis is fitted on it and ranked by BIC there); the rest is the
+//! validation segment, simulated free-running from the start of the record with the
+//! estimation fit (the fit % reported). A candidate is accepted by blocked cross-validation
+//! over `cv_folds` contiguous folds of the whole record (each fold held out in turn, the
+//! hypothesis and the nominal refitted on the others, the held-out fold predicted by a
+//! free run through it), not by one validation segment.
+//!
+//! Before any of that: the input hold (zero- or first-order, `auto` by the nominal fit), the
+//! sub-steps per sample (by convergence against the noise level, see [`crate::discretisation`])
+//! and the initial state (the model file's when it states one, else estimated).
+use crate::discretisation::{self, SubstepCheck};
 use crate::fit::{self, FitResult, FitSettings, Problem};
 use crate::hypothesis::{self, Hypothesis, Kind, Scales};
 use crate::localise::{self, Localisation, RegimeShare, Window};
 use crate::metrics::{self, Fit};
 use crate::residual::{self, ResidualTests};
 use crate::select::{self, SelectSettings};
-use crate::simulate::{ExtendedModel, StepMaps};
+use crate::simulate::{ExtendedModel, InputHold, StepMaps};
 use crate::{DiscoveryError, Recording};
 use model::effects::Effect;
 use model::{Input, SimDefaults, System};
@@ -22,10 +31,26 @@ use serde::Serialize;
 pub struct DiagnoseSettings {
     /// Fraction of the record used for estimation. Default 0.7.
     pub estimation_fraction: f64,
-    /// Largest number of linear sub-steps per sample. Default 8.
+    /// Largest number of linear sub-steps per sample. Default 64.
     pub max_substeps: usize,
-    /// Sub-steps are chosen so that `h <= tau_fast / substep_ratio`. Default 10.
+    /// First number of sub-steps tried: `h <= tau_fast / substep_ratio`. Default 10.
     pub substep_ratio: f64,
+    /// Sub-steps are doubled until the simulated output changes by at most this fraction of
+    /// the noise level (weighted RMS). Default 0.1.
+    pub substep_tol: f64,
+    /// Input between samples: `Auto` (decided by the nominal fit), `Zoh` or `Foh`.
+    pub input_hold: HoldChoice,
+    /// The initial state stated by the model file (`None`: not stated, estimated).
+    pub initial_state: Option<InitialState>,
+    /// Estimate the initial state even when the model file states one. Default false.
+    pub estimate_x0: bool,
+    /// Contiguous folds of the blocked cross-validation. Default 5.
+    pub cv_folds: usize,
+    /// Candidates (best BIC first) cross-validated per selection step, until one passes.
+    /// Default 3.
+    pub max_cv: usize,
+    /// LM iterations per fold refit (from the estimation fit). Default 6.
+    pub cv_iter: usize,
     /// Greatest number of effects added by forward selection. Default 2.
     pub max_effects: usize,
     /// How many of the best single hypotheses are tried as second effects. Default 4.
@@ -42,8 +67,15 @@ impl Default for DiagnoseSettings {
     fn default() -> Self {
         Self {
             estimation_fraction: 0.7,
-            max_substeps: 8,
+            max_substeps: 64,
             substep_ratio: 10.0,
+            substep_tol: 0.1,
+            input_hold: HoldChoice::Auto,
+            initial_state: None,
+            estimate_x0: false,
+            cv_folds: 5,
+            max_cv: 3,
+            cv_iter: 6,
             max_effects: 2,
             max_second: 4,
             lags: 20,
@@ -52,6 +84,91 @@ impl Default for DiagnoseSettings {
             parallel: true,
         }
     }
+}
+
+/// How the input behaves between samples (`--input-hold`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HoldChoice {
+    /// Decided from the data: the hold under which the nominal model fits better.
+    #[default]
+    Auto,
+    /// Zero-order hold: each sample held until the next (a digital controller's command).
+    Zoh,
+    /// First-order hold: linear interpolation between samples.
+    Foh,
+}
+
+impl HoldChoice {
+    /// From `auto`, `zoh` or `foh`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(HoldChoice::Auto),
+            "zoh" => Some(HoldChoice::Zoh),
+            "foh" => Some(HoldChoice::Foh),
+            _ => None,
+        }
+    }
+}
+
+/// An initial state stated by the model file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    pub x0: Vec<f64>,
+    /// Backlash output `z0` when stated (else at rest in the play, `z0 = C x0`).
+    pub z0: Option<Vec<f64>>,
+}
+
+/// Which input hold was used and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoldReport {
+    /// `auto`, `zoh` or `foh` as requested.
+    pub requested: HoldChoice,
+    /// `zoh` or `foh`.
+    pub chosen: &'static str,
+    /// Nominal estimation SSE (weighted) under each hold (`None` where not computed).
+    pub sse_zoh: Option<f64>,
+    pub sse_foh: Option<f64>,
+    /// `BIC(other hold) - BIC(chosen)` of the nominal model (same parameter count).
+    pub delta_bic: Option<f64>,
+    /// Whether the data decide (`delta_bic` at least the tie margin).
+    pub decisive: bool,
+    /// `auto` only: `BIC(best single effect, chosen hold) - BIC(same effect refitted with
+    /// the other hold)` (negative: the effect confirms the hold). The nominal's preference can
+    /// be an artefact of the missing effect; where the best effect prefers the other hold by
+    /// the tie margin (by any margin when it is an input delay, with which the hold is
+    /// confounded), the hold is switched and the diagnosis redone.
+    pub effect_delta_bic: Option<f64>,
+    /// Whether the hold was switched by that check.
+    pub switched: bool,
+}
+
+/// The initial state used.
+#[derive(Debug, Clone, Serialize)]
+pub struct InitialStateReport {
+    /// `model file` or `estimated`.
+    pub source: &'static str,
+    /// Nominal `x0` (fixed or fitted).
+    pub x0: Vec<f64>,
+    /// With the model file's `x0`: `BIC(fixed) - BIC(estimated)` of the nominal model
+    /// (a large value says the file's `x0` does not match the recording's start).
+    pub delta_bic_free: Option<f64>,
+}
+
+/// The blocked cross-validation of one hypothesis against the model it would extend.
+#[derive(Debug, Clone, Serialize)]
+pub struct CvResult {
+    /// `sum_j SSE_j(hypothesis) / sum_j SSE_j(base)` over the held-out folds.
+    pub ratio: f64,
+    /// Held-out SSE per fold (weighted), hypothesis and base.
+    pub sse: Vec<f64>,
+    pub sse_base: Vec<f64>,
+    /// Share of the hypothesis' influence on the prediction (`yhat - yhat_base`, squared)
+    /// that falls in its largest fold.
+    pub max_fold_share: f64,
+    /// `passed`, `failed` or `not_testable` (the influence is confined to one fold: the
+    /// other folds cannot estimate it, so held-out data cannot test it).
+    pub status: &'static str,
 }
 
 /// File name of the input samples written beside `fitted.toml` (the model's `input.file`).
@@ -65,6 +182,11 @@ pub struct FittedEffect {
     pub description: String,
     pub params: Vec<(String, f64)>,
     pub uncertainty: Vec<(String, f64)>,
+    /// `input_delay` only: the equivalent parameters under the other input hold (a zero-order
+    /// hold acts as a first-order hold delayed by h/2): `(hold, params)`. Where the data do not
+    /// decide the hold (see the report's `hold`), the recording cannot tell the two apart and
+    /// the user's knowledge of the hold must.
+    pub other_hold: Option<(String, Vec<(String, f64)>)>,
 }
 
 /// One hypothesis (single or composite) with its fit.
@@ -83,6 +205,11 @@ pub struct Ranked {
     pub validation_ratio: f64,
     pub beats_nominal: bool,
     pub status: fit::FitStatus,
+    /// `for` (accepted against the model it extends), `against` (a conclusive fit that
+    /// does not pay), `inconclusive: ...` (a stuck fit, never evidence against its effect).
+    pub evidence: String,
+    /// Blocked cross-validation, where run.
+    pub cv: Option<CvResult>,
     #[serde(skip)]
     pub x0: Vec<f64>,
     #[serde(skip)]
@@ -111,6 +238,16 @@ pub struct Report {
     pub dt: f64,
     pub resampled: bool,
     pub substeps: usize,
+    /// Input hold between samples.
+    pub hold: HoldReport,
+    /// Sub-step convergence of the nominal model (and of the final model).
+    pub discretisation: SubstepCheck,
+    pub discretisation_final: Option<SubstepCheck>,
+    /// Noise level of each output (difference estimator, units of y).
+    pub noise_level: Vec<f64>,
+    /// BIC gain the remaining discretisation error could buy (added to the selection margin).
+    pub delta_bic_discretisation: f64,
+    pub initial_state: InitialStateReport,
     pub estimation_segment: [f64; 2],
     pub validation_segment: [f64; 2],
     pub tau_slow: f64,
@@ -149,12 +286,25 @@ struct Ctx<'a> {
     weights: Vec<f64>,
     maps: StepMaps,
     substeps: usize,
+    /// Scales of the free initial state; empty when it is fixed (model file).
     x_scale: Vec<f64>,
     x0_init: Vec<f64>,
+    hold: InputHold,
+    z0: Option<Vec<f64>>,
 }
 
 impl<'a> Ctx<'a> {
     fn problem(&'a self, fixed: Vec<Effect>, parts: Vec<Hypothesis>) -> Problem<'a> {
+        self.problem_on(fixed, parts, self.k_est, None)
+    }
+    /// The problem with residuals on `[0, k_end)` minus `exclude`.
+    fn problem_on(
+        &'a self,
+        fixed: Vec<Effect>,
+        parts: Vec<Hypothesis>,
+        k_end: usize,
+        exclude: Option<(usize, usize)>,
+    ) -> Problem<'a> {
         Problem {
             sys: self.sys,
             fixed,
@@ -165,20 +315,295 @@ impl<'a> Ctx<'a> {
             m: self.m,
             p: self.p,
             dt: self.dt,
-            k_est: self.k_est,
+            k_est: k_end,
             weights: self.weights.clone(),
             maps: self.maps.clone(),
             substeps: self.substeps,
+            hold: self.hold,
+            z0: self.z0.clone(),
+            exclude,
         }
     }
     fn weighted_sse(&self, yhat: &[f64], k0: usize, k1: usize) -> f64 {
+        self.weighted_sse_between(yhat, &self.y, k0, k1)
+    }
+    fn weighted_sse_between(&self, a: &[f64], b: &[f64], k0: usize, k1: usize) -> f64 {
         let p = self.p;
-        (k0 * p..k1 * p).map(|i| ((yhat[i] - self.y[i]) * self.weights[i % p]).powi(2)).sum()
+        (k0 * p..k1 * p).map(|i| ((a[i] - b[i]) * self.weights[i % p]).powi(2)).sum()
     }
 }
 
 fn flat(v: &[Vec<f64>]) -> Vec<f64> {
     v.iter().flat_map(|r| r.iter().copied()).collect()
+}
+
+/// Nominal fit and the quantities derived from it at one hold and sub-step count.
+struct Selection {
+    ranking: Vec<Ranked>,
+    chosen: Option<Ranked>,
+    ties: Vec<String>,
+    /// Candidates that passed the BIC margin but failed cross-validation (label, CV ratio).
+    cv_rejected: Vec<(String, f64)>,
+}
+
+fn failed_fit(p: usize) -> Fit {
+    Fit {
+        fit_percent: vec![Some(f64::NEG_INFINITY); p],
+        rmse: vec![f64::INFINITY; p],
+        velocity_fit_percent: vec![Some(f64::NEG_INFINITY); p],
+        constant_outputs: vec![],
+    }
+}
+
+/// Fits one (composite) hypothesis on the estimation segment.
+fn run_one(
+    ctx: &Ctx,
+    s: &DiagnoseSettings,
+    parts: Vec<Hypothesis>,
+    warm: Option<Vec<f64>>,
+    x0: &[f64],
+    bic_nom: f64,
+    val_sse_nom: f64,
+) -> Ranked {
+    let (p, n_samp, k_est, nx) = (ctx.p, ctx.n, ctx.k_est, ctx.x_scale.len());
+    let pb = ctx.problem(vec![], parts.clone());
+    let r: FitResult = fit::fit(&pb, x0, &ctx.x_scale, warm.as_deref(), &s.fit);
+    let (val, val_sse) = match pb.simulate(&r.theta, &r.x0, None) {
+        Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, ctx.dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
+        None => (failed_fit(p), f64::INFINITY),
+    };
+    let b = select::bic(r.sse, k_est * p, pb.k() + nx);
+    Ranked {
+        label: parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>().join(" + "),
+        kinds: parts.iter().map(|h| h.kind.name().to_string()).collect(),
+        params: r.theta.clone(),
+        std: r.std.clone(),
+        sse_estimation: r.sse,
+        bic: b,
+        delta_bic: bic_nom - b,
+        validation: val,
+        validation_ratio: val_sse / val_sse_nom.max(1e-300),
+        beats_nominal: false,
+        status: r.status,
+        evidence: String::new(),
+        cv: None,
+        x0: r.x0,
+        val_sse,
+        parts,
+    }
+}
+
+/// Fold boundaries of the blocked cross-validation.
+fn folds(n: usize, k: usize) -> Vec<(usize, usize)> {
+    (0..k).map(|j| (j * n / k, (j + 1) * n / k)).collect()
+}
+
+/// Held-out SSE per fold of `parts` (refitted on the other folds from `params`, `x0`), and
+/// the full-record prediction of the estimation fit.
+fn cv_sse(ctx: &Ctx, s: &DiagnoseSettings, parts: &[Hypothesis], params: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
+    let n = ctx.n;
+    let fs = fit::FitSettings { max_iter_start: s.cv_iter, max_iter: 0, ..s.fit.clone() };
+    let one = |&(b0, b1): &(usize, usize)| -> Option<f64> {
+        let pb = ctx.problem_on(vec![], parts.to_vec(), n, Some((b0, b1)));
+        let (theta, x0f) = if pb.k() == 0 && ctx.x_scale.is_empty() {
+            (vec![], x0.to_vec())
+        } else {
+            let r = fit::fit(&pb, x0, &ctx.x_scale, Some(params), &fs);
+            (r.theta, r.x0)
+        };
+        let sim = pb.simulate(&theta, &x0f, None)?;
+        Some(ctx.weighted_sse(&sim.y, b0, b1))
+    };
+    let fl = folds(n, s.cv_folds);
+    let v: Vec<Option<f64>> = if s.parallel { fl.par_iter().map(one).collect() } else { fl.iter().map(one).collect() };
+    v.into_iter().collect()
+}
+
+/// Cross-validates `cand` against `base` (held-out SSE per fold `base_sse`).
+fn cross_validate(ctx: &Ctx, s: &DiagnoseSettings, cand: &Ranked, base: &Ranked, base_sse: &[f64]) -> CvResult {
+    let fl = folds(ctx.n, s.cv_folds);
+    let sim = |r: &Ranked| ctx.problem(vec![], r.parts.clone()).simulate(&r.params, &r.x0, None).map(|o| o.y);
+    let infl: Vec<f64> = match (sim(cand), sim(base)) {
+        (Some(a), Some(b)) => fl.iter().map(|&(b0, b1)| ctx.weighted_sse_between(&a, &b, b0, b1)).collect(),
+        _ => vec![1.0; fl.len()],
+    };
+    let tot: f64 = infl.iter().sum();
+    let max_fold_share = if tot > 0.0 { infl.iter().copied().fold(0.0, f64::max) / tot } else { 1.0 };
+    let sse = cv_sse(ctx, s, &cand.parts, &cand.params, &cand.x0).unwrap_or_else(|| vec![f64::INFINITY; fl.len()]);
+    let ratio = sse.iter().sum::<f64>() / base_sse.iter().sum::<f64>().max(1e-300);
+    // Confined to one fold: the other folds cannot estimate it, and the refit of that fold
+    // starts from the estimation fit (which saw it), so its held-out score would be leaked.
+    let status = if max_fold_share > NOT_TESTABLE_SHARE {
+        "not_testable"
+    } else if ratio <= 1.0 - s.select.min_val_gain {
+        "passed"
+    } else {
+        "failed"
+    };
+    CvResult { ratio, sse, sse_base: base_sse.to_vec(), max_fold_share, status }
+}
+
+/// An effect whose influence on the prediction lies above this share in one fold cannot be
+/// tested on held-out data (the other folds do not visit its regime).
+pub const NOT_TESTABLE_SHARE: f64 = 0.9;
+
+fn evidence_of(r: &Ranked) -> String {
+    if r.beats_nominal {
+        return match r.cv.as_ref().map(|c| c.status) {
+            Some("not_testable") => "for (supported by the estimation data, not testable on validation)".into(),
+            _ => "for".into(),
+        };
+    }
+    match r.status {
+        fit::FitStatus::ZeroGradient => "inconclusive: stuck fit (zero gradient)".into(),
+        fit::FitStatus::AtBound => "inconclusive: clipped at a bound".into(),
+        fit::FitStatus::Failed => "inconclusive: simulation failed".into(),
+        _ => match &r.cv {
+            Some(c) => format!("against: held-out folds (CV SSE ratio {:.3})", c.ratio),
+            None => "against".into(),
+        },
+    }
+}
+
+/// Fits every hypothesis, selects by BIC (margin `margin`) and blocked cross-validation,
+/// greedy forward.
+/// Fits every single hypothesis on the estimation segment (sorted by BIC).
+fn fit_singles(ctx: &Ctx, s: &DiagnoseSettings, sys: &System, nom: &FitResult) -> Vec<Ranked> {
+    let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
+    let cands = hypothesis::candidates(sys, &ctx.scales);
+    let one = |h: &Hypothesis| run_one(ctx, s, vec![h.clone()], None, &nom.x0, bic_nom, val_sse_nom);
+    let mut singles: Vec<Ranked> =
+        if s.parallel { cands.par_iter().map(one).collect() } else { cands.iter().map(one).collect() };
+    singles.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+    singles
+}
+
+/// BIC of the nominal fit and its validation SSE.
+fn nominal_scores(ctx: &Ctx, nom: &FitResult) -> (f64, f64) {
+    let bic_nom = select::bic(nom.sse, ctx.k_est * ctx.p, ctx.x_scale.len());
+    let val_sse_nom = ctx
+        .problem(vec![], vec![])
+        .simulate(&[], &nom.x0, None)
+        .map_or(f64::INFINITY, |o| ctx.weighted_sse(&o.y, ctx.k_est, ctx.n));
+    (bic_nom, val_sse_nom)
+}
+
+/// Selects among the fitted singles by BIC (margin `margin`) and blocked cross-validation,
+/// greedy forward.
+fn select_all(
+    ctx: &Ctx,
+    s: &DiagnoseSettings,
+    mut singles: Vec<Ranked>,
+    nom: &FitResult,
+    nominal_adequate: bool,
+    margin: f64,
+) -> Selection {
+    let p = ctx.p;
+    let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
+    let nominal_ranked = Ranked {
+        label: "nominal".into(),
+        kinds: vec![],
+        params: vec![],
+        std: vec![],
+        sse_estimation: nom.sse,
+        bic: bic_nom,
+        delta_bic: 0.0,
+        validation: failed_fit(p),
+        validation_ratio: 1.0,
+        beats_nominal: false,
+        status: nom.status,
+        evidence: String::new(),
+        cv: None,
+        x0: nom.x0.clone(),
+        val_sse: val_sse_nom,
+        parts: vec![],
+    };
+    let mut chosen: Option<Ranked> = None;
+    let mut ties = Vec::new();
+    let mut cv_rejected = Vec::new();
+    let mut extra: Vec<Ranked> = Vec::new();
+    if !nominal_adequate {
+        let base_sse = cv_sse(ctx, s, &[], &[], &nom.x0).unwrap_or_else(|| vec![f64::INFINITY; s.cv_folds]);
+        // Singles: cross-validate the best few that clear the BIC margin.
+        let mut tried = 0;
+        for r in singles.iter_mut() {
+            if bic_nom - r.bic < margin || tried >= s.max_cv {
+                continue;
+            }
+            tried += 1;
+            let cv = cross_validate(ctx, s, r, &nominal_ranked, &base_sse);
+            r.beats_nominal = cv.status != "failed";
+            if !r.beats_nominal {
+                cv_rejected.push((r.label.clone(), cv.ratio));
+            }
+            r.cv = Some(cv);
+            if r.beats_nominal {
+                // The best accepted single is found; the rest keep their BIC evidence only.
+                break;
+            }
+        }
+        if let Some(best) = singles.iter().find(|r| r.beats_nominal) {
+            ties = singles
+                .iter()
+                .filter(|r| {
+                    r.label != best.label && bic_nom - r.bic >= margin && (r.bic - best.bic).abs() < s.select.tie_bic
+                })
+                .map(|r| r.label.clone())
+                .collect();
+            let mut cur = best.clone();
+            // Greedy forward selection.
+            while cur.parts.len() < s.max_effects {
+                let seconds: Vec<&Ranked> = singles
+                    .iter()
+                    .filter(|r| !cur.parts.iter().any(|p| p.kind.name() == r.parts[0].kind.name()))
+                    .take(s.max_second)
+                    .collect();
+                let f = |r: &&Ranked| {
+                    let mut parts = cur.parts.clone();
+                    parts.push(r.parts[0].clone());
+                    run_one(ctx, s, parts, Some(cur.params.clone()), &cur.x0, bic_nom, val_sse_nom)
+                };
+                let mut combos: Vec<Ranked> =
+                    if s.parallel { seconds.par_iter().map(f).collect() } else { seconds.iter().map(f).collect() };
+                combos.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+                let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| base_sse.clone());
+                let mut next = None;
+                let mut tried = 0;
+                for c in combos.iter_mut() {
+                    if cur.bic - c.bic < margin || tried >= s.max_cv {
+                        continue;
+                    }
+                    tried += 1;
+                    let cv = cross_validate(ctx, s, c, &cur, &cur_sse);
+                    c.beats_nominal = cv.status != "failed";
+                    c.cv = Some(cv);
+                    if c.beats_nominal {
+                        next = Some(c.clone());
+                        break;
+                    }
+                }
+                extra.extend(combos.iter().cloned());
+                match next {
+                    Some(nx) => cur = nx,
+                    None => break,
+                }
+            }
+            chosen = Some(cur);
+        }
+    }
+    let mut ranking: Vec<Ranked> = singles.into_iter().chain(extra).collect();
+    for r in ranking.iter_mut() {
+        r.evidence = evidence_of(r);
+    }
+    // Conclusive fits by BIC; stuck ones last (they are not evidence either way).
+    ranking.sort_by(|a, b| {
+        let (ia, ib) = (a.evidence.starts_with("inconclusive"), b.evidence.starts_with("inconclusive"));
+        ia.cmp(&ib).then(a.bic.total_cmp(&b.bic))
+    });
+    if let Some(c) = chosen.as_mut() {
+        c.evidence = evidence_of(c);
+    }
+    Selection { ranking, chosen, ties, cv_rejected }
 }
 
 /// Diagnoses `rec` against nominal model `sys`.
@@ -188,6 +613,13 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             field: "estimation_fraction",
             value: s.estimation_fraction,
             reason: "must lie in [0.2, 0.95]",
+        });
+    }
+    if s.cv_folds < 2 {
+        return Err(DiscoveryError::BadSetting {
+            field: "cv_folds",
+            value: s.cv_folds as f64,
+            reason: "at least 2 folds are needed",
         });
     }
     let (m, p) = (rec.m(), rec.p());
@@ -207,6 +639,23 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             columns: "y columns".into(),
         });
     }
+    let nx = sys.n();
+    if let Some(is) = &s.initial_state {
+        if is.x0.len() != nx {
+            return Err(DiscoveryError::BadSetting {
+                field: "initial_state.x0 length",
+                value: is.x0.len() as f64,
+                reason: "must equal the model's n",
+            });
+        }
+        if is.z0.as_ref().is_some_and(|z| z.len() != p) {
+            return Err(DiscoveryError::BadSetting {
+                field: "initial_state.z0 length",
+                value: is.z0.as_ref().map_or(0, |z| z.len()) as f64,
+                reason: "must equal the model's p",
+            });
+        }
+    }
     let mu = sys.mu();
     if !(mu < 0.0) {
         return Err(DiscoveryError::Unstable { mu });
@@ -220,9 +669,9 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let w = flat(&rec.w);
     let y = flat(&rec.y);
     let k_est = ((n_samp as f64) * s.estimation_fraction).round() as usize;
+    let max_sub = s.max_substeps.max(1);
     let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
-    let substeps =
-        if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, s.max_substeps.max(1)) } else { 1 };
+    let k0 = if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, max_sub) } else { 1 };
     let range = |v: &[f64], c: usize, j: usize| {
         let lo = (0..v.len() / c).map(|k| v[k * c + j]).fold(f64::INFINITY, f64::min);
         let hi = (0..v.len() / c).map(|k| v[k * c + j]).fold(f64::NEG_INFINITY, f64::max);
@@ -243,143 +692,232 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             1.0 / var.sqrt().max(1e-300)
         })
         .collect();
-    let maps = StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / substeps as f64);
-    // Initial state: minimum-norm solution of C x0 = y_0; scales from a nominal run.
+    let noise = discretisation::noise_level(&y, p);
+    let noise_w = ((0..p).map(|i| (noise[i] * weights[i]).powi(2)).sum::<f64>() / p as f64).sqrt().max(1e-6);
+    let tol = s.substep_tol * noise_w;
+    // Initial state: the model file's when stated (fixed unless --estimate-x0), else the
+    // minimum-norm solution of C x0 = y_0, fitted.
+    let x0_fixed = s.initial_state.is_some() && !s.estimate_x0;
     let C = &sys.C;
-    let y0 = nalgebra::DVector::from_column_slice(&y[..p]);
-    let x0_init: Vec<f64> =
-        C.clone().pseudo_inverse(1e-12).map(|pi| (pi * y0).iter().copied().collect()).unwrap_or(vec![0.0; sys.n()]);
-    let nominal_ext = ExtendedModel::from_maps(sys, &[], maps.clone(), substeps)?;
-    let probe = nominal_ext.simulate(&w, dt, &x0_init);
+    let x0_init: Vec<f64> = match &s.initial_state {
+        Some(is) => is.x0.clone(),
+        None => {
+            let y0 = nalgebra::DVector::from_column_slice(&y[..p]);
+            C.clone().pseudo_inverse(1e-12).map(|pi| (pi * y0).iter().copied().collect()).unwrap_or(vec![0.0; nx])
+        }
+    };
+    let z0: Option<Vec<f64>> = if x0_fixed { s.initial_state.as_ref().and_then(|i| i.z0.clone()) } else { None };
+    let sim_nominal = |hold: InputHold, k: usize| -> Option<Vec<f64>> {
+        let ext = ExtendedModel::new(sys, &[], dt, k).ok()?.with_hold(hold);
+        let o = ext.simulate_from(&w, dt, &x0_init, z0.as_deref());
+        o.finite.then_some(o.y)
+    };
+    let probe = ExtendedModel::new(sys, &[], dt, k0)?.simulate(&w, dt, &x0_init);
     let xmax = probe.x_rms.iter().copied().fold(0.0, f64::max).max(1e-9);
-    let x_scale: Vec<f64> = probe.x_rms.iter().map(|v| v.max(1e-3 * xmax)).collect();
-    let ctx = Ctx { sys, scales, w, y, m, p, dt, n: n_samp, k_est, weights, maps, substeps, x_scale, x0_init };
-
-    // Nominal model: only the initial state is fitted.
-    let nom_pb = ctx.problem(vec![], vec![]);
-    let nom = fit::fit(&nom_pb, &ctx.x0_init, &ctx.x_scale, None, &s.fit);
-    let nom_sim = nom_pb.simulate(&[], &nom.x0, None).ok_or(DiscoveryError::Unstable { mu })?;
+    let x_scale_free: Vec<f64> = probe.x_rms.iter().map(|v| v.max(1e-3 * xmax)).collect();
+    let x_scale: Vec<f64> = if x0_fixed { vec![] } else { x_scale_free.clone() };
+    let mk_ctx = |hold: InputHold, k: usize, x_scale: Vec<f64>| Ctx {
+        sys,
+        scales: scales.clone(),
+        w: w.clone(),
+        y: y.clone(),
+        m,
+        p,
+        dt,
+        n: n_samp,
+        k_est,
+        weights: weights.clone(),
+        maps: StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / k as f64),
+        substeps: k,
+        x_scale,
+        x0_init: x0_init.clone(),
+        hold,
+        z0: z0.clone(),
+    };
+    let fit_nominal = |ctx: &Ctx| fit::fit(&ctx.problem(vec![], vec![]), &ctx.x0_init, &ctx.x_scale, None, &s.fit);
     let n_res = k_est * p;
-    let nx = sys.n();
-    let bic_nom = select::bic(nom.sse, n_res, nx);
-    let val_sse_nom = ctx.weighted_sse(&nom_sim.y, k_est, n_samp);
-    let fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, dt);
-    let e_nom: Vec<f64> = ctx.y.iter().zip(&nom_sim.y).map(|(a, b)| a - b).collect();
-    let lag_step = ((tau_slow / dt) / 10.0).floor().max(1.0) as usize;
-    let tests_for = |e: &[f64]| {
-        // Residual of output 0 weighted sum over outputs: test each output, combine (all must pass).
-        let mut t: Option<ResidualTests> = None;
-        for i in 0..p {
-            let ei: Vec<f64> = (0..n_samp).map(|k| e[k * p + i]).collect();
-            let us: Vec<Vec<f64>> = (0..m).map(|j| (0..n_samp).map(|k| ctx.w[k * m + j]).collect()).collect();
-            let ti = residual::test(&ei, &us, s.lags, lag_step);
-            t = Some(match t {
-                None => ti,
-                Some(prev) => {
-                    let (white, unc, zm) =
-                        (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
-                    ResidualTests { white, uncorrelated: unc, zero_mean: zm, ..prev }
-                }
-            });
-        }
-        t.expect("p >= 1")
-    };
-    let residual_nominal = tests_for(&e_nom);
-    let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated && residual_nominal.zero_mean;
-    let contact = nominal_ext.has_play().then_some(&nom_sim.contact[..]);
-    let half_width = ((0.1 * tau_slow / dt).round() as usize).max(3);
-    let loc: Localisation = localise::localise(rec.t0, dt, &ctx.y, &e_nom, p, &ctx.w, m, contact, half_width, 10);
 
-    // Single hypotheses.
-    let cands = hypothesis::candidates(sys, &ctx.scales);
-    let run_one = |parts: Vec<Hypothesis>, fixed: Vec<Effect>, warm: Option<Vec<f64>>, x0: &[f64]| -> Ranked {
-        let pb = ctx.problem(fixed, parts.clone());
-        let r: FitResult = fit::fit(&pb, x0, &ctx.x_scale, warm.as_deref(), &s.fit);
-        let (val, val_sse) = match pb.simulate(&r.theta, &r.x0, None) {
-            Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
-            None => (
-                Fit {
-                    fit_percent: vec![Some(f64::NEG_INFINITY); p],
-                    rmse: vec![f64::INFINITY; p],
-                    velocity_fit_percent: vec![Some(f64::NEG_INFINITY); p],
-                    constant_outputs: vec![],
+    // Input hold and sub-steps.
+    let first_hold = if s.input_hold == HoldChoice::Zoh { InputHold::Zoh } else { InputHold::Foh };
+    let mut disc = discretisation::converge(|k| sim_nominal(first_hold, k), k0, max_sub, &weights, tol);
+    let (mut hold, mut hold_report) = match s.input_hold {
+        HoldChoice::Zoh | HoldChoice::Foh => (
+            first_hold,
+            HoldReport {
+                requested: s.input_hold,
+                chosen: first_hold.name(),
+                sse_zoh: None,
+                sse_foh: None,
+                delta_bic: None,
+                decisive: false,
+                effect_delta_bic: None,
+                switched: false,
+            },
+        ),
+        HoldChoice::Auto => {
+            let fz = fit_nominal(&mk_ctx(InputHold::Zoh, disc.substeps, x_scale.clone()));
+            let ff = fit_nominal(&mk_ctx(InputHold::Foh, disc.substeps, x_scale.clone()));
+            let (bz, bf) = (select::bic(fz.sse, n_res, 0), select::bic(ff.sse, n_res, 0));
+            let hold = if bz < bf { InputHold::Zoh } else { InputHold::Foh };
+            let d = (bz - bf).abs();
+            (
+                hold,
+                HoldReport {
+                    requested: HoldChoice::Auto,
+                    chosen: hold.name(),
+                    sse_zoh: Some(fz.sse),
+                    sse_foh: Some(ff.sse),
+                    delta_bic: Some(d),
+                    decisive: d >= s.select.tie_bic,
+                    effect_delta_bic: None,
+                    switched: false,
                 },
-                f64::INFINITY,
-            ),
-        };
-        let k = pb.k() + nx;
-        let b = select::bic(r.sse, n_res, k);
-        Ranked {
-            label: parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>().join(" + "),
-            kinds: parts.iter().map(|h| h.kind.name().to_string()).collect(),
-            params: r.theta.clone(),
-            std: r.std.clone(),
-            sse_estimation: r.sse,
-            bic: b,
-            delta_bic: bic_nom - b,
-            validation: val,
-            validation_ratio: val_sse / val_sse_nom.max(1e-300),
-            beats_nominal: select::beats(b, val_sse, bic_nom, val_sse_nom, &s.select),
-            status: r.status,
-            x0: r.x0,
-            val_sse,
-            parts,
+            )
         }
     };
-    let mut singles: Vec<Ranked> = if s.parallel {
-        cands.par_iter().map(|h| run_one(vec![h.clone()], vec![], None, &nom.x0)).collect()
-    } else {
-        cands.iter().map(|h| run_one(vec![h.clone()], vec![], None, &nom.x0)).collect()
-    };
-    singles.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-    let mut ranking = singles.clone();
+    if hold != first_hold {
+        disc = discretisation::converge(|k| sim_nominal(hold, k), disc.substeps, max_sub, &weights, tol);
+    }
+    let mut ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
+    let mut nom = fit_nominal(&ctx);
+    let mut disc_final: Option<SubstepCheck> = None;
     let mut notes = Vec::new();
+    let mut pass = 0;
+    let (sel, e_nom, residual_nominal, nominal_adequate, nom_sim, loc, delta_bic_disc) = loop {
+        let nom_sim =
+            ctx.problem(vec![], vec![]).simulate(&[], &nom.x0, None).ok_or(DiscoveryError::Unstable { mu })?;
+        let e_nom: Vec<f64> = ctx.y.iter().zip(&nom_sim.y).map(|(a, b)| a - b).collect();
+        let lag_step = ((tau_slow / dt) / 10.0).floor().max(1.0) as usize;
+        let residual_nominal = tests_for(&e_nom, &ctx.w, n_samp, m, p, s.lags, lag_step);
+        let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated && residual_nominal.zero_mean;
+        let nominal_ext = ExtendedModel::from_maps(sys, &[], ctx.maps.clone(), ctx.substeps)?;
+        let contact = nominal_ext.has_play().then_some(&nom_sim.contact[..]);
+        let half_width = ((0.1 * tau_slow / dt).round() as usize).max(3);
+        let loc: Localisation = localise::localise(rec.t0, dt, &ctx.y, &e_nom, p, &ctx.w, m, contact, half_width, 10);
+        let err = disc.error_rms.max(disc_final.as_ref().map_or(0.0, |d| d.error_rms));
+        let delta_bic_disc = discretisation::delta_bic_of_error(err, nom.sse / n_res as f64, n_res);
+        let margin = s.select.margin_bic + delta_bic_disc;
+        let singles = fit_singles(&ctx, s, sys, &nom);
+        // Auto hold: does the best effect confirm the nominal's choice? The nominal's
+        // preference can be an artefact of the missing effect.
+        if s.input_hold == HoldChoice::Auto && hold_report.effect_delta_bic.is_none() && !nominal_adequate {
+            if let Some(c) = singles.first().filter(|c| nominal_scores(&ctx, &nom).0 - c.bic >= margin) {
+                let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
+                let ctx_o = mk_ctx(other, ctx.substeps, x_scale.clone());
+                let fo = fit::FitSettings { max_iter: 10, ..s.fit.clone() };
+                let r_o =
+                    fit::fit(&ctx_o.problem(vec![], c.parts.clone()), &c.x0, &ctx_o.x_scale, Some(&c.params), &fo);
+                let d = select::bic(c.sse_estimation, n_res, 0) - select::bic(r_o.sse, n_res, 0);
+                hold_report.effect_delta_bic = Some(d);
+                // With an input delay, hold and delay are confounded (a zero-order hold acts like
+                // a first-order hold delayed by h/2): the nominal's preference says nothing and
+                // the effect's comparison decides, by any margin.
+                let has_delay = c.parts.iter().any(|h| h.kind == Kind::InputDelay);
+                let threshold = if has_delay { 0.0 } else { s.select.tie_bic };
+                if d > threshold {
+                    notes.push(format!(
+                        "Input hold: the nominal model preferred {} (by {:.1} in BIC), but the best effect ({}) fits better with {} by {d:.1}: the missing effect had biased the nominal's choice; the diagnosis was redone with {}.",
+                        hold.name(),
+                        hold_report.delta_bic.unwrap_or(0.0),
+                        c.label,
+                        other.name(),
+                        other.name()
+                    ));
+                    hold = other;
+                    hold_report.chosen = other.name();
+                    hold_report.switched = true;
+                    disc = discretisation::converge(|k| sim_nominal(hold, k), ctx.substeps, max_sub, &weights, tol);
+                    ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
+                    nom = fit_nominal(&ctx);
+                    disc_final = None;
+                    continue;
+                }
+            }
+        }
+        let sel = select_all(&ctx, s, singles, &nom, nominal_adequate, margin);
+        // Final model: does it need more sub-steps than the nominal?
+        if let Some(c) = &sel.chosen {
+            let effects = ctx.problem(vec![], c.parts.clone()).effects(&c.params);
+            let x0c = c.x0.clone();
+            let chk = discretisation::converge(
+                |k| {
+                    let ext = ExtendedModel::new(sys, &effects, dt, k).ok()?.with_hold(hold);
+                    let o = ext.simulate_from(&w, dt, &x0c, z0.as_deref());
+                    o.finite.then_some(o.y)
+                },
+                ctx.substeps,
+                max_sub,
+                &weights,
+                tol,
+            );
+            let more = chk.substeps > ctx.substeps;
+            disc_final = Some(chk);
+            if more && pass == 0 {
+                pass += 1;
+                let k = disc_final.as_ref().map_or(ctx.substeps, |d| d.substeps);
+                notes.push(format!(
+                    "The selected model ({}) needed {k} sub-steps per sample where the nominal converged at {}: the whole selection was rerun at {k}.",
+                    c.label, ctx.substeps
+                ));
+                disc = discretisation::converge(|k| sim_nominal(hold, k), k, max_sub, &weights, tol);
+                ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
+                nom = fit_nominal(&ctx);
+                continue;
+            }
+        }
+        break (sel, e_nom, residual_nominal, nominal_adequate, nom_sim, loc, delta_bic_disc);
+    };
+    let substeps = ctx.substeps;
+    let bic_nom = select::bic(nom.sse, n_res, ctx.x_scale.len());
+    let fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, dt);
+    let Selection { ranking, chosen, ties, cv_rejected } = sel;
+    // Initial state report (with the model file's x0: how much freeing it would gain).
+    let initial_state = if x0_fixed {
+        let free = fit_nominal(&mk_ctx(hold, substeps, x_scale_free.clone()));
+        let d = bic_nom - select::bic(free.sse, n_res, nx);
+        if d > s.select.margin_bic && chosen.is_none() {
+            notes.push(format!(
+                "The model file's initial state may not match the start of the recording: with the nominal model, estimating it would gain {d:.1} in BIC. Run with --estimate-x0 if the file's x0 is not the recorded machine's."
+            ));
+        }
+        InitialStateReport { source: "model file", x0: nom.x0.clone(), delta_bic_free: Some(d) }
+    } else {
+        InitialStateReport { source: "estimated", x0: nom.x0.clone(), delta_bic_free: None }
+    };
     if rec.resampled {
         notes.push(format!("Irregular time stamps ({} rows) were resampled by linear interpolation to a uniform grid of dt = {:.6} s ({} samples).", rec.rows_in_file, dt, n_samp));
     }
-    let mut chosen: Option<Ranked> = None;
-    let mut ties = Vec::new();
-    if !nominal_adequate {
-        if let Some(best) = singles.iter().find(|r| r.beats_nominal) {
-            ties = singles
-                .iter()
-                .filter(|r| r.label != best.label && r.beats_nominal && (r.bic - best.bic).abs() < s.select.tie_bic)
-                .map(|r| r.label.clone())
-                .collect();
-            let mut cur = best.clone();
-            // Greedy forward selection.
-            while cur.parts.len() < s.max_effects {
-                let seconds: Vec<&Ranked> = singles
-                    .iter()
-                    .filter(|r| !cur.parts.iter().any(|p| p.kind.name() == r.parts[0].kind.name()))
-                    .take(s.max_second)
-                    .collect();
-                let combos: Vec<Ranked> = {
-                    let f = |r: &&Ranked| {
-                        let mut parts = cur.parts.clone();
-                        parts.push(r.parts[0].clone());
-                        run_one(parts, vec![], Some(cur.params.clone()), &cur.x0)
-                    };
-                    if s.parallel {
-                        seconds.par_iter().map(f).collect()
-                    } else {
-                        seconds.iter().map(f).collect()
-                    }
-                };
-                ranking.extend(combos.iter().cloned());
-                let next = combos
-                    .into_iter()
-                    .filter(|c| select::beats(c.bic, c.val_sse, cur.bic, cur.val_sse, &s.select))
-                    .min_by(|a, b| a.bic.total_cmp(&b.bic));
-                match next {
-                    Some(nx) => cur = nx,
-                    None => break,
-                }
-            }
-            chosen = Some(cur);
-        }
+    match (hold_report.requested, hold_report.decisive) {
+        (HoldChoice::Auto, _) if hold_report.switched => {}
+        (HoldChoice::Auto, true) => notes.push(format!(
+            "Input hold: {} (chosen from the data: the nominal model fits better by {:.1} in BIC than with {}).",
+            hold.name(),
+            hold_report.delta_bic.unwrap_or(0.0),
+            if hold == InputHold::Zoh { "foh" } else { "zoh" }
+        )),
+        (HoldChoice::Auto, false) => notes.push(format!(
+            "Input hold: {} by a margin of {:.1} in BIC, below the tie margin {}: the recording does not tell zero- from first-order hold (sampling fast against the dynamics).",
+            hold.name(),
+            hold_report.delta_bic.unwrap_or(0.0),
+            s.select.tie_bic
+        )),
+        _ => notes.push(format!("Input hold: {} (as requested).", hold.name())),
     }
-    ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+    if !disc.converged {
+        notes.push(format!(
+            "The simulation did not converge within {} sub-steps per sample (change {:.2e} against the tolerance {:.2e}): effects whose gain is within the remaining error ({:.1} in BIC) are not accepted.",
+            max_sub,
+            disc.ladder.last().map_or(f64::NAN, |l| l.1),
+            disc.tolerance,
+            delta_bic_disc
+        ));
+    }
+    for (l, r) in &cv_rejected {
+        notes.push(format!(
+            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {:.2} required): rejected.",
+            1.0 - s.select.min_val_gain
+        ));
+    }
 
     // Fitted model and its residual.
     let (effects_chosen, x0_fit) = match &chosen {
@@ -393,21 +931,47 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let fit_sim = fit_pb.simulate(&[], &x0_fit, None).unwrap_or(nom_sim.clone());
     let fit_after = metrics::fit(&ctx.y, &fit_sim.y, p, k_est, n_samp, dt);
     let e_fit: Vec<f64> = ctx.y.iter().zip(&fit_sim.y).map(|(a, b)| a - b).collect();
-    let residual_fitted = tests_for(&e_fit);
+    let lag_step = ((tau_slow / dt) / 10.0).floor().max(1.0) as usize;
+    let residual_fitted = tests_for(&e_fit, &ctx.w, n_samp, m, p, s.lags, lag_step);
     let mut fitted_sys = sys.clone();
     fitted_sys.effects.list.extend(effects_chosen.iter().cloned());
     fitted_sys.x0 = nalgebra::DVector::from_column_slice(&x0_fit);
-    fitted_sys.z0 = &sys.C * &fitted_sys.x0;
+    fitted_sys.z0 = match &z0 {
+        Some(z) => nalgebra::DVector::from_column_slice(z),
+        None => &sys.C * &fitted_sys.x0,
+    };
     fitted_sys.name = format!("{} (fitted by moreau diagnose)", sys.name);
     // The recording's input (on the uniform grid the fit used, time from 0) and the fit's
-    // step, so that `moreau simulate fitted.toml` reproduces the fitted curve.
-    fitted_sys.input = Input::Samples {
-        path: FITTED_INPUT_FILE.into(),
-        t: (0..n_samp).map(|k| k as f64 * dt).collect(),
-        w: rec.w.clone(),
-        period: None,
+    // step, so that `moreau simulate fitted.toml` reproduces the fitted curve. The model
+    // file's input is interpolated linearly between its samples: a zero-order hold is
+    // written as two samples per interval (at t_k and one sub-step before t_{k+1}), so that
+    // only the last sub-step of each interval ramps.
+    let sub_w = substeps.max(2);
+    let h_sub = dt / sub_w as f64;
+    let (t_in, w_in): (Vec<f64>, Vec<Vec<f64>>) = match hold {
+        InputHold::Foh => ((0..n_samp).map(|k| k as f64 * dt).collect(), rec.w.clone()),
+        InputHold::Zoh => {
+            let mut t = Vec::with_capacity(2 * n_samp);
+            let mut wv = Vec::with_capacity(2 * n_samp);
+            for k in 0..n_samp {
+                t.push(k as f64 * dt);
+                wv.push(rec.w[k].clone());
+                if k + 1 < n_samp {
+                    t.push((k + 1) as f64 * dt - h_sub);
+                    wv.push(rec.w[k].clone());
+                }
+            }
+            (t, wv)
+        }
     };
-    fitted_sys.sim = SimDefaults { dt: dt / substeps as f64, periods: 1, t_end: Some((n_samp - 1) as f64 * dt) };
+    fitted_sys.input = Input::Samples { path: FITTED_INPUT_FILE.into(), t: t_in, w: w_in, period: None };
+    let sim_dt = if hold == InputHold::Zoh { h_sub } else { dt / substeps as f64 };
+    fitted_sys.sim = SimDefaults { dt: sim_dt, periods: 1, t_end: Some((n_samp - 1) as f64 * dt) };
+    if hold == InputHold::Zoh {
+        notes.push(format!(
+            "fitted.toml replays the held input with linear interpolation over the last of {sub_w} sub-steps of each sample (its input file has two points per sample): `moreau simulate` reproduces the fit up to that ramp."
+        ));
+    }
     let effects: Vec<FittedEffect> = match &chosen {
         Some(c) => {
             let mut off = 0;
@@ -426,6 +990,14 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                             .zip(&c.std[off..off + k])
                             .map(|(n, v)| (n.to_string(), *v))
                             .collect(),
+                        other_hold: (h.kind == Kind::InputDelay).then(|| {
+                            let d = c.params[off];
+                            let (name, v) = match hold {
+                                InputHold::Zoh => ("foh", d + 0.5 * dt),
+                                InputHold::Foh => ("zoh", (d - 0.5 * dt).max(0.0)),
+                            };
+                            (name.to_string(), vec![("delay".to_string(), v)])
+                        }),
                     };
                     off += k;
                     fe
@@ -434,27 +1006,38 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         }
         None => vec![],
     };
+    let untestable = chosen.as_ref().is_some_and(|c| c.cv.as_ref().is_some_and(|v| v.status == "not_testable"));
     let verdict = if nominal_adequate {
         "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)"
             .to_string()
     } else if let Some(c) = &chosen {
+        let tail = if untestable {
+            " (supported by the estimation data; not testable on validation: its effect lies in one fold of the record)"
+        } else {
+            ""
+        };
         if fit_before.constant_outputs.is_empty() {
             format!(
-                "missing physics: {} (validation fit {} -> {} %)",
+                "missing physics: {}{tail} (validation fit {} -> {} %)",
                 c.label,
                 fmt_opt(&fit_before.fit_percent),
                 fmt_opt(&fit_after.fit_percent)
             )
         } else {
             format!(
-                "missing physics: {} (validation RMSE {} -> {}; fit % undefined, the validation output is constant)",
+                "missing physics: {}{tail} (validation RMSE {} -> {}; fit % undefined, the validation output is constant)",
                 c.label,
                 fmt_e(&fit_before.rmse),
                 fmt_e(&fit_after.rmse)
             )
         }
+    } else if !cv_rejected.is_empty() {
+        format!(
+            "the nominal residual is not white; {} improve(s) the estimation fit but not the held-out folds of the blocked cross-validation, so nothing is added (see the ranking)",
+            cv_rejected.iter().map(|c| c.0.clone()).collect::<Vec<_>>().join(", ")
+        )
     } else {
-        "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC and validation): the mismatch is outside the library".to_string()
+        "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library".to_string()
     };
     if !fit_before.constant_outputs.is_empty() {
         notes.push(format!(
@@ -466,10 +1049,28 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     if fit_before.fit_percent.iter().flatten().any(|f| *f > 97.0) {
         notes.push("Plain fit % is above 97 % (a tightly tracking loop saturates it): judge by the RMSE ratio (validation_ratio), the velocity fit and BIC instead.".into());
     }
-    if matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset))
-        || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset"))
-    {
-        notes.push("A constant force b on state j and a sensor offset C F^{-1} e_j b are observationally equivalent when the initial state is free (the play is translation invariant): the recording cannot tell them apart; physics must.".into());
+    let twin =
+        matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset))
+            || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset"));
+    if twin {
+        if x0_fixed {
+            notes.push("A constant force and a sensor offset are told apart here by the known initial state (the model file's x0): an offset shifts y(0) itself, a force only bends the trajectory after it.".into());
+        } else {
+            notes.push("A constant force b on state j and a sensor offset C F^{-1} e_j b are observationally equivalent when the initial state is free (the play is translation invariant): the recording cannot tell them apart; physics must (or a known x0 in the model file).".into());
+        }
+    }
+    if chosen.as_ref().is_some_and(|c| c.parts.iter().any(|h| h.kind == Kind::InputDelay)) {
+        notes.push(format!(
+            "An input delay trades off against the input hold: a zero-order hold acts like a first-order hold delayed by h/2 = {:.3e} s. The delay is reported for the {} hold; under the {} hold it is {} (effects[].other_hold).{}",
+            0.5 * dt,
+            hold.name(),
+            if hold == InputHold::Zoh { "foh" } else { "zoh" },
+            effects.iter().filter_map(|e| e.other_hold.as_ref()).map(|o| format!("{:.4e} s", o.1[0].1)).collect::<Vec<_>>().join(", "),
+            match hold_report.effect_delta_bic {
+                Some(d) if d.abs() < s.select.tie_bic => format!(" The delay model fits both holds alike ({:.1} in BIC): the recording cannot tell which; use --input-hold if the hold is known.", d.abs()),
+                _ => String::new(),
+            }
+        ));
     }
     let series = Series {
         t: (0..n_samp).map(|k| rec.time(k)).collect(),
@@ -479,7 +1080,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         yhat_fitted: fit_sim.y.clone(),
         energy: loc.energy.clone(),
     };
-    let _ = ctx.n;
+    let _ = e_nom;
     Ok(Report {
         model: sys.name.clone(),
         recording: rec.source.clone(),
@@ -487,6 +1088,12 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         dt,
         resampled: rec.resampled,
         substeps,
+        hold: hold_report,
+        discretisation: disc,
+        discretisation_final: disc_final,
+        noise_level: noise,
+        delta_bic_discretisation: delta_bic_disc,
+        initial_state,
         estimation_segment: [rec.time(0), rec.time(k_est - 1)],
         validation_segment: [rec.time(k_est), rec.time(n_samp - 1)],
         tau_slow,
@@ -505,6 +1112,25 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         fitted_model: Some(fitted_sys),
         series,
     })
+}
+
+/// Residual tests of every output (all must pass).
+fn tests_for(e: &[f64], w: &[f64], n: usize, m: usize, p: usize, lags: usize, lag_step: usize) -> ResidualTests {
+    let mut t: Option<ResidualTests> = None;
+    let us: Vec<Vec<f64>> = (0..m).map(|j| (0..n).map(|k| w[k * m + j]).collect()).collect();
+    for i in 0..p {
+        let ei: Vec<f64> = (0..n).map(|k| e[k * p + i]).collect();
+        let ti = residual::test(&ei, &us, lags, lag_step);
+        t = Some(match t {
+            None => ti,
+            Some(prev) => {
+                let (white, unc, zm) =
+                    (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
+                ResidualTests { white, uncorrelated: unc, zero_mean: zm, ..prev }
+            }
+        });
+    }
+    t.expect("p >= 1")
 }
 
 fn fmt_vec(v: &[f64]) -> String {
@@ -537,6 +1163,24 @@ impl Report {
         s += &format!(
             "Record: {} samples, dt = {:.6} s{}; simulation with {} exact linear sub-step(s) per sample. Estimation segment t in [{:.4}, {:.4}] s, validation segment t in [{:.4}, {:.4}] s (never fitted; free-run simulation from the start of the record). Slowest time constant of the nominal loop: {:.4} s.\n\n",
             self.samples, self.dt, if self.resampled { " (resampled from irregular stamps)" } else { "" }, self.substeps, self.estimation_segment[0], self.estimation_segment[1], self.validation_segment[0], self.validation_segment[1], self.tau_slow
+        );
+        s += &format!(
+            "Input hold: **{}**{}. Sub-steps by convergence: {} (changes k -> 2k: {}; tolerance {:.2e}, i.e. {} of the noise level; remaining discretisation error {:.2e}{}, worth at most {:.1} in BIC, added to the selection margin). Noise level (difference estimator): {}. Initial state: {}{}.\n\n",
+            self.hold.chosen,
+            match (self.hold.requested, self.hold.delta_bic) {
+                (HoldChoice::Auto, Some(d)) => format!(" (auto: the nominal model fits better by {d:.1} in BIC than with the other hold{})", if self.hold.decisive { "" } else { "; below the tie margin, not decisive" }),
+                _ => " (as requested)".into(),
+            },
+            self.substeps,
+            self.discretisation.ladder.iter().map(|(k, c)| format!("{k}: {c:.2e}")).collect::<Vec<_>>().join(", "),
+            self.discretisation.tolerance,
+            "a tenth",
+            self.discretisation.error_rms,
+            if self.discretisation.converged { "" } else { " (NOT converged)" },
+            self.delta_bic_discretisation,
+            self.noise_level.iter().map(|v| format!("{v:.3e}")).collect::<Vec<_>>().join(", "),
+            self.initial_state.source,
+            self.initial_state.delta_bic_free.map_or(String::new(), |d| format!(" (estimating it instead would gain {d:.1} in BIC with the nominal model)"))
         );
         s += "## Fit on the validation segment\n\n| | fit % | RMSE | velocity fit % |\n|---|---|---|---|\n";
         s += &format!(
@@ -592,6 +1236,11 @@ impl Report {
                     "  - {n} = {v:.6} +- {u:.2e} (1 sigma: the larger of Gauss-Newton and a batch-means sandwich for coloured residuals; model error is not included)\n"
                 );
             }
+            if let Some((h, ps)) = &e.other_hold {
+                for (n, v) in ps {
+                    s += &format!("  - under the {h} hold instead: {n} = {v:.6}\n");
+                }
+            }
         }
         if !self.ties.is_empty() {
             s += &format!(
@@ -599,16 +1248,19 @@ impl Report {
                 self.ties.join(", ")
             );
         }
-        s += "\n## Ranking of all hypotheses\n\n| hypothesis | params | delta BIC | validation fit % | validation SSE ratio | accepted vs nominal |\n|---|---|---|---|---|---|\n";
+        s += "\n## Ranking of all hypotheses\n\nSelection: BIC gain of at least the margin (plus the discretisation allowance) on the estimation segment, then blocked cross-validation over contiguous folds of the whole record (each held out in turn, the hypothesis and the model it extends refitted on the others). A stuck fit (zero gradient, clipped at a bound) is inconclusive, not evidence against its effect.\n\n| hypothesis | params | delta BIC | validation fit % | validation SSE ratio | CV SSE ratio | fit | evidence |\n|---|---|---|---|---|---|---|---|\n";
         for r in &self.ranking {
+            let inconclusive = r.evidence.starts_with("inconclusive");
             s += &format!(
-                "| {} | {} | {:.1} | {} | {:.3} | {} |\n",
+                "| {} | {} | {} | {} | {:.3} | {} | {:?} | {} |\n",
                 r.label,
                 fmt_e(&r.params),
-                r.delta_bic,
+                if inconclusive { "n/a".to_string() } else { format!("{:.1}", r.delta_bic) },
                 fmt_opt(&r.validation.fit_percent),
                 r.validation_ratio,
-                r.beats_nominal
+                r.cv.as_ref().map_or("-".to_string(), |c| format!("{:.3} ({})", c.ratio, c.status)),
+                r.status,
+                r.evidence
             );
         }
         if !self.notes.is_empty() {

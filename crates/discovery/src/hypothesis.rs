@@ -14,6 +14,14 @@
 //! - `input_delay` in `[0, min(tau_slow, T/20)]` (at least 5 samples);
 //! - `input_saturation` limit in `[0.2, 1] max|w|` (1 = no clipping);
 //! - `sensor_offset` in `+- range(y)/2` per output.
+//!
+//! Starts over decades: a level-like parameter (play width, friction level, inertia time
+//! constant, delay) is fitted in logarithmic coordinates of `theta + 1e-5 upper` (so that 0 is
+//! reachable and a step is a relative change at every magnitude) from starts at
+//! `{1e-4, 1e-3, 1e-2, 0.1, 0.4, 0.8}` of its bound ([`DECADES`]); the saturation limit gets
+//! starts down to 0.1 % below `max |w|`, the gap scale starts at +-0.5 %, +-5 %, -50 %, +70 %
+//! and +250 %. The solver screens the starts and iterates the best three. Forces and offsets
+//! enter the output linearly and need no decade starts.
 use model::effects::{Effect, PlayLocation};
 use model::System;
 use serde::Serialize;
@@ -158,6 +166,26 @@ impl Hypothesis {
     }
 }
 
+/// Fractions of the bound at which a level-like parameter is started.
+pub const DECADES: [f64; 6] = [1e-4, 1e-3, 1e-2, 0.1, 0.4, 0.8];
+
+/// Shift of the logarithmic coordinates of a level-like parameter, relative to its bound.
+pub const LEVEL_LOG_SHIFT: f64 = 1e-5;
+
+/// A level-like hypothesis in `[0, hi]`: logarithmic coordinates and starts over decades.
+fn level(kind: Kind, hi: f64, name: &'static str) -> Hypothesis {
+    let h = Hypothesis {
+        kind,
+        lower: vec![0.0],
+        upper: vec![hi],
+        starts: vec![],
+        names: vec![name],
+        log_shift: vec![Some(LEVEL_LOG_SHIFT * hi)],
+    };
+    let at: Vec<f64> = DECADES.iter().map(|f| f * hi).collect();
+    h.starts_at(&at)
+}
+
 /// Velocity-like states: `x_j` such that some other state's derivative is a multiple of
 /// `x_j` alone (`A` row `i` has its only non-zero at `j`, `B`, `E` rows `i` zero). When the
 /// model has none, every state is a candidate.
@@ -202,9 +230,9 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
     };
     let mut out = Vec::new();
     if point && e_nonzero {
-        out.push(one(Kind::Backlash { at_input: false }, 0.0, 0.5 * yr, "width"));
+        out.push(level(Kind::Backlash { at_input: false }, 0.5 * yr, "width"));
     }
-    out.push(one(Kind::Backlash { at_input: true }, 0.0, 0.5 * wr, "width"));
+    out.push(level(Kind::Backlash { at_input: true }, 0.5 * wr, "width"));
     if !point {
         // Scale 1 + relative_change from 0.1 up to the scale at which the play is wider than
         // the whole output range (beyond it z never moves and the scale is not identifiable),
@@ -213,21 +241,21 @@ pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
         let smax = if diam > 0.0 { (2.0 * yr / diam).clamp(5.0, 1e3) } else { 5.0 };
         let mut h = one(Kind::GapWidth, -0.9, smax - 1.0, "relative_change");
         h.log_shift = vec![Some(1.0)];
-        out.push(h.starts_at(&[-0.5, 1e-3, 0.7, 2.5]));
-        out.push(one(Kind::BacklashInertia, 0.0, 2.0 * s.tau_slow, "mass"));
+        out.push(h.starts_at(&[-0.5, -0.05, -0.005, 0.005, 0.05, 0.7, 2.5]));
+        out.push(level(Kind::BacklashInertia, 2.0 * s.tau_slow, "mass"));
     }
     for j in velocity_states(sys) {
         let fs = static_gain(sys, j).map(|g| yr / g).unwrap_or_else(|| s.w_absmax * sys.B.row(j).amax()).max(1e-12);
-        out.push(one(Kind::CoulombFriction { state: j }, 0.0, fs, "level"));
+        out.push(level(Kind::CoulombFriction { state: j }, fs, "level"));
         let mut h = one(Kind::ConstantForce { state: j }, -0.5 * fs, 0.5 * fs, "force");
         h.starts = vec![vec![0.3], vec![0.5], vec![0.7]];
         out.push(h);
     }
     let dmax = s.tau_slow.min(s.duration / 20.0).max(5.0 * s.dt);
-    out.push(one(Kind::InputDelay, 0.0, dmax, "delay"));
-    let mut h = one(Kind::InputSaturation, 0.2 * s.w_absmax, s.w_absmax, "limit");
-    h.starts = vec![vec![0.4], vec![0.7], vec![0.95]];
-    out.push(h);
+    out.push(level(Kind::InputDelay, dmax, "delay"));
+    let h = one(Kind::InputSaturation, 0.2 * s.w_absmax, s.w_absmax, "limit");
+    let wm = s.w_absmax;
+    out.push(h.starts_at(&[0.52 * wm, 0.76 * wm, 0.96 * wm, 0.99 * wm, 0.999 * wm]));
     let p = s.y_range.len();
     out.push(Hypothesis {
         kind: Kind::SensorOffset,

@@ -12,8 +12,14 @@
 //! 5. [`localise`]: residual energy per regime (reversals, contact, input extremes, high
 //!    acceleration) and the time windows where it concentrates.
 //! 6. [`hypothesis`] + [`fit`]: each effect of the physics library fitted by simulation-error
-//!    Levenberg-Marquardt with bounds and several starts; [`select`]: BIC with a margin plus
-//!    validation improvement, greedy forward selection of combinations.
+//!    Levenberg-Marquardt with bounds and starts over decades (stuck fits flagged, never
+//!    evidence against their effect); [`select`]: BIC with a margin (plus the remaining
+//!    discretisation error's worth) and blocked cross-validation over contiguous folds
+//!    ("not testable" where an effect lives in one fold), greedy forward selection.
+//!
+//! Before fitting: the input hold between samples (zero-/first-order, `auto` from the data)
+//! and the sub-steps per sample by convergence against the noise level ([`discretisation`]);
+//! the model file's initial state is used when it states one.
 //!
 //! [`bench_gen`] generates recordings with a concealed effect for the benchmark; no diagnosis
 //! module imports it (the benchmark runner [`bench`] joins the two).
@@ -22,6 +28,7 @@
 pub mod bench;
 pub mod bench_gen;
 pub mod diagnose;
+pub mod discretisation;
 pub mod error;
 pub mod fit;
 pub mod hypothesis;
@@ -34,6 +41,6 @@ pub mod select;
 /// The extended-model simulator lives in `dynamics` (one simulator for every command).
 pub use dynamics::extended as simulate;
 
-pub use diagnose::{diagnose, DiagnoseSettings, Report};
+pub use diagnose::{diagnose, DiagnoseSettings, HoldChoice, InitialState, Report};
 pub use error::DiscoveryError;
 pub use recording::Recording;

@@ -70,9 +70,12 @@ fn robonine_other_configurations_agree_with_the_authors() {
 /// voltage command below the supply, |theta| <= 0.49 rad), nominal model written from the
 /// upstream documentation (`examples/real/bam-xl330-kp100.toml`). What is asserted is what is
 /// stable across the two trajectories: the nominal model is rejected (residual not white),
-/// the same pair of effects is selected on both logs, it improves the validation fit by more
-/// than 15 points, and the fitted input-play widths agree within 0.1 rad. The width
-/// (~0.5 rad) is NOT a gear play: see data/bam-servo/SOURCE.md (stiction dead zone).
+/// input saturation is selected on both logs together with a stand-in for the controller's
+/// stiction, a play at the input or Coulomb friction (equivalent in a stiff position loop,
+/// issue 13 cause 6; on `sin_sin` the blocked cross-validation rejects the play, CV SSE ratio
+/// 1.35, and accepts friction, 0.86, their BIC 1.8 apart), the validation fit improves by more
+/// than 15 points, and where both logs pick the play its widths agree within 0.1 rad. The
+/// width (~0.5 rad) is NOT a gear play: see data/bam-servo/SOURCE.md (stiction dead zone).
 #[test]
 fn bam_xl330_kp100_diagnosis_is_stable() {
     let sys = model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/real/bam-xl330-kp100.toml"))
@@ -84,12 +87,19 @@ fn bam_xl330_kp100_diagnosis_is_stable() {
         eprintln!("{log}: {} (fit {:?} -> {:?})", r.verdict, r.fit_before.fit_percent, r.fit_after.fit_percent);
         assert!(!r.nominal_adequate);
         assert!(!r.residual_nominal.white);
-        let mut kinds: Vec<&str> = r.effects.iter().map(|e| e.label.as_str()).collect();
-        kinds.sort();
-        assert_eq!(kinds, ["backlash(input)", "input_saturation"], "{log}");
+        let kinds: Vec<&str> = r.effects.iter().map(|e| e.label.as_str()).collect();
+        assert_eq!(kinds.len(), 2, "{log}: {kinds:?}");
+        assert!(kinds.contains(&"input_saturation"), "{log}: {kinds:?}");
+        assert!(
+            kinds.contains(&"backlash(input)") || kinds.contains(&"coulomb_friction(x2)"),
+            "{log}: no stiction stand-in in {kinds:?}"
+        );
         assert!(r.fit_after.fit_percent[0].unwrap() > r.fit_before.fit_percent[0].unwrap() + 15.0);
-        let w = r.effects.iter().find(|e| e.label == "backlash(input)").unwrap().params[0].1;
-        widths.push(w);
+        if let Some(e) = r.effects.iter().find(|e| e.label == "backlash(input)") {
+            widths.push(e.params[0].1);
+        }
     }
-    assert!((widths[0] - widths[1]).abs() < 0.1, "{widths:?}");
+    if widths.len() == 2 {
+        assert!((widths[0] - widths[1]).abs() < 0.1, "{widths:?}");
+    }
 }

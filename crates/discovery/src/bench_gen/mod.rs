@@ -10,11 +10,22 @@
 //! - n = 3: the same driven through a first-order actuator lag, `x = (pos, vel, act)`;
 //! - n = 4: two masses coupled by a spring, `x = (pos1, vel1, pos2, vel2)`, output `pos1`.
 //!
-//! Natural frequency `omega0` in [1, 4] rad/s, damping ratio in [0.1, 0.7], input a multisine,
-//! low-pass filtered noise or a sequence of sine segments, 60 samples per natural period, at
-//! least 10 slowest time constants and 25 natural periods. The effect's magnitude is set by
-//! bisection so that the nominal model, simulated from the true initial state, fits the noisy
-//! recording to a target drawn from [86, 94] %; measurement noise at 30 dB SNR.
+//! Two profiles ([`Profile`]):
+//! - `classic` (the original benchmark): natural frequency `omega0` in [1, 4] rad/s, damping
+//!   ratio in [0.1, 0.7], 60 samples per natural period, the plant driven by the continuous
+//!   input signal (the recording samples it), white measurement noise;
+//! - `digital` (recordings of a digitally controlled machine): sample period log-uniform in
+//!   [1, 10] ms, 30-100 samples per natural period (so `omega0 = 2 pi / (N dt)`), half the
+//!   plants lightly damped (damping ratio in [0.03, 0.1]), the recorded command held constant
+//!   over each sample (zero-order hold) as the plant sees it, and the measurement noise white
+//!   or AR(1)-coloured (`rho` in [0.5, 0.9], half the cases each).
+//!
+//! Both: input a multisine, low-pass filtered noise or a sequence of sine segments, at least
+//! 10 slowest time constants and 25 natural periods (at most 80). The effect's magnitude is
+//! set by bisection so that the nominal model, simulated from the true initial state, fits
+//! the noisy recording to a target drawn from [86, 94] %; measurement noise at 30 dB SNR.
+//! The classic profile draws exactly the random numbers it always did (old seeds reproduce);
+//! the digital profile's extra draws come from a second stream.
 pub mod plant_sim;
 
 use crate::recording::Recording;
@@ -37,6 +48,57 @@ pub const CLASSES: [&str; 9] = [
     "input_saturation",
     "sensor_offset",
 ];
+
+/// Which kind of recording the generator makes (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Profile {
+    Classic,
+    Digital,
+}
+
+impl Profile {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Profile::Classic => "classic",
+            Profile::Digital => "digital",
+        }
+    }
+    /// From its name (`classic` or `digital`).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "classic" => Some(Profile::Classic),
+            "digital" => Some(Profile::Digital),
+            _ => None,
+        }
+    }
+}
+
+/// The sampling and noise conditions of one case (reported per case by the benchmark).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Conditions {
+    pub profile: Profile,
+    /// `continuous` (the plant sees the continuous signal) or `zoh` (held samples).
+    pub hold: &'static str,
+    /// Sample period (s).
+    pub dt: f64,
+    /// AR(1) coefficient of the measurement noise (0 = white).
+    pub noise_rho: f64,
+    pub omega0: f64,
+    pub zeta: f64,
+}
+
+impl Conditions {
+    pub fn short(&self) -> String {
+        format!(
+            "{} hold, dt {:.2} ms, noise {}, zeta {:.2}",
+            self.hold,
+            1e3 * self.dt,
+            if self.noise_rho > 0.0 { format!("AR(1) {:.2}", self.noise_rho) } else { "white".into() },
+            self.zeta
+        )
+    }
+}
 
 /// The continuous input signal of a case.
 #[derive(Debug, Clone)]
@@ -84,6 +146,7 @@ pub struct Case {
     /// Fit % of the nominal model (true initial state) on the noisy recording.
     pub nominal_fit: f64,
     pub description: String,
+    pub conditions: Conditions,
 }
 
 /// The true plant in physical form.
@@ -100,9 +163,12 @@ pub struct Plant {
     pub zeta: f64,
 }
 
-fn random_plant(rng: &mut ChaCha8Rng, n: usize) -> Plant {
+/// A random plant; `over = Some((omega0, zeta))` replaces the drawn natural frequency and
+/// damping (the draws are still made, so the stream is the same).
+fn random_plant(rng: &mut ChaCha8Rng, n: usize, over: Option<(f64, f64)>) -> Plant {
     let w0: f64 = rng.random_range(1.0..4.0);
     let zeta: f64 = rng.random_range(0.1..0.7);
+    let (w0, zeta) = over.unwrap_or((w0, zeta));
     let k = w0 * w0;
     let c = 2.0 * zeta * w0;
     let kappa: f64 = rng.random_range(0.2..0.6);
@@ -195,21 +261,40 @@ fn fit_percent(a: &[f64], b: &[f64]) -> f64 {
     100.0 * (1.0 - num / den)
 }
 
-/// Generates case number `index` of `class` from `seed`.
+/// Generates case number `index` of `class` from `seed` (classic profile).
 pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
-    let mut rng = ChaCha8Rng::seed_from_u64(
-        seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1))
-            ^ (CLASSES.iter().position(|c| *c == class).unwrap_or(0) as u64) << 40,
-    );
+    generate_profile(class, seed, index, Profile::Classic)
+}
+
+/// Generates case number `index` of `class` from `seed` in `profile`.
+pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
+    let mix = seed
+        ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1))
+        ^ (CLASSES.iter().position(|c| *c == class).unwrap_or(0) as u64) << 40;
+    let mut rng = ChaCha8Rng::seed_from_u64(mix);
+    // The digital profile's own draws (a second stream: the classic stream is untouched).
+    let mut rd = ChaCha8Rng::seed_from_u64(mix ^ 0xD161_7A1D_0000_0001);
+    let digital = profile == Profile::Digital;
+    let (dig_dt, over, noise_rho): (Option<f64>, Option<(f64, f64)>, f64) = if digital {
+        let dt = (rd.random_range(1e-3f64.ln()..1e-2f64.ln())).exp();
+        let spp: f64 = rd.random_range(30.0..100.0);
+        let light = rd.random::<bool>();
+        let zeta = if light { rd.random_range(0.03..0.1) } else { rd.random_range(0.1..0.7) };
+        let rho = if rd.random::<bool>() { rd.random_range(0.5..0.9) } else { 0.0 };
+        (Some(dt), Some((TAU / (spp * dt), zeta)), rho)
+    } else {
+        (None, None, 0.0)
+    };
     let n = rng.random_range(2..=4);
-    let plant = random_plant(&mut rng, n);
+    let plant = random_plant(&mut rng, n, over);
     let tau_slow = {
         let F = &plant.A + &plant.E * &plant.C;
         let mu = F.complex_eigenvalues().iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max);
         1.0 / mu.abs()
     };
     let period = TAU / plant.omega0;
-    let dt = period / 60.0;
+    let dt = dig_dt.unwrap_or(period / 60.0);
+    let zoh = digital;
     let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period);
     let ns = (duration / dt) as usize + 1;
     let (signal, sig_name) = random_signal(&mut rng, plant.omega0, duration);
@@ -228,15 +313,28 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
     let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
     let target: f64 = rng.random_range(86.0..94.0);
     let hw_nom = if nominal_has_play { plant.half_width } else { 0.0 };
-    let clean_nom = plant_sim::simulate(&plant, hw_nom, None, &signal, &x0, dt, ns);
+    let clean_nom = plant_sim::simulate(&plant, hw_nom, None, &signal, &x0, dt, ns, zoh);
     let ystd = {
         let m = clean_nom.iter().sum::<f64>() / ns as f64;
         (clean_nom.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ns as f64).sqrt()
     };
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
-    let noise: Vec<f64> = (0..ns).map(|_| gauss(&mut rng) * noise_std).collect();
+    let mut noise: Vec<f64> = (0..ns).map(|_| gauss(&mut rng) * noise_std).collect();
+    if noise_rho > 0.0 {
+        // AR(1) with the same stationary variance: e_k = rho e_{k-1} + sqrt(1 - rho^2) v_k.
+        let c = (1.0 - noise_rho * noise_rho).sqrt();
+        let mut e = noise[0];
+        for v in noise.iter_mut().skip(1) {
+            e = noise_rho * e + c * *v;
+            *v = e;
+        }
+    }
     let measure = |eff: Option<&Effect>| -> Vec<f64> {
-        plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns).iter().zip(&noise).map(|(a, b)| a + b).collect()
+        plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns, zoh)
+            .iter()
+            .zip(&noise)
+            .map(|(a, b)| a + b)
+            .collect()
     };
     let fit_at = |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel).as_ref()), &clean_nom);
     let truth_a = if class == "none" {
@@ -298,11 +396,21 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
         y.iter().map(|v| vec![*v]).collect(),
         None,
     );
+    let conditions = Conditions {
+        profile,
+        hold: if zoh { "zoh" } else { "continuous" },
+        dt,
+        noise_rho,
+        omega0: plant.omega0,
+        zeta: plant.zeta,
+    };
     let description = format!(
-        "n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, nominal fit {nominal_fit:.1} %",
-        plant.omega0, plant.zeta
+        "n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, {}, nominal fit {nominal_fit:.1} %",
+        plant.omega0,
+        plant.zeta,
+        conditions.short()
     );
-    Case { class, nominal, truth, recording, nominal_fit, description }
+    Case { class, nominal, truth, recording, nominal_fit, description, conditions }
 }
 
 /// A standard normal sample (Box-Muller).

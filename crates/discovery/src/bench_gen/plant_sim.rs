@@ -2,15 +2,27 @@
 //! (RK2) on a grid 20 times finer than the samples, forces and the play held over each fine
 //! step, Coulomb friction by a semi-implicit velocity update (stick when the friction-free
 //! velocity change cannot reverse the sign), backlash inertia by semi-implicit Euler, input
-//! effects on the continuous signal.
+//! effects on the continuous signal or on its zero-order-held samples.
 use super::{Plant, Signal};
 use model::effects::{Effect, PlayLocation};
 
 const FINE: usize = 20;
 
 /// Simulates the plant (play half-width `hw`, 0 = none) with at most one effect and returns
-/// `y` at the `ns` sample times `k dt`.
-pub fn simulate(pl: &Plant, hw: f64, eff: Option<&Effect>, sig: &Signal, x0: &[f64], dt: f64, ns: usize) -> Vec<f64> {
+/// `y` at the `ns` sample times `k dt`. With `zoh`, the plant sees the input sampled at `k dt`
+/// and held constant until the next sample (a digital controller's command), delayed as a
+/// whole by an `input_delay`; otherwise it sees the continuous signal.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    pl: &Plant,
+    hw: f64,
+    eff: Option<&Effect>,
+    sig: &Signal,
+    x0: &[f64],
+    dt: f64,
+    ns: usize,
+    zoh: bool,
+) -> Vec<f64> {
     let n = pl.A.nrows();
     let h = dt / FINE as f64;
     let mut hw = hw;
@@ -26,7 +38,13 @@ pub fn simulate(pl: &Plant, hw: f64, eff: Option<&Effect>, sig: &Signal, x0: &[f
         Some(Effect::SensorOffset { offset: o }) => offset = o[0],
         _ => {}
     }
-    let input = |t: f64| sig.eval(t - delay).clamp(-sat, sat);
+    let input = |t: f64| {
+        let s = t - delay;
+        // Held: the sample at or before `s` (a hair of tolerance so that the fine grid's
+        // sample instants, which are exact multiples up to rounding, pick their own sample).
+        let s = if zoh { dt * (s / dt + 1e-9).floor() } else { s };
+        sig.eval(s).clamp(-sat, sat)
+    };
     let cy = |x: &[f64]| (0..n).map(|j| pl.C[(0, j)] * x[j]).sum::<f64>();
     let deriv = |x: &[f64], w: f64, z: f64, out: &mut [f64]| {
         for i in 0..n {
@@ -39,13 +57,13 @@ pub fn simulate(pl: &Plant, hw: f64, eff: Option<&Effect>, sig: &Signal, x0: &[f
     let mut vz = 0.0;
     let (mut k1, mut xm, mut k2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut out = Vec::with_capacity(ns);
-    let mut t = 0.0;
     for k in 0..ns {
         out.push(cy(&x) + offset);
         if k + 1 == ns {
             break;
         }
-        for _ in 0..FINE {
+        for jf in 0..FINE {
+            let t = k as f64 * dt + jf as f64 * h;
             deriv(&x, input(t), z, &mut k1);
             for i in 0..n {
                 xm[i] = x[i] + 0.5 * h * k1[i];
@@ -81,7 +99,6 @@ pub fn simulate(pl: &Plant, hw: f64, eff: Option<&Effect>, sig: &Signal, x0: &[f
             } else {
                 z = y;
             }
-            t += h;
         }
     }
     out

@@ -41,6 +41,20 @@ pub enum FitStatus {
     MaxIterations,
     /// Every start produced a diverging simulation.
     Failed,
+    /// An effect parameter has no influence on the residual at the solution (e.g. friction
+    /// that holds the mass stuck for the whole record, a saturation limit above every input):
+    /// the fit is stuck, not evidence against the effect.
+    ZeroGradient,
+    /// An effect parameter ended on its upper bound (clipped): the optimum may lie beyond.
+    AtBound,
+}
+
+impl FitStatus {
+    /// Whether the fit can count as evidence against its effect (it converged inside its
+    /// box with a non-zero gradient).
+    pub fn conclusive(&self) -> bool {
+        matches!(self, FitStatus::Converged | FitStatus::MaxIterations)
+    }
 }
 
 /// Result of a fit.
@@ -61,14 +75,20 @@ pub struct FitResult {
 
 struct Vars<'p, 'a> {
     pb: &'p Problem<'a>,
+    /// Scales of the free initial state (empty: the initial state is fixed at `x0_fixed`).
     xs: Vec<f64>,
+    x0_fixed: Vec<f64>,
     k: usize,
 }
 
 impl Vars<'_, '_> {
     fn split(&self, v: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let theta = self.pb.params_at(&v[..self.k]);
-        let x0 = (0..self.xs.len()).map(|i| v[self.k + i] * self.xs[i]).collect();
+        let x0 = if self.xs.is_empty() {
+            self.x0_fixed.clone()
+        } else {
+            (0..self.xs.len()).map(|i| v[self.k + i] * self.xs[i]).collect()
+        };
         (theta, x0)
     }
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
@@ -230,15 +250,40 @@ fn lm(
 }
 
 /// Fits `pb` from the starts of its parts (the cartesian product is avoided: start `i` of
-/// every part together) and initial state `x0_init`; `x_scale` scales the initial state.
+/// every part together) and initial state `x0_init`; `x_scale` scales the initial state, and
+/// an empty `x_scale` holds the initial state fixed at `x0_init` (known from the model file).
+///
+/// With more than [`SCREENED_STARTS`] starts (decades of a level-like parameter), every start
+/// is first evaluated once and only the best [`SCREENED_STARTS`] are iterated.
 pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>, s: &FitSettings) -> FitResult {
     let lo = pb.lower();
     let k = lo.len();
     let xs: Vec<f64> = x_scale.iter().map(|v| v.max(1e-9)).collect();
-    let vars = Vars { pb, xs: xs.clone(), k };
+    let vars = Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k };
     let mut evals = 0;
-    let x0v: Vec<f64> = x0_init.iter().zip(&xs).map(|(a, b)| a / b).collect();
-    let nstart = pb.parts.iter().map(|h| h.starts.len()).max().unwrap_or(1).max(1);
+    if k == 0 && xs.is_empty() {
+        // Nothing to fit: the nominal model from a known initial state.
+        let r = vars.res(&[], &mut evals);
+        let (cost, n_res, status) = match &r {
+            Some(r) => (sse(r), r.len(), FitStatus::Converged),
+            None => (f64::INFINITY, 0, FitStatus::Failed),
+        };
+        return FitResult {
+            theta: vec![],
+            std: vec![],
+            x0: x0_init.to_vec(),
+            sse: cost,
+            n_res,
+            status,
+            evaluations: evals,
+        };
+    }
+    let x0v: Vec<f64> = if xs.is_empty() { vec![] } else { x0_init.iter().zip(&xs).map(|(a, b)| a / b).collect() };
+    let nstart = if warm.is_some_and(|w| w.len() >= k) {
+        1
+    } else {
+        pb.parts.iter().map(|h| h.starts.len()).max().unwrap_or(1).max(1)
+    };
     let mut starts: Vec<Vec<f64>> = Vec::new();
     if let Some(w) = warm {
         // Warm start: the given leading parameters, then the new part's starts.
@@ -261,6 +306,12 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
             v.extend(x0v.iter());
             starts.push(v);
         }
+    }
+    if starts.len() > SCREENED_STARTS {
+        let mut scored: Vec<(f64, Vec<f64>)> =
+            starts.into_iter().map(|v| (vars.res(&v, &mut evals).map_or(f64::INFINITY, |r| sse(&r)), v)).collect();
+        scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+        starts = scored.into_iter().take(SCREENED_STARTS).map(|(_, v)| v).collect();
     }
     let mut best: Option<(Vec<f64>, Vec<f64>, f64, bool)> = None;
     for v in starts {
@@ -299,16 +350,23 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         None => vec![f64::NAN; k],
     };
     let (theta, x0) = vars.split(&v);
-    FitResult {
-        theta,
-        std,
-        x0,
-        sse: cost,
-        n_res: nres,
-        status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations },
-        evaluations: evals,
-    }
+    // Stuck fits: a parameter without influence, or one clipped at its upper bound.
+    let col_norm = |c: usize| J.column(c).norm();
+    let scale = (0..v.len()).map(col_norm).fold(0.0, f64::max);
+    let status = if (0..k).any(|c| col_norm(c) <= 1e-9 * scale.max(1e-300) || col_norm(c) == 0.0) {
+        FitStatus::ZeroGradient
+    } else if (0..k).any(|c| v[c] >= 1.0 - 1e-9) {
+        FitStatus::AtBound
+    } else if conv {
+        FitStatus::Converged
+    } else {
+        FitStatus::MaxIterations
+    };
+    FitResult { theta, std, x0, sse: cost, n_res: nres, status, evaluations: evals }
 }
+
+/// Starts iterated after screening (see [`fit`]).
+pub const SCREENED_STARTS: usize = 3;
 
 #[cfg(test)]
 mod tests {

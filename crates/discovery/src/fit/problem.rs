@@ -2,9 +2,11 @@
 //!
 //! Unknowns: effect parameters `theta` in a box and the initial state `x0`. Residual on the
 //! estimation segment `k < k_est`: `r_{k,i} = (yhat_{k,i}(theta, x0) - y_{k,i}) / sigma_i`
-//! with `sigma_i` the standard deviation of output `i`, so outputs weigh alike.
+//! with `sigma_i` the standard deviation of output `i`, so outputs weigh alike. A held-out
+//! block `exclude = [b0, b1)` (blocked cross-validation) is left out of the residual; the
+//! simulation still runs through it (the input there is known, the output is not used).
 use crate::hypothesis::{Hypothesis, Scales};
-use crate::simulate::{ExtendedModel, SimOutput, StepMaps};
+use crate::simulate::{ExtendedModel, InputHold, SimOutput, StepMaps};
 use model::effects::Effect;
 use model::System;
 
@@ -26,6 +28,12 @@ pub struct Problem<'a> {
     pub weights: Vec<f64>,
     pub maps: StepMaps,
     pub substeps: usize,
+    /// Input between samples.
+    pub hold: InputHold,
+    /// Backlash output at the start (`None`: at rest in the play, `z0 = C x0`).
+    pub z0: Option<Vec<f64>>,
+    /// Samples `[b0, b1)` left out of the residual (a held-out fold).
+    pub exclude: Option<(usize, usize)>,
 }
 
 impl<'a> Problem<'a> {
@@ -92,15 +100,23 @@ impl<'a> Problem<'a> {
     }
     /// Simulates with `theta`, `x0` over the first `len` samples (`None`: the whole record).
     pub fn simulate(&self, theta: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
-        let ext = ExtendedModel::from_maps(self.sys, &self.effects(theta), self.maps.clone(), self.substeps).ok()?;
+        let ext = ExtendedModel::from_maps(self.sys, &self.effects(theta), self.maps.clone(), self.substeps)
+            .ok()?
+            .with_hold(self.hold);
         let len = len.unwrap_or(self.w.len() / self.m);
-        let out = ext.simulate(&self.w[..len * self.m], self.dt, x0);
+        let out = ext.simulate_from(&self.w[..len * self.m], self.dt, x0, self.z0.as_deref());
         out.finite.then_some(out)
     }
-    /// Weighted residual on the estimation segment (None if the simulation blew up).
+    /// Weighted residual on the estimation samples (None if the simulation blew up).
     pub fn residual(&self, theta: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
         let out = self.simulate(theta, x0, Some(self.k_est))?;
         let p = self.p;
-        Some((0..self.k_est * p).map(|idx| (out.y[idx] - self.y[idx]) * self.weights[idx % p]).collect())
+        let (b0, b1) = self.exclude.unwrap_or((0, 0));
+        Some(
+            (0..self.k_est * p)
+                .filter(|idx| !(b0 * p..b1 * p).contains(idx))
+                .map(|idx| (out.y[idx] - self.y[idx]) * self.weights[idx % p])
+                .collect(),
+        )
     }
 }

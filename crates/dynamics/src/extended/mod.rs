@@ -15,5 +15,7 @@
 pub mod model;
 pub mod step_maps;
 
-pub use model::{regime_by_simulation, simulate_trajectory, theta_is_point, ExtendedModel, SimOutput, SimulatedRegime};
+pub use model::{
+    regime_by_simulation, simulate_trajectory, theta_is_point, ExtendedModel, InputHold, SimOutput, SimulatedRegime,
+};
 pub use step_maps::StepMaps;

@@ -55,6 +55,9 @@ pub struct ExtendedModel {
     delay: f64,
     saturation: Option<f64>,
     offset: Vec<f64>,
+    hold: InputHold,
+    /// Set when an input delay puts the input's breakpoints inside a sub-step.
+    split: Option<Split>,
 }
 
 /// Result of a simulation on the sample grid.
@@ -119,6 +122,8 @@ impl ExtendedModel {
             delay: 0.0,
             saturation: None,
             offset: vec![0.0; p],
+            hold: InputHold::Foh,
+            split: None,
         };
         for e in sys.effects.list.iter().chain(extra) {
             match e {
@@ -209,7 +214,35 @@ impl ExtendedModel {
                 Play::Scaled { shape: shape.clone(), s: scale }
             }
         };
+        if me.delay > 0.0 {
+            // Breakpoints of the delayed input at t_k + delay: fraction `phi` of a sample
+            // interval, in sub-step `s` at fraction `at` of it.
+            let h = me.maps.h;
+            let sub = me.substeps as f64;
+            let pos = (me.delay / (h * sub)).fract() * sub;
+            let (si, at) = (pos.floor(), pos - pos.floor());
+            if at > 1e-9 && at < 1.0 - 1e-9 {
+                let F = sys.F();
+                me.split = Some(Split {
+                    substep: (si as usize).min(me.substeps - 1),
+                    at,
+                    first: StepMaps::new(&F, &sys.B, &sys.E, at * h),
+                    second: StepMaps::new(&F, &sys.B, &sys.E, (1.0 - at) * h),
+                });
+            }
+        }
         Ok(me)
+    }
+
+    /// The same model with input hold `hold` between samples (default: first-order hold).
+    pub fn with_hold(mut self, hold: InputHold) -> Self {
+        self.hold = hold;
+        self
+    }
+
+    /// The input hold between samples.
+    pub fn hold(&self) -> InputHold {
+        self.hold
     }
 
     /// Whether the model has a play in the loop.
@@ -218,7 +251,8 @@ impl ExtendedModel {
     }
 
     /// The effective input `w_eff` on the sample grid (flat, `k * m + j`), from the measured
-    /// `w` (flat): delay (linear interpolation, first value held before the start), saturation,
+    /// `w` (flat), with linear interpolation for the delay (for figures and checks; the
+    /// simulator evaluates the input between samples itself, by the model's hold): delay (linear interpolation, first value held before the start), saturation,
     /// input play (play operator started centred).
     pub fn effective_input(&self, w: &[f64], dt: f64) -> Vec<f64> {
         let m = self.m;
@@ -312,11 +346,16 @@ impl ExtendedModel {
 
     /// As [`ExtendedModel::simulate`] from `(x0, z0)`; `z0 = None` starts at rest in the play
     /// (`z0 = C x0`). `z0 - C x0` is taken as it is (it should lie in the play's set).
+    ///
+    /// Between samples the input follows the model's [`InputHold`]: linear interpolation of
+    /// the samples (first-order hold, the default) or the sample held until the next one
+    /// (zero-order hold). Either is integrated exactly by the linear step maps: an input delay
+    /// moves the input's breakpoints to `t_k + delay`, and the sub-step that contains one is
+    /// split there (two extra step maps, computed once per model). Saturation and a play at
+    /// the input act on the held samples exactly (ZOH) or on the sub-step knots (FOH).
     pub fn simulate_from(&self, w: &[f64], dt: f64, x0: &[f64], z0: Option<&[f64]>) -> SimOutput {
         let (n, m, p) = (self.n, self.m, self.p);
         let ns = w.len() / m;
-        let weff = self.effective_input(w, dt);
-        let mp = &self.maps;
         let mut x = x0.to_vec();
         let mut xn = vec![0.0; n];
         let mut q = vec![0.0; p];
@@ -347,21 +386,72 @@ impl ExtendedModel {
                 q[i] = z[i] - y[i];
             }
         }
+        if ns == 0 {
+            return out;
+        }
         let sub = self.substeps;
-        let h = mp.h;
-        let decay =
-            if self.inertia_tau > 0.0 && self.inertia_tau.is_finite() { (-h / self.inertia_tau).exp() } else { 1.0 };
-        let coast = if self.inertia_tau > 0.0 {
-            if self.inertia_tau.is_finite() {
-                self.inertia_tau * (1.0 - decay)
-            } else {
-                h
+        let main = Piece::new(&self.maps, &self.force, self.inertia_tau);
+        let split = self.split.as_ref().map(|sp| {
+            (
+                sp.substep,
+                sp.at,
+                Piece::new(&sp.first, &self.force, self.inertia_tau),
+                Piece::new(&sp.second, &self.force, self.inertia_tau),
+            )
+        });
+        let shift = self.delay / dt;
+        // Zero-order hold: saturation and input play act on the held samples exactly.
+        let held: Vec<f64> = match self.hold {
+            InputHold::Zoh => {
+                let mut hv = w.to_vec();
+                if let Some(l) = self.saturation {
+                    hv.iter_mut().for_each(|v| *v = v.clamp(-l, l));
+                }
+                if let Some(width) = self.input_play {
+                    let r = 0.5 * width;
+                    let mut u: Vec<f64> = hv[..m].to_vec();
+                    for k in 0..ns {
+                        for j in 0..m {
+                            u[j] = u[j].clamp(hv[k * m + j] - r, hv[k * m + j] + r);
+                            hv[k * m + j] = u[j];
+                        }
+                    }
+                }
+                hv
             }
-        } else {
-            0.0
+            InputHold::Foh => Vec::new(),
         };
-        // Constant-force contribution per substep: Psi b.
-        let fb: Vec<f64> = (0..n).map(|i| (0..n).map(|j| mp.Psi[i * n + j] * self.force[j]).sum()).collect();
+        // First-order hold: the delayed, interpolated input at sample time `tau` (in samples),
+        // saturated and passed through the input play (state `uplay`).
+        let foh_at = |tau: f64, uplay: &mut [f64], outv: &mut [f64]| {
+            for j in 0..m {
+                let raw = if tau <= 0.0 {
+                    w[j]
+                } else {
+                    let i = tau.floor() as usize;
+                    if i + 1 >= ns {
+                        w[(ns - 1) * m + j]
+                    } else {
+                        let a = tau - i as f64;
+                        w[i * m + j] * (1.0 - a) + w[(i + 1) * m + j] * a
+                    }
+                };
+                let mut u = match self.saturation {
+                    Some(l) => raw.clamp(-l, l),
+                    None => raw,
+                };
+                if let Some(width) = self.input_play {
+                    let r = 0.5 * width;
+                    uplay[j] = uplay[j].clamp(u - r, u + r);
+                    u = uplay[j];
+                }
+                outv[j] = u;
+            }
+        };
+        let mut uplay: Vec<f64> = (0..m).map(|j| self.saturation.map_or(w[j], |l| w[j].clamp(-l, l))).collect();
+        let mut ucur = vec![0.0; m];
+        foh_at(-shift, &mut uplay, &mut ucur);
+        let mut unext = vec![0.0; m];
         let mut w0 = vec![0.0; m];
         let mut dw = vec![0.0; m];
         for k in 0..ns {
@@ -377,61 +467,88 @@ impl ExtendedModel {
                 break;
             }
             for s in 0..sub {
-                let a0 = s as f64 / sub as f64;
-                for j in 0..m {
-                    let (wa, wb) = (weff[k * m + j], weff[(k + 1) * m + j]);
-                    w0[j] = wa + (wb - wa) * a0;
-                    dw[j] = (wb - wa) / sub as f64;
-                }
-                for i in 0..n {
-                    let mut acc = 0.0;
-                    for j in 0..n {
-                        acc += mp.Phi[i * n + j] * x[j];
+                let f0 = s as f64 / sub as f64;
+                let f1 = (s + 1) as f64 / sub as f64;
+                let pieces: [(f64, f64, &Piece); 2];
+                let np = match &split {
+                    Some((ss, at, a, b)) if *ss == s => {
+                        let fm = f0 + at / sub as f64;
+                        pieces = [(f0, fm, a), (fm, f1, b)];
+                        2
                     }
-                    for j in 0..m {
-                        acc += mp.PsiB[i * m + j] * w0[j] + mp.Psi1B[i * m + j] * dw[j];
+                    _ => {
+                        pieces = [(f0, f1, &main), (f1, f1, &main)];
+                        1
                     }
-                    for j in 0..p {
-                        acc += mp.PsiE[i * p + j] * q[j];
-                    }
-                    if self.has_force {
-                        acc += fb[i];
-                    }
-                    xn[i] = acc;
-                }
-                for &(j, level) in &self.coulomb {
-                    let a = xn[j];
-                    let g = mp.Psi[j * n + j];
-                    let f = if a.abs() <= level * g { -a / g } else { -level * a.signum() };
-                    for i in 0..n {
-                        xn[i] += mp.Psi[i * n + j] * f;
-                    }
-                }
-                std::mem::swap(&mut x, &mut xn);
-                cx(&x, &mut y);
-                if has_play {
-                    // z_pred: massless output stays; with inertia it coasts.
-                    for i in 0..p {
-                        scratch[i] = z[i] + v[i] * coast;
-                        q[i] = scratch[i] - y[i];
-                    }
-                    // The deviation before projection: the contact is decided on `q` itself
-                    // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
-                    // a contact and slow the coasting decay spuriously).
-                    qp.copy_from_slice(&q);
-                    let hit = self.project_q(&mut q, &mut scratch);
-                    for i in 0..p {
-                        let znew = y[i] + q[i];
-                        if self.inertia_tau > 0.0 {
-                            v[i] = if q[i] != qp[i] { (znew - z[i]) / h } else { v[i] * decay };
+                };
+                for (pi, &(fa, fb, pc)) in pieces[..np].iter().enumerate() {
+                    match self.hold {
+                        InputHold::Zoh => {
+                            let tau = k as f64 + 0.5 * (fa + fb) - shift;
+                            let idx = if tau <= 0.0 { 0 } else { (tau.floor() as usize).min(ns - 1) };
+                            w0.copy_from_slice(&held[idx * m..(idx + 1) * m]);
+                            dw.iter_mut().for_each(|d| *d = 0.0);
                         }
-                        z[i] = znew;
+                        InputHold::Foh => {
+                            foh_at(k as f64 + fb - shift, &mut uplay, &mut unext);
+                            for j in 0..m {
+                                w0[j] = ucur[j];
+                                dw[j] = unext[j] - ucur[j];
+                            }
+                            ucur.copy_from_slice(&unext);
+                        }
                     }
-                    if s + 1 == sub {
-                        out.contact[k + 1] = hit;
+                    let mp = pc.maps;
+                    for i in 0..n {
+                        let mut acc = 0.0;
+                        for j in 0..n {
+                            acc += mp.Phi[i * n + j] * x[j];
+                        }
+                        for j in 0..m {
+                            acc += mp.PsiB[i * m + j] * w0[j] + mp.Psi1B[i * m + j] * dw[j];
+                        }
+                        for j in 0..p {
+                            acc += mp.PsiE[i * p + j] * q[j];
+                        }
+                        if self.has_force {
+                            acc += pc.fb[i];
+                        }
+                        xn[i] = acc;
                     }
-                } else {
-                    z.copy_from_slice(&y);
+                    for &(j, level) in &self.coulomb {
+                        let a = xn[j];
+                        let g = mp.Psi[j * n + j];
+                        let f = if a.abs() <= level * g { -a / g } else { -level * a.signum() };
+                        for i in 0..n {
+                            xn[i] += mp.Psi[i * n + j] * f;
+                        }
+                    }
+                    std::mem::swap(&mut x, &mut xn);
+                    cx(&x, &mut y);
+                    if has_play {
+                        // z_pred: massless output stays; with inertia it coasts.
+                        for i in 0..p {
+                            scratch[i] = z[i] + v[i] * pc.coast;
+                            q[i] = scratch[i] - y[i];
+                        }
+                        // The deviation before projection: the contact is decided on `q` itself
+                        // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
+                        // a contact and slow the coasting decay spuriously).
+                        qp.copy_from_slice(&q);
+                        let hit = self.project_q(&mut q, &mut scratch);
+                        for i in 0..p {
+                            let znew = y[i] + q[i];
+                            if self.inertia_tau > 0.0 {
+                                v[i] = if q[i] != qp[i] { (znew - z[i]) / mp.h } else { v[i] * pc.decay };
+                            }
+                            z[i] = znew;
+                        }
+                        if s + 1 == sub && pi + 1 == np {
+                            out.contact[k + 1] = hit;
+                        }
+                    } else {
+                        z.copy_from_slice(&y);
+                    }
                 }
             }
             if !x.iter().all(|v| v.is_finite()) {
@@ -446,6 +563,63 @@ impl ExtendedModel {
         }
         out.x_rms.iter_mut().for_each(|v| *v = (*v / ns as f64).sqrt());
         out
+    }
+}
+
+/// How the recorded input behaves between its samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InputHold {
+    /// Linear interpolation between samples (first-order hold).
+    #[default]
+    Foh,
+    /// Each sample held until the next (zero-order hold, a digital controller's command).
+    Zoh,
+}
+
+impl InputHold {
+    pub fn name(&self) -> &'static str {
+        match self {
+            InputHold::Foh => "foh",
+            InputHold::Zoh => "zoh",
+        }
+    }
+}
+
+/// The sub-step of every sample interval that contains the delayed input's breakpoint
+/// `t_k + delay`, split there: `first` covers `at h`, `second` `(1 - at) h`.
+#[derive(Debug, Clone)]
+struct Split {
+    substep: usize,
+    at: f64,
+    first: StepMaps,
+    second: StepMaps,
+}
+
+/// Per-step constants of one step length.
+struct Piece<'a> {
+    maps: &'a StepMaps,
+    /// `Psi b` (constant force).
+    fb: Vec<f64>,
+    decay: f64,
+    coast: f64,
+}
+
+impl<'a> Piece<'a> {
+    fn new(maps: &'a StepMaps, force: &[f64], inertia_tau: f64) -> Self {
+        let n = maps.n;
+        let h = maps.h;
+        let decay = if inertia_tau > 0.0 && inertia_tau.is_finite() { (-h / inertia_tau).exp() } else { 1.0 };
+        let coast = if inertia_tau > 0.0 {
+            if inertia_tau.is_finite() {
+                inertia_tau * (1.0 - decay)
+            } else {
+                h
+            }
+        } else {
+            0.0
+        };
+        let fb = (0..n).map(|i| (0..n).map(|j| maps.Psi[i * n + j] * force[j]).sum()).collect();
+        Self { maps, fb, decay, coast }
     }
 }
 

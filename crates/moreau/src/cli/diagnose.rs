@@ -26,6 +26,36 @@ pub struct Args {
     /// Greatest number of effects added by forward selection.
     #[arg(long, default_value_t = 2)]
     pub max_effects: usize,
+    /// Input between samples: `zoh` (each sample held until the next, as a digital
+    /// controller's command), `foh` (linear interpolation) or `auto` (the hold under which the
+    /// nominal model fits better; the report says which and by how much).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "zoh", "foh"])]
+    pub input_hold: String,
+    /// Estimate the initial state even when the model file states `[initial] x0` (by default
+    /// a stated x0, and z0, is used as known).
+    #[arg(long)]
+    pub estimate_x0: bool,
+}
+
+/// The initial state the model file states (`[initial] x0`, optional `z0`), if any.
+fn stated_initial_state(
+    path: &std::path::Path,
+    sys: &model::System,
+) -> anyhow::Result<Option<discovery::InitialState>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("model {}", path.display()))?;
+    let root: toml::Table = match toml::from_str(&text) {
+        Ok(t) => t,
+        Err(_) => return Ok(None), // model::load accepted it; nothing more to learn here
+    };
+    let init = root.get("initial").and_then(|v| v.as_table());
+    let has = |k: &str| init.is_some_and(|t| t.contains_key(k));
+    if !has("x0") {
+        return Ok(None);
+    }
+    Ok(Some(discovery::InitialState {
+        x0: sys.x0.iter().copied().collect(),
+        z0: has("z0").then(|| sys.z0.iter().copied().collect()),
+    }))
 }
 
 /// At most `max` evenly spaced points of a series (for figures of long records).
@@ -108,10 +138,14 @@ pub fn write_outputs(r: &Report, out: &std::path::Path) -> anyhow::Result<()> {
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let sys = model::load(&a.model).with_context(|| format!("model {}", a.model.display()))?;
-    let rec = Recording::load(&a.data)?;
+    let text = crate::csv_check::read_checked(&a.data, "recording", crate::csv_check::TimeColumn::Numeric("t"))?;
+    let rec = Recording::parse_str(&text, &a.data.display().to_string())?;
     let settings = DiagnoseSettings {
         estimation_fraction: a.estimation_fraction,
         max_effects: a.max_effects,
+        input_hold: discovery::HoldChoice::parse(&a.input_hold).unwrap_or_default(),
+        initial_state: stated_initial_state(&a.model, &sys)?,
+        estimate_x0: a.estimate_x0,
         ..Default::default()
     };
     let start = std::time::Instant::now();
@@ -119,6 +153,18 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let secs = start.elapsed().as_secs_f64();
     write_outputs(&r, &a.out)?;
     println!("{}", r.verdict);
+    println!(
+        "input hold {}{}; {} sub-step(s) per sample (remaining discretisation error {:.2e} output standard deviations; noise level {}); initial state {}",
+        r.hold.chosen,
+        match (r.hold.requested, r.hold.delta_bic) {
+            (discovery::HoldChoice::Auto, Some(d)) => format!(" (auto: better by {d:.1} in BIC{})", if r.hold.decisive { "" } else { ", not decisive" }),
+            _ => " (as requested)".to_string(),
+        },
+        r.substeps,
+        r.discretisation.error_rms,
+        r.noise_level.iter().map(|v| format!("{v:.2e}")).collect::<Vec<_>>().join(", "),
+        r.initial_state.source
+    );
     let pct = |v: &[Option<f64>]| {
         v.iter().map(|x| x.map_or("undefined".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
     };

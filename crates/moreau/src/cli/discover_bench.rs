@@ -1,6 +1,7 @@
 //! `moreau discover-bench --cases N --seed S`: the concealed-effect benchmark of `discovery`
 //! (N cases of each of the 9 classes: none and the 8 effects), printing the confusion matrix,
-//! the false-alarm rate on `none` and the parameter errors.
+//! the false-alarm rate on `none` and the parameter errors. `--profile digital` generates
+//! zero-order-held inputs, 1-10 ms sampling, white or AR(1) noise and lightly damped plants.
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -13,6 +14,14 @@ pub struct Args {
     /// Seed of the generator.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Generator profile: `classic` (continuous inputs, white noise, 60 samples per natural
+    /// period) or `digital` (zero-order-held inputs, sample periods 1-10 ms, white or
+    /// AR(1)-coloured noise, half the plants lightly damped).
+    #[arg(long, default_value = "classic", value_parser = ["classic", "digital"])]
+    pub profile: String,
+    /// Estimate the initial state although each case's model states the true one.
+    #[arg(long)]
+    pub estimate_x0: bool,
     /// Also write every case's result as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -26,11 +35,20 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if a.cases == 0 {
         anyhow::bail!("--cases must be at least 1 (got 0)");
     }
+    // each case simulates and fits several hypotheses (seconds); the results stay in memory
+    crate::budget::check(
+        "discover-bench: --cases",
+        a.cases as f64,
+        crate::budget::MAX_BENCH_CASES as f64,
+        1e6,
+        "per class, 9 classes",
+    )?;
+    let profile = discovery::bench_gen::Profile::parse(&a.profile).unwrap_or(discovery::bench_gen::Profile::Classic);
     if let Some(dir) = &a.write_cases {
         let st = crate::output::StagedDir::new(dir)?;
         for i in 0..a.cases {
             for &c in discovery::bench_gen::CLASSES.iter() {
-                let case = discovery::bench_gen::generate(c, a.seed, i);
+                let case = discovery::bench_gen::generate_profile(c, a.seed, i, profile);
                 let mut m = case.nominal.clone();
                 m.name = format!("{} [{}]", m.name, case.description);
                 std::fs::write(st.path(&format!("{c}-{i}.toml")), model::to_toml_string(&m))?;
@@ -41,14 +59,16 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         st.commit()?;
         return Ok(ExitCode::SUCCESS);
     }
-    let r = discovery::bench::run(a.cases, a.seed, &Default::default(), |c| {
+    let settings = discovery::DiagnoseSettings { estimate_x0: a.estimate_x0, ..Default::default() };
+    let r = discovery::bench::run_with(a.cases, a.seed, profile, &settings, |c| {
         eprintln!(
-            "{:>18} #{:<3} -> {:<34} {} ({:.1} s)",
+            "{:>18} #{:<3} -> {:<34} {} ({:.1} s; {})",
             c.class,
             c.index,
             c.selected,
             c.error.as_deref().unwrap_or(""),
-            c.seconds
+            c.seconds,
+            c.conditions.short()
         );
     });
     println!("{}", r.to_text());
