@@ -1,0 +1,396 @@
+//! The extension module `moreau._native`: argument conversion and the GIL. Results travel as
+//! JSON text (the CLI's own objects, parsed by `json.loads` on the Python side) and as raw
+//! little-endian `float64` buffers (`numpy.frombuffer`); errors as `MoreauError` with the CLI's
+//! one-line message. The Python package `moreau` (python/python/moreau) is the public API.
+use crate::commands::{self as core, RecordingSource, SamplesSpec, Source, Stated};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::PathBuf;
+
+pyo3::create_exception!(
+    moreau,
+    MoreauError,
+    PyValueError,
+    "An error of moreau, with the one-line message the `moreau` command prints after `error: `."
+);
+
+fn err(e: anyhow::Error) -> PyErr {
+    MoreauError::new_err(core::one_line(&e))
+}
+
+fn to_json(v: &serde_json::Value) -> PyResult<String> {
+    serde_json::to_string(v).map_err(|e| err(e.into()))
+}
+
+/// A validated system `x' = A x + B w + E z, y = C x, z in y + Theta` (model::System).
+#[pyclass(frozen, name = "System", module = "moreau._native")]
+pub struct PySystem {
+    inner: model::System,
+    /// Which of `[initial] x0`, `z0` the model states (diagnose takes a stated x0 as known).
+    stated: Stated,
+}
+
+/// A Python value of a model-file table as a TOML value (numbers, strings, booleans, lists,
+/// dicts).
+fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return Ok(toml::Value::Table(toml_table(key, d)?));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let mut a = Vec::new();
+        for x in v.try_iter()? {
+            a.push(toml_value(key, &x?)?);
+        }
+        return Ok(toml::Value::Array(a));
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    Err(PyTypeError::new_err(format!("key `{key}`: cannot use a value of type {} in a model", v.get_type().name()?)))
+}
+
+fn toml_table(prefix: &str, d: &Bound<'_, PyDict>) -> PyResult<toml::Table> {
+    let mut t = toml::Table::new();
+    for (k, v) in d.iter() {
+        let k: String = k.extract()?;
+        if v.is_none() {
+            continue;
+        }
+        let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+        t.insert(k, toml_value(&key, &v)?);
+    }
+    Ok(t)
+}
+
+fn rows(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+}
+
+#[pymethods]
+impl PySystem {
+    /// From the tables of a model file as a dict (`plant`, `theta`, `input`, `initial`,
+    /// `simulation`, `effects`, `name`); `samples = (t, w, period, source)` replaces the input.
+    #[staticmethod]
+    #[pyo3(signature = (table, samples=None))]
+    fn from_table(py: Python<'_>, table: &Bound<'_, PyDict>, samples: Option<SamplesArg>) -> PyResult<Self> {
+        let t = toml_table("", table)?;
+        let stated = Stated::of_table(&t);
+        let samples = samples.map(|(t, w, period, source)| SamplesSpec { t, w, period, source });
+        let inner = py.detach(move || core::system_from_table(t, samples)).map_err(err)?;
+        Ok(Self { inner, stated })
+    }
+    /// Reads a model file (as `moreau validate FILE`).
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let inner = core::load(&path).map_err(err)?;
+        let stated = std::fs::read_to_string(&path).map(|t| Stated::of_text(&t)).unwrap_or_default();
+        Ok(Self { inner, stated })
+    }
+    /// Parses model-file text (`csv` inputs relative to the working directory).
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        Ok(Self { inner: model::parse_str(text).map_err(|e| err(e.into()))?, stated: Stated::of_text(text) })
+    }
+    /// The model file of this system.
+    fn to_toml(&self) -> String {
+        model::to_toml_string(&self.inner)
+    }
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    #[getter]
+    fn n(&self) -> usize {
+        self.inner.n()
+    }
+    #[getter]
+    fn m(&self) -> usize {
+        self.inner.m()
+    }
+    #[getter]
+    fn p(&self) -> usize {
+        self.inner.p()
+    }
+    #[getter(A)]
+    fn a(&self) -> Vec<Vec<f64>> {
+        rows(&self.inner.A)
+    }
+    #[getter(B)]
+    fn b(&self) -> Vec<Vec<f64>> {
+        rows(&self.inner.B)
+    }
+    #[getter(C)]
+    fn c(&self) -> Vec<Vec<f64>> {
+        rows(&self.inner.C)
+    }
+    #[getter(E)]
+    fn e(&self) -> Vec<Vec<f64>> {
+        rows(&self.inner.E)
+    }
+    #[getter]
+    fn x0(&self) -> Vec<f64> {
+        self.inner.x0.iter().copied().collect()
+    }
+    #[getter]
+    fn z0(&self) -> Vec<f64> {
+        self.inner.z0.iter().copied().collect()
+    }
+    /// Period `T` of the input (`None` if not periodic).
+    #[getter]
+    fn period(&self) -> Option<f64> {
+        self.inner.period()
+    }
+    /// `mu = max Re eig(F)`, `F = A + E C` (estimate).
+    #[getter]
+    fn mu(&self) -> f64 {
+        self.inner.mu()
+    }
+    /// Eigenvalues of `F` as (re, im), by decreasing real part.
+    fn eig_f(&self) -> Vec<(f64, f64)> {
+        self.inner.eig_F().iter().map(|c| (c.re, c.im)).collect()
+    }
+    #[getter]
+    fn theta_kind(&self) -> &'static str {
+        self.inner.theta.kind()
+    }
+    #[getter]
+    fn theta_description(&self) -> String {
+        use geometry::ConvexSet;
+        self.inner.theta.describe()
+    }
+    /// Upper bound of the strong-convexity constant `R` of Theta (`inf` if not strongly
+    /// convex) and whether it is proven.
+    fn strong_convexity(&self) -> (f64, bool) {
+        use geometry::ConvexSet;
+        let s = self.inner.theta.strong_convexity();
+        (s.upper(), s.is_verified_upper())
+    }
+    #[getter]
+    fn input_kind(&self) -> &'static str {
+        self.inner.input.kind()
+    }
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.sim.dt
+    }
+    #[getter]
+    fn periods(&self) -> usize {
+        self.inner.sim.periods
+    }
+    #[getter]
+    fn t_end(&self) -> Option<f64> {
+        self.inner.sim.t_end
+    }
+    /// Kinds of the `[[effects]]` (empty for the paper's class).
+    #[getter]
+    fn effects(&self) -> Vec<&'static str> {
+        self.inner.effects.list.iter().map(|e| e.kind()).collect()
+    }
+    /// The input `w(t)` at the given times, row-major (len(t) x m) float64 bytes.
+    fn input_at<'py>(&self, py: Python<'py>, t: Vec<f64>) -> Bound<'py, PyBytes> {
+        let mut out = vec![0.0; self.inner.m()];
+        let mut v = Vec::with_capacity(t.len() * out.len());
+        for &s in &t {
+            self.inner.input.eval(s, &mut out);
+            v.extend_from_slice(&out);
+        }
+        bytes(py, &v)
+    }
+}
+
+/// Sampled input as it crosses from Python: `(t, w rows, period, source name)`.
+type SamplesArg = (Vec<f64>, Vec<Vec<f64>>, Option<f64>, String);
+
+fn bytes<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyBytes> {
+    let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+    PyBytes::new(py, &b)
+}
+
+/// A `System` or a path (str or os.PathLike) to a model file.
+fn source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
+    if let Ok(s) = obj.cast::<PySystem>() {
+        let s = s.get();
+        return Ok(Source::Built(Box::new(s.inner.clone()), s.stated));
+    }
+    match obj.extract::<PathBuf>() {
+        Ok(p) => Ok(Source::File(p)),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "expected a moreau.System or the path of a model file, got {}",
+            obj.get_type().name()?
+        ))),
+    }
+}
+
+/// `moreau theta FILE --json` (guidance as without `--no-guidance` when `guidance`).
+#[pyfunction]
+#[pyo3(signature = (model, *, measure=true, stationary=true, guidance=true))]
+fn theta(
+    py: Python<'_>,
+    model: &Bound<'_, PyAny>,
+    measure: bool,
+    stationary: bool,
+    guidance: bool,
+) -> PyResult<String> {
+    let src = source(model)?;
+    let v =
+        py.detach(move || core::theta_json(&src, core::ThetaOptions { measure, stationary, guidance })).map_err(err)?;
+    to_json(&v)
+}
+
+/// `moreau simulate FILE`: (n, m, p, method, h, {t, w, x, y, z, q} as float64 bytes).
+#[pyfunction]
+#[pyo3(signature = (model, *, periods=None, dt=None, t_end=None, integrator="catching-up", max_rows=None))]
+#[allow(clippy::type_complexity)]
+fn simulate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    periods: Option<usize>,
+    dt: Option<f64>,
+    t_end: Option<f64>,
+    integrator: &str,
+    max_rows: Option<usize>,
+) -> PyResult<(usize, usize, usize, String, f64, Bound<'py, PyDict>)> {
+    let event = match integrator {
+        "catching-up" => false,
+        "event" => true,
+        other => {
+            return Err(MoreauError::new_err(format!(
+                "invalid value '{other}' for '--integrator <INTEGRATOR>' [possible values: catching-up, event]"
+            )))
+        }
+    };
+    let src = source(model)?;
+    let o = core::SimulateOptions { periods, dt, t_end, event, max_rows };
+    let r = py.detach(move || core::simulate(&src, &o)).map_err(err)?;
+    let d = PyDict::new(py);
+    for (k, v) in [("t", &r.t), ("w", &r.w), ("x", &r.x), ("y", &r.y), ("z", &r.z), ("q", &r.q)] {
+        d.set_item(k, bytes(py, v))?;
+    }
+    Ok((r.n, r.m, r.p, r.method, r.h, d))
+}
+
+/// `moreau periodic FILE --json`.
+#[pyfunction]
+#[pyo3(signature = (model, *, dt=None, periods=60, pairs=3))]
+fn periodic(
+    py: Python<'_>,
+    model: &Bound<'_, PyAny>,
+    dt: Option<f64>,
+    periods: usize,
+    pairs: usize,
+) -> PyResult<String> {
+    let src = source(model)?;
+    let v = py.detach(move || core::periodic_json(&src, dt, periods, pairs)).map_err(err)?;
+    to_json(&v)
+}
+
+/// `moreau check --json`: (JSON, whether the command would exit with status 1).
+#[pyfunction]
+#[pyo3(signature = (*, only=None, cases=None, seed=0, negative_control=false, out=None))]
+fn check(
+    py: Python<'_>,
+    only: Option<String>,
+    cases: Option<u64>,
+    seed: u64,
+    negative_control: bool,
+    out: Option<PathBuf>,
+) -> PyResult<(String, bool)> {
+    let o = core::CheckOptions { cases, seed, only, negative_control, out };
+    let (v, bad) = py.detach(move || core::check_json(&o)).map_err(err)?;
+    Ok((to_json(&v)?, bad))
+}
+
+/// `moreau diagnose`: (report JSON, fitted System or None, p, {t, y, yhat_nominal, yhat_fitted}).
+/// The recording is a path (`data`) or CSV text (`text`, named `source` in messages).
+#[pyfunction]
+#[pyo3(signature = (model, *, data=None, text=None, source_name="<recording>".to_string(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, out=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn diagnose<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    data: Option<PathBuf>,
+    text: Option<String>,
+    source_name: String,
+    estimation_fraction: f64,
+    max_effects: usize,
+    input_hold: String,
+    estimate_x0: bool,
+    out: Option<PathBuf>,
+) -> PyResult<(String, Option<PySystem>, usize, Bound<'py, PyDict>)> {
+    let src = source(model)?;
+    let rec = match (data, text) {
+        (Some(p), None) => RecordingSource::File(p),
+        (None, Some(text)) => RecordingSource::Text { text, source: source_name },
+        _ => return Err(PyTypeError::new_err("give exactly one of data= (a path) and text= (CSV text)")),
+    };
+    let o = core::DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, out };
+    let r = py.detach(move || core::diagnose(&src, &rec, &o)).map_err(err)?;
+    let d = PyDict::new(py);
+    for (k, v) in [("t", &r.t), ("y", &r.y), ("yhat_nominal", &r.yhat_nominal), ("yhat_fitted", &r.yhat_fitted)] {
+        d.set_item(k, bytes(py, v))?;
+    }
+    // the fitted model file states the initial state it was fitted with
+    let fitted = r.fitted.map(|inner| PySystem { inner, stated: Stated { x0: true, z0: true } });
+    Ok((to_json(&r.report)?, fitted, r.p, d))
+}
+
+/// `moreau sweep SPEC --out DIR --quiet`: (JSON table, files written, exit status 0).
+#[pyfunction]
+#[pyo3(signature = (spec, out, *, shard=None, threads=None, digits=None, overwrite=false, fresh=false, retry_failed=false))]
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    py: Python<'_>,
+    spec: PathBuf,
+    out: PathBuf,
+    shard: Option<String>,
+    threads: Option<usize>,
+    digits: Option<usize>,
+    overwrite: bool,
+    fresh: bool,
+    retry_failed: bool,
+) -> PyResult<(String, Vec<PathBuf>, bool)> {
+    let args =
+        moreau::cli::sweep::Args { spec, out, shard, threads, digits, overwrite, fresh, retry_failed, quiet: true };
+    let (v, files, ok) = py.detach(move || core::sweep(args)).map_err(err)?;
+    Ok((to_json(&v)?, files, ok))
+}
+
+/// The CLI's global `--allow-large`: lifts the soft work limits of every later call.
+#[pyfunction]
+fn set_allow_large(on: bool) {
+    moreau::budget::set_allow_large(on);
+}
+
+#[pyfunction]
+fn allow_large() -> bool {
+    moreau::budget::allow_large()
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MoreauError", m.py().get_type::<MoreauError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<PySystem>()?;
+    m.add_function(wrap_pyfunction!(theta, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(periodic, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(set_allow_large, m)?)?;
+    m.add_function(wrap_pyfunction!(allow_large, m)?)?;
+    Ok(())
+}
