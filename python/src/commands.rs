@@ -8,22 +8,8 @@ use dynamics::trajectory::Trajectory;
 use model::{Input, ModelError, System};
 use std::path::{Path, PathBuf};
 
-/// The error and its causes on one line, exactly as `moreau` prints them after `error: `
-/// (a copy of `moreau::cli::one_line`, which is private to the CLI).
-pub fn one_line(e: &anyhow::Error) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    for cause in e.chain() {
-        let text = cause.to_string().lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ");
-        if parts.iter().any(|p| p.contains(&text)) {
-            continue;
-        }
-        match parts.last_mut() {
-            Some(last) if text.contains(last.as_str()) => *last = text,
-            _ => parts.push(text),
-        }
-    }
-    parts.join(": ")
-}
+/// The error and its causes on one line, exactly as `moreau` prints them after `error: `.
+pub use moreau::cli::one_line;
 
 /// Where a command's model comes from: a model file (errors carry its path, as in the CLI) or
 /// a system built in Python (with which parts of `[initial]` it states).
@@ -468,20 +454,7 @@ pub fn check_json(a: &CheckOptions) -> anyhow::Result<(serde_json::Value, bool)>
             }
             _ => None,
         };
-        results.push(serde_json::json!({
-            "name": r.name,
-            "label": r.label,
-            "title": r.title,
-            "variant": match r.variant { Variant::Claim => "claim", Variant::NegativeControl => "negative_control" },
-            "cases": r.cases,
-            "skipped": r.skipped,
-            "min_slack": if r.min_slack.is_finite() { serde_json::json!(r.min_slack) } else { serde_json::Value::Null },
-            "violations": r.violations,
-            "first_violation": r.first_violation,
-            "counterexample_file": file.map(|f| f.display().to_string()),
-            "counterexample": r.counterexample.as_ref().map(|c| c.summary.clone()),
-            "seconds": r.seconds,
-        }));
+        results.push(moreau::cli::check::report_json(r, file.as_ref()));
     }
     let bad = if a.negative_control {
         reports.iter().any(|r| r.violations == 0)

@@ -48,7 +48,7 @@ fn fmt_slack(s: f64) -> String {
     }
 }
 
-fn report_json(r: &PropertyReport, file: Option<&PathBuf>) -> serde_json::Value {
+pub fn report_json(r: &PropertyReport, file: Option<&PathBuf>) -> serde_json::Value {
     serde_json::json!({
         "name": r.name,
         "label": r.label,

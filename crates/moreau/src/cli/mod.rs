@@ -115,7 +115,7 @@ pub fn main() -> ExitCode {
 /// A context that the next cause repeats (`f.toml` then `f.toml: TOML syntax error ...` or
 /// `cannot read f.toml: ...`) is replaced by that cause, so the path is printed once; line breaks inside a
 /// message are folded.
-pub(crate) fn one_line(e: &anyhow::Error) -> String {
+pub fn one_line(e: &anyhow::Error) -> String {
     let mut parts: Vec<String> = Vec::new();
     for cause in e.chain() {
         let text = cause.to_string().lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ");
