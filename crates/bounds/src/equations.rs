@@ -142,7 +142,10 @@ mod tests {
             assert!(crate::report::glossary(def.key).is_some(), "no glossary entry for {}", def.key);
         }
         assert!(crate::report::glossary("no_such_key").is_none());
-        assert_eq!(numbered("(theta),(path1)"), format!("({}),({})", number("theta").unwrap(), number("path1").unwrap()));
+        assert_eq!(
+            numbered("(theta),(path1)"),
+            format!("({}),({})", number("theta").unwrap(), number("path1").unwrap())
+        );
         assert_eq!(number("xy"), Some("1"));
         assert!(number("lem1:2").unwrap().starts_with('A') && number("spec").unwrap().starts_with('B'));
         // Negative control: an unknown label is not given a number.

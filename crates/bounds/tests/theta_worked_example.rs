@@ -151,7 +151,8 @@ fn theta_star_is_sharper_and_verified_on_the_worked_example() {
 /// b_hat >= beta and alpha_lower <= alpha and rounded up, is never negative on the examples.
 #[test]
 fn psi_at_zero_is_never_negative_on_the_examples() {
-    for name in ["worked-example.toml", "worked-example-a5.toml", "ellipse-p2.toml", "lens-p2.toml", "polytope-p2.toml"] {
+    for name in ["worked-example.toml", "worked-example-a5.toml", "ellipse-p2.toml", "lens-p2.toml", "polytope-p2.toml"]
+    {
         let r = assemble(&load(name), &ThetaSettings::bound_only()).unwrap();
         assert!(r.psi_0 >= 0.0, "{name}: psi(0) = {}", r.psi_0);
         for &(l, b, _) in &r.curve {

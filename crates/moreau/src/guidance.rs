@@ -89,8 +89,7 @@ fn amplitudes(sys: &System) -> Option<&[f64]> {
 
 fn with_amplitude_factor(sys: &System, f: f64) -> Option<System> {
     let a = amplitudes(sys)?.to_vec();
-    let params: Vec<Parameter> =
-        (0..a.len()).map(|k| Parameter::InputAmplitude { component: Some(k) }).collect();
+    let params: Vec<Parameter> = (0..a.len()).map(|k| Parameter::InputAmplitude { component: Some(k) }).collect();
     let settings: Vec<(&Parameter, f64)> = params.iter().zip(&a).map(|(p, v)| (p, v * f)).collect();
     apply_all(sys, &settings).ok()
 }
@@ -148,7 +147,11 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
     if amplitudes(sys).is_some() {
         push("input.amplitude", with_amplitude_factor(sys, up), with_amplitude_factor(sys, dn));
         if let Input::Sine { omega, .. } | Input::Square { omega, .. } = &sys.input {
-            push("input.omega", with(sys, Parameter::InputOmega, omega * up), with(sys, Parameter::InputOmega, omega * dn));
+            push(
+                "input.omega",
+                with(sys, Parameter::InputOmega, omega * up),
+                with(sys, Parameter::InputOmega, omega * dn),
+            );
         }
     } else {
         notes.push("the input is not a sine or square wave: amplitude and frequency are not varied".into());
@@ -165,7 +168,10 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
         };
         let (mut lo, mut hi) = (1.0f64, None);
         if let Some(v) = certifies(sys) {
-            notes.push("already certified: the amplitude search looks for the smallest factor <= 1 that still certifies".into());
+            notes.push(
+                "already certified: the amplitude search looks for the smallest factor <= 1 that still certifies"
+                    .into(),
+            );
             let mut f = 1.0;
             hi = Some((1.0, v));
             lo = f64::NAN;

@@ -46,6 +46,7 @@ fn psi_figure_as_pgfplots_is_ascii_balanced_and_compiles_when_latex_is_present()
         String::from_utf8_lossy(&out.stdout).lines().rev().take(25).collect::<Vec<_>>().join("\n")
     );
     // Negative control: a broken figure (an unescaped special character) must not compile.
-    std::fs::write(dir.path().join("fig.tex"), tex.replacen("\\addlegendentry{", "\\addlegendentry{50% & #", 1)).unwrap();
+    std::fs::write(dir.path().join("fig.tex"), tex.replacen("\\addlegendentry{", "\\addlegendentry{50% & #", 1))
+        .unwrap();
     assert!(!run("doc.tex").status.success(), "a broken pgf file compiled: the check cannot fail");
 }

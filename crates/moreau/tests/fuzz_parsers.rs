@@ -36,9 +36,28 @@ impl Rng {
 }
 
 const HOSTILE: [&str; 22] = [
-    "nan", "inf", "-inf", "1e400", "-1e400", "1e-320", "-0.0", "0", "-1", "1e300", "9223372036854775808",
-    "18446744073709551616", "\"x\"", "[]", "[[1.0, 2.0], [3.0]]", "{}", "true", "0x10", "1e6", "1e-300",
-    "-5", "\"\"",
+    "nan",
+    "inf",
+    "-inf",
+    "1e400",
+    "-1e400",
+    "1e-320",
+    "-0.0",
+    "0",
+    "-1",
+    "1e300",
+    "9223372036854775808",
+    "18446744073709551616",
+    "\"x\"",
+    "[]",
+    "[[1.0, 2.0], [3.0]]",
+    "{}",
+    "true",
+    "0x10",
+    "1e6",
+    "1e-300",
+    "-5",
+    "\"\"",
 ];
 
 /// One structure-aware mutation (1 to 4 operations) of `seed`.
@@ -67,8 +86,7 @@ fn mutate(seed: &str, rng: &mut Rng) -> String {
                 let starts: Vec<usize> = l
                     .char_indices()
                     .filter(|(k, c)| {
-                        (c.is_ascii_digit() || *c == '-')
-                            && (*k == 0 || !l.as_bytes()[k - 1].is_ascii_alphanumeric())
+                        (c.is_ascii_digit() || *c == '-') && (*k == 0 || !l.as_bytes()[k - 1].is_ascii_alphanumeric())
                     })
                     .map(|(k, _)| k)
                     .collect();
@@ -98,7 +116,9 @@ fn mutate(seed: &str, rng: &mut Rng) -> String {
             }
             7 => {
                 // flip or insert a byte (kept valid UTF-8: ASCII only)
-                let b = [b'"', b'[', b']', b'{', b'}', b',', b'=', b'\n', b'#', b'\\', b'\'', b'.', b'e', b'0', b' ', b'\t'];
+                let b = [
+                    b'"', b'[', b']', b'{', b'}', b',', b'=', b'\n', b'#', b'\\', b'\'', b'.', b'e', b'0', b' ', b'\t',
+                ];
                 let mut l = lines[i].clone().into_bytes();
                 let at = rng.below(l.len() + 1);
                 if rng.below(2) == 0 && at < l.len() && l[at].is_ascii() {
@@ -128,8 +148,10 @@ fn mutate(seed: &str, rng: &mut Rng) -> String {
 
 fn corpus(name: &str) -> Vec<String> {
     let dir = root().join("fuzz/corpus").join(name);
-    let mut files: Vec<PathBuf> =
-        std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())).map(|e| e.unwrap().path()).collect();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
     files.sort();
     let seeds: Vec<String> = files.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect();
     assert!(!seeds.is_empty(), "empty corpus {name}");

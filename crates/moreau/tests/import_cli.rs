@@ -53,7 +53,11 @@ fn mat_v5(vars: &[(&str, usize, usize, Vec<f64>)]) -> Vec<u8> {
 }
 
 fn theta_json(model: &Path) -> serde_json::Value {
-    let out = moreau().args(["theta", "--json", "--no-measure", "--no-stationary", "--no-guidance"]).arg(model).output().unwrap();
+    let out = moreau()
+        .args(["theta", "--json", "--no-measure", "--no-stationary", "--no-guidance"])
+        .arg(model)
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     serde_json::from_slice(&out.stdout).unwrap()
 }
@@ -112,10 +116,30 @@ fn mat_and_json_imports_reproduce_the_worked_example() {
 fn bad_state_space_files_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let cases: Vec<(&str, Vec<u8>, &[&str], &str)> = vec![
-        ("d.mat", mat_v5(&[("A", 1, 1, vec![-1.0]), ("B", 1, 1, vec![1.0]), ("C", 1, 1, vec![1.0]), ("D", 1, 1, vec![0.5])]), &["--e-from-b", "0", "--interval", "0.1", "--sine", "1"], "D has a nonzero entry 0.5"),
-        ("noe.json", br#"{"A": [[-1]], "B": [[1]], "C": [[1]]}"#.to_vec(), &["--interval", "0.1", "--sine", "1"], "no E"),
-        ("ragged.json", br#"{"A": [[-1, 0], [0]], "B": [[1]], "C": [[1]], "E": [[1]]}"#.to_vec(), &["--interval", "0.1", "--sine", "1"], "row 1 has 1 entries"),
-        ("garbage.mat", b"not a mat file at all".to_vec(), &["--e-from-b", "0", "--interval", "0.1", "--sine", "1"], "not a readable MATLAB v5 .mat file"),
+        (
+            "d.mat",
+            mat_v5(&[("A", 1, 1, vec![-1.0]), ("B", 1, 1, vec![1.0]), ("C", 1, 1, vec![1.0]), ("D", 1, 1, vec![0.5])]),
+            &["--e-from-b", "0", "--interval", "0.1", "--sine", "1"],
+            "D has a nonzero entry 0.5",
+        ),
+        (
+            "noe.json",
+            br#"{"A": [[-1]], "B": [[1]], "C": [[1]]}"#.to_vec(),
+            &["--interval", "0.1", "--sine", "1"],
+            "no E",
+        ),
+        (
+            "ragged.json",
+            br#"{"A": [[-1, 0], [0]], "B": [[1]], "C": [[1]], "E": [[1]]}"#.to_vec(),
+            &["--interval", "0.1", "--sine", "1"],
+            "row 1 has 1 entries",
+        ),
+        (
+            "garbage.mat",
+            b"not a mat file at all".to_vec(),
+            &["--e-from-b", "0", "--interval", "0.1", "--sine", "1"],
+            "not a readable MATLAB v5 .mat file",
+        ),
         ("ss.txt", b"A = 1".to_vec(), &["--interval", "0.1"], "unknown extension"),
     ];
     for (name, bytes, args, needle) in cases {

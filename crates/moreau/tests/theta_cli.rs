@@ -85,6 +85,12 @@ fn explain_prints_a_glossary_row_for_every_quantity() {
     assert!(glossary.contains("psi(0)") && glossary.contains("Always >= 0"));
     // one row per reported quantity
     let rows = glossary.lines().filter(|l| l.starts_with("- ")).count();
-    let table_rows = s.split("What the rows mean").next().unwrap().lines().filter(|l| l.contains(" yes ") || l.contains(" no ")).count();
+    let table_rows = s
+        .split("What the rows mean")
+        .next()
+        .unwrap()
+        .lines()
+        .filter(|l| l.contains(" yes ") || l.contains(" no "))
+        .count();
     assert!(rows >= 20 && rows >= table_rows, "{rows} glossary rows for {table_rows} table rows");
 }

@@ -41,7 +41,13 @@ fn theta_json_keys_and_numbers_are_stable() {
         let name = path.file_stem().unwrap().to_str().unwrap().to_string();
         let before: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         let model = root().join("examples").join(format!("{name}.toml"));
-        let out = Command::new(env!("CARGO_BIN_EXE_moreau")).arg("theta").arg(&model).arg("--json").arg("--no-guidance").output().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_moreau"))
+            .arg("theta")
+            .arg(&model)
+            .arg("--json")
+            .arg("--no-guidance")
+            .output()
+            .unwrap();
         assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
         let after: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         for (k, v) in before.as_object().unwrap() {
@@ -56,7 +62,12 @@ fn theta_json_keys_and_numbers_are_stable() {
             let key = q["key"].as_str().unwrap();
             let a = qa.iter().find(|x| x["key"] == q["key"]).unwrap_or_else(|| panic!("{name}: quantity {key} gone"));
             for field in ["value", "kind", "label", "symbol"] {
-                assert!(same(&a[field], &q[field]), "{name}: quantity {key}: {field} changed: {} vs {}", a[field], q[field]);
+                assert!(
+                    same(&a[field], &q[field]),
+                    "{name}: quantity {key}: {field} changed: {} vs {}",
+                    a[field],
+                    q[field]
+                );
             }
         }
         checked += 1;

@@ -174,9 +174,7 @@ impl EtaOrbit {
         let slack = 0.5 * dt * self.deta_lipschitz * (1.0 + 1e-12);
         let bounds = (0..cells)
             .map(|c| {
-                let m = (c * per..=(c + 1) * per)
-                    .map(|k| geometry::linalg::norm(&self.deta[k]))
-                    .fold(0.0, f64::max);
+                let m = (c * per..=(c + 1) * per).map(|k| geometry::linalg::norm(&self.deta[k])).fold(0.0, f64::max);
                 (m + slack + 2.0 * self.rel_margin * self.eta_dot_inf) * (1.0 + 1e-12)
             })
             .collect();

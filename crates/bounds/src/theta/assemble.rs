@@ -337,9 +337,9 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf),
             &settings.lambda,
         ) {
-            Ok(s2) => star_points.extend(
-                s2.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))),
-            ),
+            Ok(s2) => {
+                star_points.extend(s2.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))))
+            }
             Err(e) => notes.push(format!("second lambda search (for theta*) failed: {e}")),
         }
     }
@@ -360,8 +360,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     };
     let (theta_profile, lambda_profile, profile_intervals) = match &profile {
         Some(prof) => {
-            let nodes =
-                prof.best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
+            let nodes = prof
+                .best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
             let (v, l) = star_points
                 .iter()
                 .map(|&(l, b)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))

@@ -66,10 +66,7 @@ impl SpeedProfile {
     /// slope gives a larger, still valid, upper chord).
     pub fn slopes(&self, psi: &Psi) -> Vec<f64> {
         let p0 = psi.at_zero();
-        self.g
-            .iter()
-            .map(|&g| if g > 0.0 { ((p0 - psi.eval(g)) / g * (1.0 - 1e-12)).max(0.0) } else { 0.0 })
-            .collect()
+        self.g.iter().map(|&g| if g > 0.0 { ((p0 - psi.eval(g)) / g * (1.0 - 1e-12)).max(0.0) } else { 0.0 }).collect()
     }
 
     /// `L` of the cells `i..j` (boundaries `i < j`) with path bound `m`: greedy fill by

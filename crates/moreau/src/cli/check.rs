@@ -82,8 +82,10 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     };
     bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} cases, {per_sec}, about {eta} left {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} cases, {per_sec}, about {eta} left {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut reports = Vec::new();
     for p in &props {

@@ -157,7 +157,9 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
             }
             B.columns(k, 1).into_owned()
         }
-        (None, None) => bail!("the file has no E (how the backlash output enters the plant): add it, or give --e-from-b K"),
+        (None, None) => {
+            bail!("the file has no E (how the backlash output enters the plant): add it, or give --e-from-b K")
+        }
     };
     let (n, p, m) = (A.nrows(), C.nrows(), B.ncols());
     let theta = match (a.interval, a.ball, ss.rest.get("theta")) {

@@ -106,7 +106,10 @@ fn coords(pts: &[(f64, f64)]) -> String {
 /// pgfplots code of `f` (a `tikzpicture`).
 pub fn to_pgf(f: &Figure) -> String {
     let mut s = String::new();
-    s.push_str(&format!("% {} -- written by moreau; needs \\usepackage{{pgfplots}} (compat >= 1.11)\n", tex_text(&f.title)));
+    s.push_str(&format!(
+        "% {} -- written by moreau; needs \\usepackage{{pgfplots}} (compat >= 1.11)\n",
+        tex_text(&f.title)
+    ));
     s.push_str("\\begin{tikzpicture}\n\\begin{axis}[\n");
     s.push_str("  width=0.9\\linewidth, height=0.55\\linewidth, clip=false,\n");
     if let Some(((x0, x1), (y0, y1))) = f.ranges() {
@@ -191,9 +194,9 @@ pub fn to_csv(f: &Figure) -> String {
     let mut s = String::from("element,label,x,y\n");
     for (i, e) in f.elements.iter().enumerate() {
         let (label, pts): (&str, Vec<(f64, f64)>) = match e {
-            Element::Line { label, pts, .. } | Element::Polygon { label, pts, .. } | Element::Markers { label, pts, .. } => {
-                (label, pts.clone())
-            }
+            Element::Line { label, pts, .. }
+            | Element::Polygon { label, pts, .. }
+            | Element::Markers { label, pts, .. } => (label, pts.clone()),
             Element::Band { label, x, lo, hi, .. } => {
                 let mut p: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
                 p.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));

@@ -76,20 +76,29 @@ pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Resul
             // certified points (the `certified` column of the sweep, when present) filled in the
             // curve's colour, the others grey
             let certified = |x: f64| {
-                cert_idx.is_some_and(|ci| {
-                    pts.iter().any(|p| p.params[xi] == x && matches!(p.cells[ci], Cell::Flag(true)))
-                })
+                cert_idx
+                    .is_some_and(|ci| pts.iter().any(|p| p.params[xi] == x && matches!(p.cells[ci], Cell::Flag(true))))
             };
             let (yes, no): (Vec<(f64, f64)>, Vec<(f64, f64)>) = xy.iter().partition(|(x, _)| certified(*x));
             if cert_idx.is_some() {
-                f.elements.push(Element::Markers { label: String::new(), pts: yes, text: vec![], color: palette(colour) });
+                f.elements.push(Element::Markers {
+                    label: String::new(),
+                    pts: yes,
+                    text: vec![],
+                    color: palette(colour),
+                });
                 if !no.is_empty() {
                     let label = if grey_labelled { String::new() } else { "not certified".to_string() };
                     grey_labelled = true;
                     f.elements.push(Element::Markers { label, pts: no, text: vec![], color: GREY });
                 }
             } else {
-                f.elements.push(Element::Markers { label: String::new(), pts: xy, text: vec![], color: palette(colour) });
+                f.elements.push(Element::Markers {
+                    label: String::new(),
+                    pts: xy,
+                    text: vec![],
+                    color: palette(colour),
+                });
             }
             colour += 1;
         }

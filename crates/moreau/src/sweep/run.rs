@@ -271,7 +271,9 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     let stem = stem(opts.shard);
     let _lock = OutLock::acquire(&opts.out, &stem)?;
     // staging directories of interrupted runs beside `--out`
-    crate::output::remove_stale_staging(opts.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")));
+    crate::output::remove_stale_staging(
+        opts.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")),
+    );
     let mut done = previous_points(&header, &opts.out, &stem, opts.overwrite)?;
     if opts.fresh {
         done.clear();
