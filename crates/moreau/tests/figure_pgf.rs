@@ -12,6 +12,52 @@ fn psi_figure() -> moreau::figures::Figure {
     psi::from_report(&rep)
 }
 
+/// Compiles `tex` (a figure's pgfplots code) in a minimal document when pdflatex is installed:
+/// the folder and a function that runs pdflatex on a file in it; `None` (and a note) without it.
+fn latex(tex: &str) -> Option<(tempfile::TempDir, impl Fn(&str) -> std::process::Output)> {
+    let have_latex = Command::new("pdflatex").arg("--version").output().map(|o| o.status.success()).unwrap_or(false);
+    if !have_latex {
+        eprintln!("pdflatex not installed: compile step skipped");
+        return None;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("fig.tex"), tex).unwrap();
+    let doc = "\\documentclass{article}\n\\usepackage{pgfplots}\n\\pgfplotsset{compat=1.11}\n\\begin{document}\n\\input{fig.tex}\n\\end{document}\n";
+    std::fs::write(dir.path().join("doc.tex"), doc).unwrap();
+    let path = dir.path().to_path_buf();
+    let run = move |name: &str| {
+        Command::new("pdflatex")
+            .args(["-interaction=nonstopmode", "-halt-on-error", name])
+            .current_dir(&path)
+            .output()
+            .unwrap()
+    };
+    let out = run("doc.tex");
+    assert!(
+        out.status.success() && dir.path().join("doc.pdf").exists(),
+        "pdflatex failed:\n{}",
+        String::from_utf8_lossy(&out.stdout).lines().rev().take(25).collect::<Vec<_>>().join("\n")
+    );
+    Some((dir, run))
+}
+
+#[test]
+fn stacked_sweep_figure_as_pgfplots_has_one_axis_per_scale_and_compiles_when_latex_is_present() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sweeps/amplitude/sweep.json");
+    let r = moreau::sweep::SweepResult::read(std::path::Path::new(path)).unwrap();
+    let f = moreau::figures::sweep::sweep_figure(&r, None, &["theta", "theta_best", "measured_rate"]).unwrap();
+    assert_eq!(f.below.len(), 1, "theta bounds and the measured rate on separate axes");
+    let tex = pgf::to_pgf(&f);
+    assert!(tex.is_ascii());
+    assert_eq!(tex.matches("\\begin{axis}").count(), 2);
+    assert_eq!(tex.matches('{').count(), tex.matches('}').count(), "unbalanced braces");
+    // all elements of both panels are drawn, and the CSV carries both panels' data
+    let elements: usize = f.panels().iter().map(|p| p.elements.len()).sum();
+    assert_eq!(tex.matches("\\addplot").count(), elements);
+    assert!(pgf::to_csv(&f).lines().count() > 3 * 9);
+    latex(&tex);
+}
+
 #[test]
 fn psi_figure_as_pgfplots_is_ascii_balanced_and_compiles_when_latex_is_present() {
     let f = psi_figure();
@@ -23,28 +69,7 @@ fn psi_figure_as_pgfplots_is_ascii_balanced_and_compiles_when_latex_is_present()
     let csv = pgf::to_csv(&f);
     assert!(csv.lines().count() > 400 && csv.starts_with("element,label,x,y"));
 
-    let have_latex = Command::new("pdflatex").arg("--version").output().map(|o| o.status.success()).unwrap_or(false);
-    if !have_latex {
-        eprintln!("pdflatex not installed: compile step skipped");
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("fig.tex"), &tex).unwrap();
-    let doc = "\\documentclass{article}\n\\usepackage{pgfplots}\n\\pgfplotsset{compat=1.11}\n\\begin{document}\n\\input{fig.tex}\n\\end{document}\n";
-    std::fs::write(dir.path().join("doc.tex"), doc).unwrap();
-    let run = |name: &str| {
-        Command::new("pdflatex")
-            .args(["-interaction=nonstopmode", "-halt-on-error", name])
-            .current_dir(dir.path())
-            .output()
-            .unwrap()
-    };
-    let out = run("doc.tex");
-    assert!(
-        out.status.success() && dir.path().join("doc.pdf").exists(),
-        "pdflatex failed:\n{}",
-        String::from_utf8_lossy(&out.stdout).lines().rev().take(25).collect::<Vec<_>>().join("\n")
-    );
+    let Some((dir, run)) = latex(&tex) else { return };
     // Negative control: a broken figure (an unescaped special character) must not compile.
     std::fs::write(dir.path().join("fig.tex"), tex.replacen("\\addlegendentry{", "\\addlegendentry{50% & #", 1))
         .unwrap();

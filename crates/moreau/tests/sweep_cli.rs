@@ -142,7 +142,12 @@ fn figures_are_written_as_svg_and_png_with_text() {
     }
     let o = moreau(&["figure", "sweep", "examples/sweeps/amplitude", "--out", s(&out)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(out.join("sweep-theta-measured_rate.svg").exists());
+    assert!(out.join("sweep-theta-theta_best-measured_rate.svg").exists());
+    // the bounds (about -0.02) and the measured rate (about -0.3) on separate stacked axes
+    let tex = std::fs::read_to_string(out.join("sweep-theta-theta_best-measured_rate.tex")).unwrap();
+    assert_eq!(tex.matches("\\begin{axis}").count(), 2, "{tex}");
+    let second = &tex[tex.find("name=panel1").expect("a second panel")..];
+    assert!(second.contains("ylabel={measured\\_rate}") && !second.contains("addlegendentry{theta}"), "{second}");
     let o = moreau(&["figure", "sweep", "examples/sweeps/amplitude", "--out", s(&out), "--columns", "theta,nonsense"]);
     assert_one_line_error(&o, "no numeric column `nonsense`");
 }

@@ -32,8 +32,9 @@ pub struct Args {
     /// Output directory (fig-psi1, fig-loop, trajectory-yz/-x or sweep-<columns>, each .svg and .png).
     #[arg(long)]
     pub out: PathBuf,
-    /// sweep: numeric columns to draw.
-    #[arg(long, value_delimiter = ',', default_value = "theta,measured_rate")]
+    /// sweep: numeric columns to draw (default: those of theta, theta_best, measured_rate the
+    /// sweep has). The theta bounds share a panel; any other column gets its own, stacked below.
+    #[arg(long, value_delimiter = ',')]
     pub columns: Vec<String>,
     /// sweep: the axis on the horizontal axis (default: the first).
     #[arg(long)]
@@ -67,7 +68,14 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         Kind::Sweep => {
             let path = if a.input.is_dir() { a.input.join("sweep.json") } else { a.input.clone() };
             let r = SweepResult::read(&path)?;
-            let cols: Vec<&str> = a.columns.iter().map(String::as_str).collect();
+            let cols: Vec<&str> = if a.columns.is_empty() {
+                ["theta", "theta_best", "measured_rate"]
+                    .into_iter()
+                    .filter(|c| r.columns.iter().any(|k| k.name == *c))
+                    .collect()
+            } else {
+                a.columns.iter().map(String::as_str).collect()
+            };
             let f = figures::sweep::sweep_figure(&r, a.x.as_deref(), &cols)?;
             vec![(format!("sweep-{}", cols.join("-")), f)]
         }

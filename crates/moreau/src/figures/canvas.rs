@@ -52,6 +52,10 @@ pub struct Figure {
     pub equal_aspect: bool,
     /// Pixel size. Default `900 x 600`.
     pub size: (u32, u32),
+    /// Further panels stacked below this one, sharing its x axis (quantities of different
+    /// scales, e.g. a bound near -0.02 and a measured rate near -0.3): each panel keeps its own
+    /// y axis, label and legend; only the top panel's title is drawn.
+    pub below: Vec<Figure>,
 }
 
 impl Figure {
@@ -63,7 +67,42 @@ impl Figure {
             elements: vec![],
             equal_aspect: false,
             size: (900, 600),
+            below: vec![],
         }
+    }
+
+    /// Width in pixels of the legend column right of the plot (0 when nothing is labelled):
+    /// the legend stands beside the data, never on it.
+    pub fn legend_width(&self) -> u32 {
+        let chars = self
+            .elements
+            .iter()
+            .map(|e| match e {
+                Element::Line { label, .. }
+                | Element::Band { label, .. }
+                | Element::Polygon { label, .. }
+                | Element::Markers { label, .. } => label.chars().count(),
+            })
+            .max()
+            .unwrap_or(0);
+        if chars == 0 {
+            0
+        } else {
+            (48 + 8 * chars as u32).min(self.size.0 / 3)
+        }
+    }
+
+    /// This panel and the ones stacked below it, top first.
+    pub fn panels(&self) -> Vec<&Figure> {
+        std::iter::once(self).chain(self.below.iter()).collect()
+    }
+
+    /// The x range shared by all panels (padded, as [`Figure::ranges`]).
+    pub fn shared_x_range(&self) -> Option<(f64, f64)> {
+        let rs: Vec<(f64, f64)> = self.panels().iter().filter_map(|p| p.ranges().map(|r| r.0)).collect();
+        let lo = rs.iter().map(|r| r.0).fold(f64::INFINITY, f64::min);
+        let hi = rs.iter().map(|r| r.1).fold(f64::NEG_INFINITY, f64::max);
+        (lo <= hi).then_some((lo, hi))
     }
 
     /// Data ranges with 5 % padding; `None` when nothing is finite.
@@ -89,7 +128,7 @@ impl Figure {
         let (mut xr, mut yr) = (pad(x0, x1), pad(y0, y1));
         if self.equal_aspect {
             let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
-            let (pw, ph) = (self.size.0 as f64 - 110.0, self.size.1 as f64 - 110.0);
+            let (pw, ph) = (self.size.0 as f64 - 110.0 - self.legend_width() as f64, self.size.1 as f64 - 110.0);
             let scale = (w / pw).max(h / ph);
             let (cx, cy) = (0.5 * (xr.0 + xr.1), 0.5 * (yr.0 + yr.1));
             xr = (cx - 0.5 * scale * pw, cx + 0.5 * scale * pw);
@@ -108,14 +147,49 @@ where
     DB::ErrorType: 'static,
 {
     let err = |e: &dyn std::fmt::Debug| FigureError::Draw { figure: f.title.clone(), reason: format!("{e:?}") };
-    let ((x0, x1), (y0, y1)) = f.ranges().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut builder = ChartBuilder::on(&root);
-    if !f.title.is_empty() {
+    if f.below.is_empty() {
+        draw_panel(&root, f, None, true)?;
+    } else {
+        let xr = f.shared_x_range().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
+        let body = if f.title.is_empty() {
+            root.clone()
+        } else {
+            root.titled(&f.title, ("sans-serif", 22)).map_err(|e| err(&e))?
+        };
+        let panels = f.panels();
+        for (area, p) in body.split_evenly((panels.len(), 1)).iter().zip(panels) {
+            // an empty panel (no finite data) is left blank rather than failing the figure
+            if p.ranges().is_some() {
+                draw_panel(area, p, Some(xr), false)?;
+            }
+        }
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// One panel of `f` in `root`: its own y range, the x range `x_range` when given (stacked
+/// panels), its title when `title`.
+fn draw_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    f: &Figure,
+    x_range: Option<(f64, f64)>,
+    title: bool,
+) -> Result<(), FigureError>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: &dyn std::fmt::Debug| FigureError::Draw { figure: f.title.clone(), reason: format!("{e:?}") };
+    let ((x0, x1), (y0, y1)) = f.ranges().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
+    let (x0, x1) = x_range.unwrap_or((x0, x1));
+    let mut builder = ChartBuilder::on(root);
+    if title && !f.title.is_empty() {
         builder.caption(&f.title, ("sans-serif", 22));
     }
     let mut chart = builder
         .margin(14)
+        .margin_right(14 + f.legend_width())
         .x_label_area_size(48)
         .y_label_area_size(72)
         .build_cartesian_2d(x0..x1, y0..y1)
@@ -151,56 +225,32 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(|e| err(&e))?;
-    let mut legend = false;
     for e in &f.elements {
         match e {
-            Element::Band { label, x, lo, hi, color } => {
+            Element::Band { x, lo, hi, color, .. } => {
                 let mut pts: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
                 pts.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
-                let c = *color;
-                let a = chart
-                    .draw_series(std::iter::once(Polygon::new(finite(&pts), c.mix(0.22).filled())))
+                chart
+                    .draw_series(std::iter::once(Polygon::new(finite(&pts), color.mix(0.22).filled())))
                     .map_err(|e| err(&e))?;
-                if !label.is_empty() {
-                    legend = true;
-                    a.label(label.clone())
-                        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
-                }
             }
-            Element::Polygon { label, pts, color } => {
-                let c = *color;
-                let a = chart
-                    .draw_series(std::iter::once(Polygon::new(finite(pts), c.mix(0.12).filled())))
+            Element::Polygon { pts, color, .. } => {
+                chart
+                    .draw_series(std::iter::once(Polygon::new(finite(pts), color.mix(0.12).filled())))
                     .map_err(|e| err(&e))?;
-                if !label.is_empty() {
-                    legend = true;
-                    a.label(label.clone())
-                        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], c.mix(0.3).filled()));
-                }
             }
-            Element::Line { label, pts, color, dashed } => {
-                let c = *color;
-                let style = c.stroke_width(2);
-                let a = if *dashed {
-                    chart.draw_series(DashedLineSeries::new(finite(pts), 8, 6, style)).map_err(|e| err(&e))?
+            Element::Line { pts, color, dashed, .. } => {
+                let style = color.stroke_width(2);
+                if *dashed {
+                    chart.draw_series(DashedLineSeries::new(finite(pts), 8, 6, style)).map_err(|e| err(&e))?;
                 } else {
-                    chart.draw_series(LineSeries::new(finite(pts), style)).map_err(|e| err(&e))?
-                };
-                if !label.is_empty() {
-                    legend = true;
-                    a.label(label.clone())
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                    chart.draw_series(LineSeries::new(finite(pts), style)).map_err(|e| err(&e))?;
                 }
             }
-            Element::Markers { label, pts, text, color } => {
-                let c = *color;
-                let a = chart
-                    .draw_series(finite(pts).into_iter().map(|p| Circle::new(p, 5, c.filled())))
+            Element::Markers { pts, text, color, .. } => {
+                chart
+                    .draw_series(finite(pts).into_iter().map(|p| Circle::new(p, 5, color.filled())))
                     .map_err(|e| err(&e))?;
-                if !label.is_empty() {
-                    legend = true;
-                    a.label(label.clone()).legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
-                }
                 for (p, t) in pts.iter().zip(text) {
                     if p.0.is_finite() && p.1.is_finite() && !t.is_empty() {
                         // text set off above right of the marker (pixels), clear of the curves
@@ -212,17 +262,36 @@ where
             }
         }
     }
-    if legend {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 15))
-            .draw()
+    // the legend in its own column right of the plot (reserved by `legend_width`), off the data
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let base = root.get_base_pixel();
+    let (lx, mut ly) = (xr.end - base.0 + 12, yr.start - base.1 + 8);
+    for e in &f.elements {
+        let (label, c) = match e {
+            Element::Line { label, color, .. }
+            | Element::Band { label, color, .. }
+            | Element::Polygon { label, color, .. }
+            | Element::Markers { label, color, .. } => (label, *color),
+        };
+        if label.is_empty() {
+            continue;
+        }
+        match e {
+            Element::Band { .. } | Element::Polygon { .. } => {
+                root.draw(&Rectangle::new([(lx, ly - 6), (lx + 22, ly + 6)], c.mix(0.3).filled()))
+            }
+            Element::Line { dashed: true, .. } => {
+                root.draw(&PathElement::new(vec![(lx, ly), (lx + 8, ly)], c.stroke_width(2))).map_err(|e| err(&e))?;
+                root.draw(&PathElement::new(vec![(lx + 14, ly), (lx + 22, ly)], c.stroke_width(2)))
+            }
+            Element::Line { .. } => root.draw(&PathElement::new(vec![(lx, ly), (lx + 22, ly)], c.stroke_width(2))),
+            Element::Markers { .. } => root.draw(&Circle::new((lx + 11, ly), 5, c.filled())),
+        }
+        .map_err(|e| err(&e))?;
+        root.draw(&Text::new(label.clone(), (lx + 30, ly - 9), ("sans-serif", 15).into_font().color(&BLACK)))
             .map_err(|e| err(&e))?;
+        ly += 22;
     }
-    root.present().map_err(|e| err(&e))?;
     Ok(())
 }
 

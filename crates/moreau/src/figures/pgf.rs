@@ -103,22 +103,49 @@ fn coords(pts: &[(f64, f64)]) -> String {
         .join(" ")
 }
 
-/// pgfplots code of `f` (a `tikzpicture`).
+/// pgfplots code of `f` (a `tikzpicture`; stacked panels ([`Figure::below`]) as axes placed
+/// one under the other with the same x range, the x label on the bottom one only).
 pub fn to_pgf(f: &Figure) -> String {
     let mut s = String::new();
     s.push_str(&format!(
         "% {} -- written by moreau; needs \\usepackage{{pgfplots}} (compat >= 1.11)\n",
         tex_text(&f.title)
     ));
-    s.push_str("\\begin{tikzpicture}\n\\begin{axis}[\n");
-    s.push_str("  width=0.9\\linewidth, height=0.55\\linewidth, clip=false,\n");
+    s.push_str("\\begin{tikzpicture}\n");
+    let panels = f.panels();
+    let stacked = panels.len() > 1;
+    let shared_x = f.shared_x_range();
+    for (k, p) in panels.iter().enumerate() {
+        axis(&mut s, p, k, stacked, k + 1 == panels.len(), shared_x);
+    }
+    s.push_str("\\end{tikzpicture}\n");
+    s
+}
+
+/// One `axis` environment: panel `k` of the picture.
+fn axis(s: &mut String, f: &Figure, k: usize, stacked: bool, bottom: bool, shared_x: Option<(f64, f64)>) {
+    s.push_str(&format!("\\begin{{axis}}[\n  name=panel{k},\n"));
+    if k > 0 {
+        s.push_str(&format!("  at={{(panel{}.below south west)}}, anchor=north west, yshift=-0.6cm,\n", k - 1));
+    }
+    let height = if stacked { "0.32\\linewidth" } else { "0.55\\linewidth" };
+    let width = if stacked { "0.72\\linewidth" } else { "0.9\\linewidth" };
+    s.push_str(&format!("  width={width}, height={height}, clip=false,\n"));
     if let Some(((x0, x1), (y0, y1))) = f.ranges() {
+        let (x0, x1) = shared_x.filter(|_| stacked).unwrap_or((x0, x1));
         s.push_str(&format!("  xmin={}, xmax={}, ymin={}, ymax={},\n", num(x0), num(x1), num(y0), num(y1)));
     }
-    s.push_str(&format!("  xlabel={{{}}}, ylabel={{{}}},\n", tex_text(&f.x_label), tex_text(&f.y_label)));
-    // the legend below the axes, off the data
-    s.push_str("  legend cell align=left, legend columns=2,\n");
-    s.push_str("  legend style={font=\\small, at={(0.5,-0.18)}, anchor=north, draw=none},\n");
+    let xlabel = if bottom { tex_text(&f.x_label) } else { String::new() };
+    s.push_str(&format!("  xlabel={{{}}}, ylabel={{{}}},\n", xlabel, tex_text(&f.y_label)));
+    s.push_str("  legend cell align=left,\n");
+    if stacked {
+        // the legend right of the panel, off the data and clear of the panel below
+        s.push_str("  legend style={font=\\small, at={(1.03,1)}, anchor=north west, draw=none},\n");
+    } else {
+        // the legend below the axes, off the data
+        s.push_str("  legend columns=2,\n");
+        s.push_str("  legend style={font=\\small, at={(0.5,-0.18)}, anchor=north, draw=none},\n");
+    }
     s.push_str("  scaled ticks=false, tick label style={font=\\small},\n]\n");
     for e in &f.elements {
         let (label, line) = match e {
@@ -185,14 +212,14 @@ pub fn to_pgf(f: &Figure) -> String {
             }
         }
     }
-    s.push_str("\\end{axis}\n\\end{tikzpicture}\n");
-    s
+    s.push_str("\\end{axis}\n");
 }
 
 /// The data of `f` as CSV (`element,label,x,y`; bands as their closed outline).
 pub fn to_csv(f: &Figure) -> String {
     let mut s = String::from("element,label,x,y\n");
-    for (i, e) in f.elements.iter().enumerate() {
+    let elements = f.panels().into_iter().flat_map(|p| p.elements.iter());
+    for (i, e) in elements.enumerate() {
         let (label, pts): (&str, Vec<(f64, f64)>) = match e {
             Element::Line { label, pts, .. }
             | Element::Polygon { label, pts, .. }

@@ -21,7 +21,9 @@ pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
     let curve: Vec<(f64, f64)> = (0..=k).map(|i| g_max * i as f64 / k as f64).map(|g| (g, psi.eval(g))).collect();
     let (p0, pinf) = (psi.at_zero(), psi.eval(gamma_inf));
     let theta = psi.theta(gamma_1, gamma_inf);
-    let mut f = Figure::new("ψ(γ), eq. (phipsi), and θ of eq. (theta)", "γ", "ψ(γ)");
+    // the paper's printed equation numbers, not its LaTeX labels
+    let eq = |l: &str| bounds::equations::numbered(&format!("({l})"));
+    let mut f = Figure::new(&format!("ψ(γ) of eq. {} and θ of eq. {}", eq("phipsi"), eq("theta")), "γ", "ψ(γ)");
     f.elements.push(Element::Line { label: "ψ(γ)".into(), pts: curve, color: BLUE, dashed: false });
     f.elements.push(Element::Line {
         label: format!("limit −λ = {}", v(psi.limit())),
