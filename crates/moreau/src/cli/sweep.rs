@@ -9,7 +9,9 @@ use std::process::ExitCode;
 #[command(after_help = "Examples:
   moreau sweep examples/sweeps/amplitude.toml --out out/amplitude
   moreau sweep examples/sweeps/amplitude.toml --out out/shard1 --shard 1/4   # one task of a job array
-  moreau merge out/shard* --out out/amplitude                                  # then join the shards")]
+  moreau merge out/shard* --out out/amplitude                                  # then join the shards
+
+Spec file reference (every key, axis, range, column, output file, limit): docs/sweep-spec.md")]
 pub struct Args {
     /// Sweep specification (TOML): base model, axes, [evaluate], [table].
     pub spec: PathBuf,
