@@ -158,7 +158,7 @@ fn digits_option_changes_only_markdown_and_latex() {
     assert!(a[2].contains("| -2.12 |") && b[2].contains("| -2.12346 |"));
     assert!(matches!(
         sweep::run(&spec, &ev, &RunOptions { digits: Some(0), ..opts(&tmp.path().join("d0")) }),
-        Err(SweepError::BadDigits { digits: 0 })
+        Err(SweepError::BadDigits { digits: 0, source_key: "--digits" })
     ));
 }
 
@@ -326,7 +326,8 @@ fn bad_specs_give_clear_errors() {
     let e = load_err("[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0]\nstep = 2\n", "");
     assert!(matches!(e, SweepError::UnknownKey { .. }), "{e}");
     let e = load_err("[[axis]]\nparameter = \"input.omega\"\nvalues = [1.0]\n", "[table]\ndigits = 40\n");
-    assert!(matches!(e, SweepError::BadDigits { digits: 40 }), "{e}");
+    assert!(matches!(e, SweepError::BadDigits { digits: 40, .. }), "{e}");
+    assert_eq!(e.to_string(), "[table] digits = 40 is out of range: use 1 to 17");
     // an entry making the model invalid is caught at load time (E must stay finite etc.)
     let e = load_err("[[axis]]\nparameter = \"theta.scale\"\nvalues = [-1.0]\n", "");
     assert!(matches!(e, SweepError::NotApplicable { .. }), "{e}");

@@ -50,8 +50,8 @@ pub enum SweepError {
     TooManyPoints { points: u128, limit: usize },
     #[error("bad shard `{text}`: expected K/N with 0 <= K < N (K counts from 0, e.g. $SLURM_ARRAY_TASK_ID)")]
     BadShard { text: String },
-    #[error("--digits {digits} is out of range: use 1 to 17")]
-    BadDigits { digits: usize },
+    #[error("{source_key} {digits} is out of range: use 1 to 17")]
+    BadDigits { digits: i64, source_key: &'static str },
     #[error("{path} holds results of a different sweep (spec hash {found}, this spec {expected}): choose another --out or pass --overwrite")]
     OtherSpec { path: PathBuf, found: String, expected: String },
     #[error("{path}: not a moreau sweep result: {reason}")]

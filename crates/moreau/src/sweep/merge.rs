@@ -148,7 +148,7 @@ pub fn merge_into(
     let mut m = merge(&files, partial)?;
     let digits = digits.unwrap_or(m.table.digits);
     if !(1..=17).contains(&digits) {
-        return Err(SweepError::BadDigits { digits });
+        return Err(SweepError::BadDigits { digits: digits as i64, source_key: "--digits" });
     }
     m.table.digits = digits;
     let written = super::run::write_tables(&m, out, "sweep", digits)?;

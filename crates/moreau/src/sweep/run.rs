@@ -259,7 +259,7 @@ fn evaluate_point(spec: &SweepSpec, evaluator: &dyn Evaluator, index: usize, nco
 pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Result<RunSummary, SweepError> {
     let digits = opts.digits.unwrap_or(spec.table.digits);
     if !(1..=17).contains(&digits) {
-        return Err(SweepError::BadDigits { digits });
+        return Err(SweepError::BadDigits { digits: digits as i64, source_key: "--digits" });
     }
     let mut header = result_header(spec, evaluator, opts.shard, digits);
     if let Some(name) = header.unknown_table_columns().into_iter().next() {

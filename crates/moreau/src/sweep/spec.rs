@@ -245,7 +245,7 @@ impl SweepSpec {
                 if let Some(d) = t.get("digits") {
                     let d = d.as_integer().ok_or_else(|| wrong(path, "table.digits", "an integer"))?;
                     if !(1..=17).contains(&d) {
-                        return Err(SweepError::BadDigits { digits: d.max(0) as usize });
+                        return Err(SweepError::BadDigits { digits: d, source_key: "[table] digits =" });
                     }
                     table.digits = d as usize;
                 }
