@@ -9,6 +9,9 @@
 //!   `StepMap::new(&A, h)`, `apply_held`, `apply_linear`, `SystemStepMap::new(&A, &B, &E, h, hold)`).
 //! - [`integrators::catching_up`]: Moreau's scheme `z_{k+1} = P_{y_{k+1} + Theta}(z_k)` with the
 //!   exact linear step, any [`geometry::Shape`]; [`Simulator`] picks a fixed-size fast path.
+//! - [`integrators::ensemble`]: the same scheme for many trajectories of one system at once
+//!   (structure of arrays, SIMD lanes through `pulp`, the single path's arithmetic lane by lane);
+//!   used by the measured rate (all pairs in one ensemble).
 //! - [`integrators::event_driven`]: the reference integrator (interval: exact piecewise linear;
 //!   ball / ellipsoid: exact free phases, RK4 contact phases), events located by bisection.
 //! - [`convergence`]: error of catching-up against the reference for a ladder of steps, order.

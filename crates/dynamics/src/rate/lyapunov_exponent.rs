@@ -10,9 +10,11 @@
 //! `separation` along the current difference (its `q` re-projected onto `Theta`), and the log of
 //! the scale change is added to the running `ln V`, so distances never underflow nor sink into
 //! rounding noise. Several pairs (random directions, seeded) are measured; the reported exponent
-//! is the largest (slowest convergence), as the limsup over initial conditions.
+//! is the largest (slowest convergence), as the limsup over initial conditions. The reference
+//! and the perturbed trajectories of all pairs run together on the ensemble integrator.
 use crate::error::DynamicsError;
-use crate::integrators::catching_up::{CatchingUpSettings, Simulator};
+use crate::integrators::catching_up::CatchingUpSettings;
+use crate::integrators::ensemble::{Ensemble, EnsembleState};
 use crate::linear::step_map::InputHold;
 use crate::periodic::{period_of, steps_per_period};
 use crate::rate::path_length::{PathAccumulator, PathStats};
@@ -182,6 +184,11 @@ pub fn regression_slope(t: &[f64], y: &[f64]) -> (f64, f64) {
 }
 
 /// Measures the exponent from `(x0, z0)` (default: the system's initial state).
+///
+/// The reference trajectory and the `pairs` perturbed ones run together on the ensemble
+/// integrator ([`Ensemble`]: lane 0 the reference, lane `i` the second trajectory of pair `i`),
+/// which reproduces the single path lane by lane; the reference is simulated once instead of
+/// once per pair.
 pub fn measure_rate(
     sys: &System,
     settings: &RateSettings,
@@ -198,80 +205,98 @@ pub fn measure_rate(
     let (n, p) = (sys.n(), sys.p());
     let pi = settings.pi.as_ref();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
-    let mut pairs = Vec::new();
-    let mut path = PathStats::new();
-    let ts: Vec<f64> = (settings.transient_periods..=settings.periods).map(|j| j as f64 * T).collect();
-    for pair in 0..settings.pairs {
+    let np = settings.pairs;
+    let mut state = EnsembleState::zeros(n, p, np + 1);
+    state.set(0, &x0, &z0);
+    let mut log_v = Vec::with_capacity(np);
+    for pair in 0..np {
         // second state: x2 = x0 + d, q2 = P_Theta(q0 + e), scaled so that sqrt V = separation
         let dx: Vec<f64> = (0..n).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
         let dq: Vec<f64> = (0..p).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
-        let (mut x1, mut z1) = (x0.clone(), z0.clone());
-        let (mut x2, mut z2) = perturbed(sys, &x1, &z1, &dx, &dq, 1.0);
-        let v = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
+        let (mut x2, mut z2) = perturbed(sys, &x0, &z0, &dx, &dq, 1.0);
+        let v = lyapunov_v(sys, pi, &x0, &z0, &x2, &z2);
         if v > 0.0 {
             let s = settings.separation / v.sqrt();
-            (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
+            (x2, z2) = rescale(sys, &x0, &z0, &x2, &z2, s);
         }
-        let mut sim1 = Simulator::new(sys, &cu)?;
-        let mut sim2 = sim1.clone();
-        let mut offset = 0.0;
-        let mut log_v = vec![lyapunov_v(sys, pi, &x1, &z1, &x2, &z2).ln()];
-        let mut renorms = 0;
-        let mut collapsed = false;
-        for j in 0..settings.periods {
-            let t0 = j as f64 * T;
-            if pair == 0 {
-                let mut acc = PathAccumulator::start(&z1);
-                sim1.run(t0, &mut x1, &mut z1, N, |_, _, _, z| acc.observe(z, h));
-                path.per_period.push(acc.length);
-                path.max_speed_per_period.push(acc.max_speed);
-            } else {
-                sim1.run(t0, &mut x1, &mut z1, N, |_, _, _, _| {});
+        state.set(pair + 1, &x2, &z2);
+        log_v.push(vec![lyapunov_v(sys, pi, &x0, &z0, &x2, &z2).ln()]);
+    }
+    let mut ens = Ensemble::new(sys, &cu)?;
+    let mut offset = vec![0.0; np];
+    let mut renorms = vec![0; np];
+    let mut collapsed = vec![false; np];
+    let mut path = PathStats::new();
+    let mut zbuf = vec![0.0; p];
+    for j in 0..settings.periods {
+        let t0 = j as f64 * T;
+        for (i, z) in zbuf.iter_mut().enumerate() {
+            *z = state.z_component(i)[0];
+        }
+        let mut acc = PathAccumulator::start(&zbuf);
+        ens.run_observed(t0, &mut state, N, |_, _, s| {
+            for (i, z) in zbuf.iter_mut().enumerate() {
+                *z = s.z_component(i)[0];
             }
-            sim2.run(t0, &mut x2, &mut z2, N, |_, _, _, _| {});
-            if !(x1.iter().chain(&z1).chain(&x2).chain(&z2).all(|v| v.is_finite())) {
-                return Err(DynamicsError::NonFinite { t: t0 + T });
+            acc.observe(&zbuf, h);
+        });
+        path.per_period.push(acc.length);
+        path.max_speed_per_period.push(acc.max_speed);
+        if !state.all_finite() {
+            return Err(DynamicsError::NonFinite { t: t0 + T });
+        }
+        let (x1, z1) = (state.x_of(0), state.z_of(0));
+        for pair in 0..np {
+            if collapsed[pair] {
+                continue;
             }
+            let (x2, z2) = (state.x_of(pair + 1), state.z_of(pair + 1));
             let v = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
             if v == 0.0 {
-                collapsed = true;
-                break;
+                collapsed[pair] = true;
+                continue;
             }
-            log_v.push(v.ln() + offset);
+            log_v[pair].push(v.ln() + offset[pair]);
             if v.sqrt() < settings.renorm_below * settings.separation {
                 let s = settings.separation / v.sqrt();
-                (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
+                let (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
                 let v_new = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
-                offset += v.ln() - v_new.ln();
-                renorms += 1;
+                offset[pair] += v.ln() - v_new.ln();
+                renorms[pair] += 1;
+                state.set(pair + 1, &x2, &z2);
             }
         }
-        if collapsed {
-            pairs.push(PairRate {
-                exponent: f64::NEG_INFINITY,
-                ci_low: f64::NEG_INFINITY,
-                ci_high: f64::NEG_INFINITY,
-                std_error: 0.0,
-                renormalisations: renorms,
-                log_v,
-                collapsed,
-            });
-            continue;
-        }
-        let ys = &log_v[settings.transient_periods..];
-        let (b, se) = regression_slope(&ts, ys);
-        let tq = t_quantile_975(ts.len().saturating_sub(2));
-        let exponent = 0.5 * b;
-        pairs.push(PairRate {
-            exponent,
-            ci_low: exponent - 0.5 * tq * se,
-            ci_high: exponent + 0.5 * tq * se,
-            std_error: 0.5 * se,
-            renormalisations: renorms,
-            log_v,
-            collapsed,
-        });
     }
+    let ts: Vec<f64> = (settings.transient_periods..=settings.periods).map(|j| j as f64 * T).collect();
+    let tq = t_quantile_975(ts.len().saturating_sub(2));
+    let pairs: Vec<PairRate> = log_v
+        .into_iter()
+        .enumerate()
+        .map(|(pair, log_v)| {
+            if collapsed[pair] {
+                return PairRate {
+                    exponent: f64::NEG_INFINITY,
+                    ci_low: f64::NEG_INFINITY,
+                    ci_high: f64::NEG_INFINITY,
+                    std_error: 0.0,
+                    renormalisations: renorms[pair],
+                    log_v,
+                    collapsed: true,
+                };
+            }
+            let (b, se) = regression_slope(&ts, &log_v[settings.transient_periods..]);
+            let exponent = 0.5 * b;
+            PairRate {
+                exponent,
+                ci_low: exponent - 0.5 * tq * se,
+                ci_high: exponent + 0.5 * tq * se,
+                std_error: 0.5 * se,
+                renormalisations: renorms[pair],
+                log_v,
+                collapsed: false,
+            }
+        })
+        .collect();
     let best = pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent)).expect("pairs >= 1");
     let from = settings.transient_periods;
     Ok(MeasuredRate {

@@ -6,14 +6,16 @@
 //! `(Dz_1 - Dz_2)^T Q(k+1) <= -(|Dz_1| + |Dz_2|) |Q(k+1)|^2 / (2R)` exactly up to rounding;
 //! dividing by `h` this is (QZdot). Per case the step with the smallest normalised slack is
 //! reported. Cases: random systems (mu in `[-2, -0.2]`), strongly convex `Theta`, two initial
-//! states, 2 periods.
+//! states, 2 periods, simulated together on the ensemble integrator (`dynamics::integrators::
+//! ensemble`, the single path's arithmetic lane by lane) and checked step by step on the fly.
 //! Negative control: `1/R` instead of `1/(2R)`; two 1-D trajectories resting on opposite ends
 //! of `[-delta, delta]` attain equality in the claim.
 //! Tolerance: [`fp_tol`] of `(|Dz_1| + |Dz_2| + |z|) (|q_1| + |q_2| + |Q|)`, `|z|` the sum of the
 //! norms of the four `z` values (each `Dz` is a difference of two of them).
 use super::sets_prelude::*;
-use super::simulation::simulate;
 use crate::strategies::systems::{system_params, SystemParams, SystemStrategyConfig};
+use dynamics::integrators::catching_up::CatchingUpSettings;
+use dynamics::integrators::ensemble::{Ensemble, EnsembleState};
 
 pub fn info() -> PropertyInfo {
     PropertyInfo {
@@ -55,47 +57,56 @@ pub fn eval(case: &QzCase, variant: Variant) -> Eval {
     let dt = (T / 2000.0).min(5e-3);
     let steps = (2.0 * T / dt).ceil() as usize;
     let (n, p) = (sys.n(), sys.p());
-    let mut x1: Vec<f64> = sys.x0.iter().copied().collect();
-    let mut z1: Vec<f64> = sys.z0.iter().copied().collect();
-    let (mut x2, mut z2) = second_state(case, &sys);
-    // record z and q of both trajectories
-    let mut tr1: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(steps + 1);
-    let mut tr2: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(steps + 1);
-    let q_of = |x: &[f64], z: &[f64]| -> Vec<f64> {
-        (0..p).map(|i| z[i] - (0..n).map(|j| sys.C[(i, j)] * x[j]).sum::<f64>()).collect()
-    };
-    tr1.push((z1.clone(), q_of(&x1, &z1)));
-    tr2.push((z2.clone(), q_of(&x2, &z2)));
-    if !simulate(&sys, dt, 0.0, &mut x1, &mut z1, steps, |_, x, z| tr1.push((z.to_vec(), q_of(x, z))))
-        || !simulate(&sys, dt, 0.0, &mut x2, &mut z2, steps, |_, x, z| tr2.push((z.to_vec(), q_of(x, z))))
-    {
+    let (x2, z2) = second_state(case, &sys);
+    // both trajectories on the ensemble integrator (lane 0: the system's initial state, lane 1:
+    // the second one), the check made on the fly at every step
+    let Ok(mut ens) = Ensemble::new(&sys, &CatchingUpSettings { dt, ..Default::default() }) else {
         return Eval::skipped();
-    }
+    };
+    let mut state = EnsembleState::zeros(n, p, 2);
+    state.set(0, sys.x0.as_slice(), sys.z0.as_slice());
+    state.set(1, &x2, &z2);
+    let q_of = |s: &EnsembleState, l: usize, i: usize| -> f64 {
+        s.z_component(i)[l] - (0..n).map(|j| sys.C[(i, j)] * s.x_component(j)[l]).sum::<f64>()
+    };
     let k = match variant {
         Variant::Claim => 0.5,
         Variant::NegativeControl => 1.0,
     };
+    // z of both trajectories before the step
+    let mut zp: [Vec<f64>; 2] = [sys.z0.as_slice().to_vec(), z2.clone()];
+    let (mut zn, mut q, mut d) =
+        ([vec![0.0; p], vec![0.0; p]], [vec![0.0; p], vec![0.0; p]], [vec![0.0; p], vec![0.0; p]]);
+    let (mut Q, mut dZ) = (vec![0.0; p], vec![0.0; p]);
     let mut worst: Option<(f64, Eval)> = None;
-    for s in 0..steps {
-        let d1: Vec<f64> = (0..p).map(|i| tr1[s + 1].0[i] - tr1[s].0[i]).collect();
-        let d2: Vec<f64> = (0..p).map(|i| tr2[s + 1].0[i] - tr2[s].0[i]).collect();
-        let (q1, q2) = (&tr1[s + 1].1, &tr2[s + 1].1);
-        let Q: Vec<f64> = (0..p).map(|i| q1[i] - q2[i]).collect();
-        let dZ: Vec<f64> = (0..p).map(|i| d1[i] - d2[i]).collect();
-        let nu = norm(&d1) + norm(&d2);
-        if nu == 0.0 {
-            continue;
+    ens.run_observed(0.0, &mut state, steps, |_, _, s| {
+        for l in 0..2 {
+            for i in 0..p {
+                zn[l][i] = s.z_component(i)[l];
+                q[l][i] = q_of(s, l, i);
+                d[l][i] = zn[l][i] - zp[l][i];
+            }
         }
-        let lhs = dot(&Q, &dZ);
-        let rhs = -k * nu * dot(&Q, &Q) / R;
-        // Dz is a difference of z values: absolute error ~ eps (|z1| + |z2|)
-        let zmag = norm(&tr1[s + 1].0) + norm(&tr2[s + 1].0) + norm(&tr1[s].0) + norm(&tr2[s].0);
-        let e = Eval::new(lhs, rhs, fp_tol((nu + zmag) * (norm(q1) + norm(q2) + norm(&Q)), p));
-        let key = if e.violated() { -2.0 } else { e.slack() };
-        if worst.as_ref().is_none_or(|(w, _)| key < *w) {
-            worst = Some((key, e));
+        for i in 0..p {
+            Q[i] = q[0][i] - q[1][i];
+            dZ[i] = d[0][i] - d[1][i];
         }
-    }
+        let nu = norm(&d[0]) + norm(&d[1]);
+        if nu != 0.0 {
+            let lhs = dot(&Q, &dZ);
+            let rhs = -k * nu * dot(&Q, &Q) / R;
+            // Dz is a difference of z values: absolute error ~ eps (|z1| + |z2|)
+            let zmag = norm(&zn[0]) + norm(&zn[1]) + norm(&zp[0]) + norm(&zp[1]);
+            let e = Eval::new(lhs, rhs, fp_tol((nu + zmag) * (norm(&q[0]) + norm(&q[1]) + norm(&Q)), p));
+            let key = if e.violated() { -2.0 } else { e.slack() };
+            if worst.as_ref().is_none_or(|(w, _)| key < *w) {
+                worst = Some((key, e));
+            }
+        }
+        for l in 0..2 {
+            zp[l].copy_from_slice(&zn[l]);
+        }
+    });
     match worst {
         Some((_, e)) => e,
         None => Eval::skipped(), // the backlash never moved: nothing to check
