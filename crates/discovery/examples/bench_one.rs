@@ -1,5 +1,7 @@
 //! Runs a few benchmark cases and prints each result (development aid).
-//! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital]`.
+//! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital]
+//! [CLASSES]`, `CLASSES` one of `classic` (default: the original 9 classes), `friction`
+//! (none, coulomb_friction and the friction library), `all`, or a comma-separated list.
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1);
@@ -8,8 +10,10 @@ fn main() {
         .get(3)
         .map(|s| discovery::bench_gen::Profile::parse(s).expect("profile: classic or digital"))
         .unwrap_or(discovery::bench_gen::Profile::Classic);
-    let r = discovery::bench::run_with(cases, seed, profile, &Default::default(), |c| {
-        println!("{:>18} -> {:<30} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
+    let classes = discovery::bench::class_set(args.get(4).map_or("classic", |s| s.as_str()))
+        .expect("classes: classic, friction, all or a comma-separated list of class names");
+    let r = discovery::bench::run_classes(&classes, cases, seed, profile, &Default::default(), |c| {
+        println!("{:>18} -> {:<30} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
     });
     println!("{}", r.to_text());
 }

@@ -92,6 +92,7 @@ fn main() {
             tau_slow: 1.0,
             dt: rec.dt,
             duration: rec.duration(),
+            ..Default::default()
         };
         let truth = case.truth.clone().unwrap();
         let x0: Vec<f64> = sys.x0.iter().copied().collect();
@@ -121,6 +122,7 @@ fn main() {
                 hold: discovery::simulate::InputHold::Foh,
                 z0: None,
                 exclude: None,
+                refit: None,
             };
             let r = fit::fit(&pb, &x0, &xs, None, &FitSettings::default());
             println!("  f {f:.2}: sse {:.4}", r.sse);

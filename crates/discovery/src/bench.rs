@@ -1,7 +1,7 @@
 //! The concealed-effect benchmark: generates cases with [`crate::bench_gen`], diagnoses each
 //! with [`crate::diagnose`] (which knows nothing of the generator) and scores the names and
 //! parameters.
-use crate::bench_gen::{self, Conditions, Profile, CLASSES};
+use crate::bench_gen::{self, Conditions, Profile, CLASSES, FRICTION_CLASSES};
 use crate::diagnose::{diagnose, DiagnoseSettings};
 use model::effects::Effect;
 use serde::Serialize;
@@ -26,6 +26,8 @@ pub struct CaseResult {
     pub correct_or_tied: bool,
     /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right.
     pub param_error: Option<f64>,
+    /// The same for every parameter of a friction-library effect ([`all_params`]).
+    pub param_errors: Vec<(String, f64)>,
     pub true_param: Option<f64>,
     pub est_param: Option<f64>,
     /// Reported 1-sigma uncertainty of the estimate (Gauss-Newton or coloured-residual sandwich, the larger).
@@ -57,6 +59,41 @@ pub fn main_param(e: &Effect) -> f64 {
         Effect::InputDelay { delay } => *delay,
         Effect::InputSaturation { limit } => *limit,
         Effect::SensorOffset { offset } => offset[0],
+        Effect::StribeckFriction { static_level, .. } => *static_level,
+        Effect::AsymmetricCoulomb { level_positive, .. } => *level_positive,
+        Effect::Cogging { amplitude, .. } => *amplitude,
+    }
+}
+
+/// Name of the hypothesis parameter that is the main parameter (for its reported
+/// uncertainty); `None` where the main parameter is derived from several.
+fn main_param_name(e: &Effect) -> Option<&'static str> {
+    Some(match e {
+        Effect::Backlash { .. } => "width",
+        Effect::GapWidth { .. } => "relative_change",
+        Effect::CoulombFriction { .. } => "level",
+        Effect::ConstantForce { .. } => "force",
+        Effect::BacklashInertia { .. } => "mass",
+        Effect::InputDelay { .. } => "delay",
+        Effect::InputSaturation { .. } => "limit",
+        Effect::SensorOffset { .. } => "offset",
+        Effect::AsymmetricCoulomb { .. } => "level_positive",
+        Effect::StribeckFriction { .. } | Effect::Cogging { .. } => return None,
+    })
+}
+
+/// Every identifiable parameter of a friction-library effect, `(name, value)` (the main
+/// parameter alone for the other effects).
+pub fn all_params(e: &Effect) -> Vec<(&'static str, f64)> {
+    match e {
+        Effect::StribeckFriction { level, static_level, stribeck_velocity, .. } => {
+            vec![("static_level", *static_level), ("level", *level), ("stribeck_velocity", *stribeck_velocity)]
+        }
+        Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
+            vec![("level_positive", *level_positive), ("level_negative", *level_negative)]
+        }
+        Effect::Cogging { amplitude, period, .. } => vec![("amplitude", *amplitude), ("period", *period)],
+        _ => vec![("main", main_param(e))],
     }
 }
 
@@ -98,6 +135,7 @@ pub fn run_case_with(
         correct: false,
         correct_or_tied: false,
         param_error: None,
+        param_errors: vec![],
         true_param: case.truth.as_ref().map(main_param),
         est_param: None,
         est_std: None,
@@ -122,7 +160,10 @@ pub fn run_case_with(
                 // on another state is an observationally equivalent but different parameter).
                 let same = |a: &Effect, b: &Effect| match (a, b) {
                     (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. })
-                    | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. }) => i == j,
+                    | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. })
+                    | (Effect::StribeckFriction { state: i, .. }, Effect::StribeckFriction { state: j, .. })
+                    | (Effect::AsymmetricCoulomb { state: i, .. }, Effect::AsymmetricCoulomb { state: j, .. })
+                    | (Effect::Cogging { state: i, .. }, Effect::Cogging { state: j, .. }) => i == j,
                     _ => a.kind() == b.kind(),
                 };
                 if let (Some(t), Some(e)) =
@@ -144,17 +185,32 @@ pub fn run_case_with(
                     }
                     out.est_param = Some(ev);
                     out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
+                    if matches!(
+                        t,
+                        Effect::StribeckFriction { .. } | Effect::AsymmetricCoulomb { .. } | Effect::Cogging { .. }
+                    ) {
+                        out.param_errors = all_params(t)
+                            .iter()
+                            .zip(all_params(e))
+                            .map(|((n, a), (_, b))| (n.to_string(), (b - a).abs() / a.abs().max(1e-300)))
+                            .collect();
+                    }
                     let label = match t {
-                        Effect::CoulombFriction { state, .. } | Effect::ConstantForce { state, .. } => {
+                        Effect::CoulombFriction { state, .. }
+                        | Effect::ConstantForce { state, .. }
+                        | Effect::StribeckFriction { state, .. }
+                        | Effect::AsymmetricCoulomb { state, .. }
+                        | Effect::Cogging { state, .. } => {
                             format!("{}(x{})", t.kind(), state + 1)
                         }
                         _ => String::new(),
                     };
-                    out.est_std = rep
-                        .effects
-                        .iter()
-                        .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))
-                        .and_then(|f| f.uncertainty.first().map(|u| u.1));
+                    out.est_std = main_param_name(t).and_then(|name| {
+                        rep.effects
+                            .iter()
+                            .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))
+                            .and_then(|f| f.uncertainty.iter().find(|u| u.0 == name).map(|u| u.1))
+                    });
                 }
             }
         }
@@ -173,24 +229,50 @@ pub fn run_with(
     seed: u64,
     profile: Profile,
     s: &DiagnoseSettings,
+    progress: impl FnMut(&CaseResult),
+) -> BenchResult {
+    run_classes(&CLASSES, cases, seed, profile, s, progress)
+}
+
+/// The classes of a named set: `classic` ([`CLASSES`]), `friction` (`none`,
+/// `coulomb_friction` and [`FRICTION_CLASSES`]: the friction library against its simplest
+/// member and against false alarms), `all`, or a comma-separated list of class names.
+pub fn class_set(name: &str) -> Option<Vec<&'static str>> {
+    let all = bench_gen::all_classes();
+    match name {
+        "classic" => Some(CLASSES.to_vec()),
+        "friction" => Some(["none", "coulomb_friction"].iter().chain(FRICTION_CLASSES.iter()).copied().collect()),
+        "all" => Some(all),
+        list => list.split(',').map(|c| all.iter().find(|a| **a == c.trim()).copied()).collect(),
+    }
+}
+
+/// Runs `cases` cases of each of `classes` (its first should be `none`: the summary counts
+/// false alarms on it and parameter errors on the others).
+pub fn run_classes(
+    classes: &[&'static str],
+    cases: usize,
+    seed: u64,
+    profile: Profile,
+    s: &DiagnoseSettings,
     mut progress: impl FnMut(&CaseResult),
 ) -> BenchResult {
     let mut results = Vec::new();
     for i in 0..cases {
-        for &c in CLASSES.iter() {
+        for &c in classes.iter() {
             let r = run_case_with(c, seed, i, profile, s);
             progress(&r);
             results.push(r);
         }
     }
-    let k = CLASSES.len();
+    let k = classes.len();
     let mut confusion = vec![vec![0; k + 1]; k];
     for r in &results {
-        let ti = CLASSES.iter().position(|c| *c == r.class).expect("known class");
-        let pi = CLASSES.iter().position(|c| *c == r.predicted).unwrap_or(k);
+        let ti = classes.iter().position(|c| *c == r.class).expect("known class");
+        let pi = classes.iter().position(|c| *c == r.predicted).unwrap_or(k);
         confusion[ti][pi] += 1;
     }
-    BenchResult { classes: CLASSES.iter().map(|s| s.to_string()).collect(), confusion, cases: results }
+    BenchResult { classes: classes.iter().map(|s| s.to_string()).collect(), confusion, cases: results }
 }
 
 impl BenchResult {
@@ -271,6 +353,25 @@ impl BenchResult {
                 z.get(z.len() / 2).copied().unwrap_or(f64::NAN),
                 z.len()
             );
+        }
+        // Every parameter of the friction-library effects.
+        for c in self.classes.iter() {
+            let rows: Vec<&CaseResult> =
+                self.cases.iter().filter(|r| &r.class == c && !r.param_errors.is_empty()).collect();
+            let Some(first) = rows.first() else { continue };
+            s += &format!("  {c:>18}, every parameter:");
+            for (i, (name, _)) in first.param_errors.iter().enumerate() {
+                let mut e: Vec<f64> = rows.iter().filter_map(|r| r.param_errors.get(i).map(|p| p.1)).collect();
+                e.sort_by(f64::total_cmp);
+                let within = e.iter().filter(|x| **x <= 0.15).count();
+                s += &format!(
+                    " {name} median {:.1} %, max {:.1} %, within 15 %: {within}/{};",
+                    100.0 * e[e.len() / 2],
+                    100.0 * e[e.len() - 1],
+                    e.len()
+                );
+            }
+            s.push('\n');
         }
         let (mut w2, mut nz, mut w15, mut np) = (0, 0, 0, 0);
         for r in &self.cases {

@@ -13,7 +13,8 @@
 //! sub-steps per sample (by convergence against the noise level, see [`crate::discretisation`])
 //! and the initial state (the model file's when it states one, else estimated).
 use crate::discretisation::{self, SubstepCheck};
-use crate::fit::{self, FitResult, FitSettings, Problem};
+use crate::fit::missing_input::{self, MissingInput, MISSING_MARGIN, MISSING_SHARE};
+use crate::fit::{self, FitResult, FitSettings, FreeNominal, Problem, Refit};
 use crate::hypothesis::{self, Hypothesis, Kind, Scales};
 use crate::localise::{self, Localisation, RegimeShare, Window};
 use crate::metrics::{self, Fit};
@@ -61,7 +62,39 @@ pub struct DiagnoseSettings {
     pub select: SelectSettings,
     /// Run hypotheses in parallel (rayon). Default true.
     pub parallel: bool,
+    /// Refit the nominal parameters the model file frees (`[fit] free`). Default true.
+    pub refit_nominal: bool,
+    /// Headline metric of the verdict: `Auto` (RMSE in the output's units when a validation
+    /// fit % exceeds 99 %, else fit %), `Fit` or `Rmse`.
+    pub metric: Metric,
 }
+
+/// Headline metric of the verdict (`--metric`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// RMSE when a validation fit % exceeds [`SERVO_FIT_PERCENT`] (a tightly tracking loop
+    /// saturates fit %), else fit %.
+    #[default]
+    Auto,
+    Fit,
+    Rmse,
+}
+
+impl Metric {
+    /// From `auto`, `fit` or `rmse`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(Metric::Auto),
+            "fit" => Some(Metric::Fit),
+            "rmse" => Some(Metric::Rmse),
+            _ => None,
+        }
+    }
+}
+
+/// Fit % above which `Metric::Auto` headlines the RMSE.
+pub const SERVO_FIT_PERCENT: f64 = 99.0;
 
 impl Default for DiagnoseSettings {
     fn default() -> Self {
@@ -82,6 +115,8 @@ impl Default for DiagnoseSettings {
             fit: FitSettings::default(),
             select: SelectSettings::default(),
             parallel: true,
+            refit_nominal: true,
+            metric: Metric::Auto,
         }
     }
 }
@@ -210,12 +245,37 @@ pub struct Ranked {
     pub evidence: String,
     /// Blocked cross-validation, where run.
     pub cv: Option<CvResult>,
+    /// Whether the freed nominal parameters (`[fit] free`) are refitted in this hypothesis.
+    pub refit: bool,
+    /// Their fitted values and 1-sigma uncertainties (empty without a refit; names in the
+    /// report's `nominal_refit`).
+    pub nominal: Vec<f64>,
+    pub nominal_std: Vec<f64>,
     #[serde(skip)]
     pub x0: Vec<f64>,
     #[serde(skip)]
     pub val_sse: f64,
     #[serde(skip)]
     pub parts: Vec<Hypothesis>,
+}
+
+/// Label of the grey-box refit hypothesis ("the plant's parameters were off").
+pub const NOMINAL_REFIT: &str = "nominal_refit";
+
+/// One refitted nominal parameter in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct NominalValue {
+    /// `plant.X[i][j]`.
+    pub name: String,
+    /// Value in the model file.
+    pub nominal: f64,
+    /// Fitted value (written into `fitted.toml`).
+    pub value: f64,
+    /// 1-sigma uncertainty (as for effects; `NaN`, JSON `null`, where not identifiable).
+    pub std: f64,
+    /// `value / nominal - 1` (`None` for a zero nominal).
+    pub relative_change: Option<f64>,
+    pub bounds: Option<(f64, f64)>,
 }
 
 /// Time series kept for figures.
@@ -255,6 +315,19 @@ pub struct Report {
     pub fit_before: Fit,
     /// Selected model on the validation segment.
     pub fit_after: Fit,
+    /// `fit` or `rmse`: what the verdict's headline states (see [`Metric`]).
+    pub headline_metric: &'static str,
+    /// The verdict's metric part (fit % or RMSE in units, velocity RMSE and fit %).
+    pub headline: String,
+    /// Units of the outputs (`[signals] y`; empty strings where not stated).
+    pub units: Vec<String>,
+    /// Grey-box refit: the freed nominal parameters (`[fit] free`) as selected (empty when
+    /// the refit was not selected or none is freed), written into `fitted.toml`.
+    pub nominal_refit: Vec<NominalValue>,
+    /// The freed nominal parameters' names (`[fit] free`), refitted or not.
+    pub free_parameters: Vec<String>,
+    /// Recorded columns that are not model inputs, tested as missing inputs.
+    pub missing_inputs: Vec<MissingInput>,
     pub residual_nominal: ResidualTests,
     pub residual_fitted: ResidualTests,
     /// Whether the nominal residual passes both tests.
@@ -291,11 +364,28 @@ struct Ctx<'a> {
     x0_init: Vec<f64>,
     hold: InputHold,
     z0: Option<Vec<f64>>,
+    /// Freed nominal parameters (`[fit] free`), if any.
+    free: Option<&'a FreeNominal>,
 }
 
 impl<'a> Ctx<'a> {
     fn problem(&'a self, fixed: Vec<Effect>, parts: Vec<Hypothesis>) -> Problem<'a> {
         self.problem_on(fixed, parts, self.k_est, None)
+    }
+    /// The problem of `parts` with the freed nominal parameters refitted from `nominal` (or
+    /// held at the model file's values: `None`).
+    fn problem_r(&'a self, parts: Vec<Hypothesis>, nominal: Option<&[f64]>) -> Problem<'a> {
+        self.with_refit(self.problem(vec![], parts), nominal)
+    }
+    /// The problem of a fitted hypothesis (its freed nominal parameters at their fit).
+    fn problem_of(&'a self, r: &Ranked) -> Problem<'a> {
+        self.problem_r(r.parts.clone(), r.refit.then_some(&r.nominal[..]))
+    }
+    fn with_refit(&'a self, mut pb: Problem<'a>, nominal: Option<&[f64]>) -> Problem<'a> {
+        if let (Some(free), Some(v)) = (self.free, nominal) {
+            pb.refit = Some(Refit { free, values: v.to_vec() });
+        }
+        pb
     }
     /// The problem with residuals on `[0, k_end)` minus `exclude`.
     fn problem_on(
@@ -322,6 +412,7 @@ impl<'a> Ctx<'a> {
             hold: self.hold,
             z0: self.z0.clone(),
             exclude,
+            refit: None,
         }
     }
     fn weighted_sse(&self, yhat: &[f64], k0: usize, k1: usize) -> f64 {
@@ -342,8 +433,9 @@ struct Selection {
     ranking: Vec<Ranked>,
     chosen: Option<Ranked>,
     ties: Vec<String>,
-    /// Candidates that passed the BIC margin but failed cross-validation (label, CV ratio).
-    cv_rejected: Vec<(String, f64)>,
+    /// Candidates that passed the BIC margin but failed cross-validation (label, CV ratio,
+    /// the ratio required).
+    cv_rejected: Vec<(String, f64, f64)>,
 }
 
 fn failed_fit(p: usize) -> Fit {
@@ -351,33 +443,42 @@ fn failed_fit(p: usize) -> Fit {
         fit_percent: vec![Some(f64::NEG_INFINITY); p],
         rmse: vec![f64::INFINITY; p],
         velocity_fit_percent: vec![Some(f64::NEG_INFINITY); p],
+        velocity_rmse: vec![f64::INFINITY; p],
         constant_outputs: vec![],
     }
 }
 
-/// Fits one (composite) hypothesis on the estimation segment.
+/// Fits one (composite) hypothesis on the estimation segment; `refit`: the freed nominal
+/// parameters are fitted too, from these values.
+#[allow(clippy::too_many_arguments)]
 fn run_one(
     ctx: &Ctx,
     s: &DiagnoseSettings,
     parts: Vec<Hypothesis>,
+    refit: Option<Vec<f64>>,
     warm: Option<Vec<f64>>,
     x0: &[f64],
     bic_nom: f64,
     val_sse_nom: f64,
 ) -> Ranked {
     let (p, n_samp, k_est, nx) = (ctx.p, ctx.n, ctx.k_est, ctx.x_scale.len());
-    let pb = ctx.problem(vec![], parts.clone());
+    let pb = ctx.problem_r(parts.clone(), refit.as_deref());
     let r: FitResult = fit::fit(&pb, x0, &ctx.x_scale, warm.as_deref(), &s.fit);
-    let (val, val_sse) = match pb.simulate(&r.theta, &r.x0, None) {
+    let (val, val_sse) = match pb.simulate_with(&r.theta, &r.nominal, &r.x0, None) {
         Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, ctx.dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
         None => (failed_fit(p), f64::INFINITY),
     };
-    let b = select::bic(r.sse, k_est * p, pb.k() + nx);
+    let b = select::bic(r.sse, k_est * p, pb.k() + pb.k_nominal() + nx);
+    let is_refit = pb.refit.is_some();
+    let labels = is_refit.then(|| NOMINAL_REFIT.to_string()).into_iter();
     Ranked {
-        label: parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>().join(" + "),
-        kinds: parts.iter().map(|h| h.kind.name().to_string()).collect(),
+        label: labels.clone().chain(parts.iter().map(|h| h.kind.label())).collect::<Vec<_>>().join(" + "),
+        kinds: labels.chain(parts.iter().map(|h| h.kind.name().to_string())).collect(),
         params: r.theta.clone(),
         std: r.std.clone(),
+        refit: is_refit,
+        nominal: r.nominal.clone(),
+        nominal_std: r.nominal_std.clone(),
         sse_estimation: r.sse,
         bic: b,
         delta_bic: bic_nom - b,
@@ -400,18 +501,25 @@ fn folds(n: usize, k: usize) -> Vec<(usize, usize)> {
 
 /// Held-out SSE per fold of `parts` (refitted on the other folds from `params`, `x0`), and
 /// the full-record prediction of the estimation fit.
-fn cv_sse(ctx: &Ctx, s: &DiagnoseSettings, parts: &[Hypothesis], params: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
+fn cv_sse(
+    ctx: &Ctx,
+    s: &DiagnoseSettings,
+    parts: &[Hypothesis],
+    nominal: Option<&[f64]>,
+    params: &[f64],
+    x0: &[f64],
+) -> Option<Vec<f64>> {
     let n = ctx.n;
     let fs = fit::FitSettings { max_iter_start: s.cv_iter, max_iter: 0, ..s.fit.clone() };
     let one = |&(b0, b1): &(usize, usize)| -> Option<f64> {
-        let pb = ctx.problem_on(vec![], parts.to_vec(), n, Some((b0, b1)));
-        let (theta, x0f) = if pb.k() == 0 && ctx.x_scale.is_empty() {
-            (vec![], x0.to_vec())
+        let pb = ctx.with_refit(ctx.problem_on(vec![], parts.to_vec(), n, Some((b0, b1))), nominal);
+        let (theta, nom, x0f) = if pb.k() == 0 && pb.k_nominal() == 0 && ctx.x_scale.is_empty() {
+            (vec![], vec![], x0.to_vec())
         } else {
             let r = fit::fit(&pb, x0, &ctx.x_scale, Some(params), &fs);
-            (r.theta, r.x0)
+            (r.theta, r.nominal, r.x0)
         };
-        let sim = pb.simulate(&theta, &x0f, None)?;
+        let sim = pb.simulate_with(&theta, &nom, &x0f, None)?;
         Some(ctx.weighted_sse(&sim.y, b0, b1))
     };
     let fl = folds(n, s.cv_folds);
@@ -422,14 +530,15 @@ fn cv_sse(ctx: &Ctx, s: &DiagnoseSettings, parts: &[Hypothesis], params: &[f64],
 /// Cross-validates `cand` against `base` (held-out SSE per fold `base_sse`).
 fn cross_validate(ctx: &Ctx, s: &DiagnoseSettings, cand: &Ranked, base: &Ranked, base_sse: &[f64]) -> CvResult {
     let fl = folds(ctx.n, s.cv_folds);
-    let sim = |r: &Ranked| ctx.problem(vec![], r.parts.clone()).simulate(&r.params, &r.x0, None).map(|o| o.y);
+    let sim = |r: &Ranked| ctx.problem_of(r).simulate(&r.params, &r.x0, None).map(|o| o.y);
     let infl: Vec<f64> = match (sim(cand), sim(base)) {
         (Some(a), Some(b)) => fl.iter().map(|&(b0, b1)| ctx.weighted_sse_between(&a, &b, b0, b1)).collect(),
         _ => vec![1.0; fl.len()],
     };
     let tot: f64 = infl.iter().sum();
     let max_fold_share = if tot > 0.0 { infl.iter().copied().fold(0.0, f64::max) / tot } else { 1.0 };
-    let sse = cv_sse(ctx, s, &cand.parts, &cand.params, &cand.x0).unwrap_or_else(|| vec![f64::INFINITY; fl.len()]);
+    let sse = cv_sse(ctx, s, &cand.parts, cand.refit.then_some(&cand.nominal[..]), &cand.params, &cand.x0)
+        .unwrap_or_else(|| vec![f64::INFINITY; fl.len()]);
     let ratio = sse.iter().sum::<f64>() / base_sse.iter().sum::<f64>().max(1e-300);
     // Confined to one fold: the other folds cannot estimate it, and the refit of that fold
     // starts from the estimation fit (which saw it), so its held-out score would be leaked.
@@ -470,10 +579,17 @@ fn evidence_of(r: &Ranked) -> String {
 /// Fits every single hypothesis on the estimation segment (sorted by BIC).
 fn fit_singles(ctx: &Ctx, s: &DiagnoseSettings, sys: &System, nom: &FitResult) -> Vec<Ranked> {
     let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
-    let cands = hypothesis::candidates(sys, &ctx.scales);
-    let one = |h: &Hypothesis| run_one(ctx, s, vec![h.clone()], None, &nom.x0, bic_nom, val_sse_nom);
+    let mut cands = hypothesis::candidates(sys, &ctx.scales);
+    // Several inputs: play, saturation and delay on each input alone, too.
+    cands.extend(crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w));
+    let one = |h: &Hypothesis| run_one(ctx, s, vec![h.clone()], None, None, &nom.x0, bic_nom, val_sse_nom);
     let mut singles: Vec<Ranked> =
         if s.parallel { cands.par_iter().map(one).collect() } else { cands.iter().map(one).collect() };
+    // Grey-box refit: the freed nominal parameters alone, ranked with the effects ("the
+    // plant's parameters were off" is a hypothesis of its own, not missing physics).
+    if let Some(free) = ctx.free {
+        singles.push(run_one(ctx, s, vec![], Some(free.nominal.clone()), None, &nom.x0, bic_nom, val_sse_nom));
+    }
     singles.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     singles
 }
@@ -505,6 +621,9 @@ fn select_all(
         kinds: vec![],
         params: vec![],
         std: vec![],
+        refit: false,
+        nominal: vec![],
+        nominal_std: vec![],
         sse_estimation: nom.sse,
         bic: bic_nom,
         delta_bic: 0.0,
@@ -523,7 +642,7 @@ fn select_all(
     let mut cv_rejected = Vec::new();
     let mut extra: Vec<Ranked> = Vec::new();
     if !nominal_adequate {
-        let base_sse = cv_sse(ctx, s, &[], &[], &nom.x0).unwrap_or_else(|| vec![f64::INFINITY; s.cv_folds]);
+        let base_sse = cv_sse(ctx, s, &[], None, &[], &nom.x0).unwrap_or_else(|| vec![f64::INFINITY; s.cv_folds]);
         // Singles: cross-validate the best few that clear the BIC margin.
         let mut tried = 0;
         for r in singles.iter_mut() {
@@ -534,12 +653,35 @@ fn select_all(
             let cv = cross_validate(ctx, s, r, &nominal_ranked, &base_sse);
             r.beats_nominal = cv.status != "failed";
             if !r.beats_nominal {
-                cv_rejected.push((r.label.clone(), cv.ratio));
+                cv_rejected.push((r.label.clone(), cv.ratio, 1.0 - s.select.min_val_gain));
             }
             r.cv = Some(cv);
             if r.beats_nominal {
                 // The best accepted single is found; the rest keep their BIC evidence only.
                 break;
+            }
+        }
+        // A generalisation of a simpler single (hypothesis::simpler_form: Stribeck or
+        // direction-dependent friction over Coulomb friction) must also beat it on held-out folds.
+        if let Some(bi) = singles.iter().position(|r| r.beats_nominal) {
+            let simple = singles[bi].parts.first().and_then(|h| hypothesis::simpler_form(h.kind));
+            let si = simple.and_then(|k| singles.iter().position(|r| r.parts.len() == 1 && r.parts[0].kind == k));
+            if let (Some(si), 1) = (si, singles[bi].parts.len()) {
+                let sb = &singles[si];
+                let sse_s = cv_sse(ctx, s, &sb.parts, sb.refit.then_some(&sb.nominal[..]), &sb.params, &sb.x0)
+                    .unwrap_or_else(|| vec![f64::INFINITY; s.cv_folds]);
+                let cv = cross_validate(ctx, s, &singles[bi], sb, &sse_s);
+                if cv.status != "not_testable" && cv.ratio > hypothesis::NESTED_MAX_CV_RATIO {
+                    let cv0 = cross_validate(ctx, s, &singles[si], &nominal_ranked, &base_sse);
+                    if cv0.status != "failed" {
+                        let label = format!("{} (against {})", singles[bi].label, singles[si].label);
+                        cv_rejected.push((label, cv.ratio, hypothesis::NESTED_MAX_CV_RATIO));
+                        singles[bi].beats_nominal = false;
+                        singles[bi].cv = Some(cv);
+                        singles[si].beats_nominal = true;
+                        singles[si].cv = Some(cv0);
+                    }
+                }
             }
         }
         if let Some(best) = singles.iter().find(|r| r.beats_nominal) {
@@ -552,16 +694,25 @@ fn select_all(
                 .collect();
             let mut cur = best.clone();
             // Greedy forward selection.
+            // The nominal refit counts as a step (it adds parameters), not as an effect.
             while cur.parts.len() < s.max_effects {
                 let seconds: Vec<&Ranked> = singles
                     .iter()
-                    .filter(|r| !cur.parts.iter().any(|p| p.kind.name() == r.parts[0].kind.name()))
+                    .filter(|r| match r.parts.first() {
+                        None => r.refit && !cur.refit,
+                        Some(h) => !cur.parts.iter().any(|p| p.kind.name() == h.kind.name()),
+                    })
                     .take(s.max_second)
                     .collect();
                 let f = |r: &&Ranked| {
                     let mut parts = cur.parts.clone();
-                    parts.push(r.parts[0].clone());
-                    run_one(ctx, s, parts, Some(cur.params.clone()), &cur.x0, bic_nom, val_sse_nom)
+                    parts.extend(r.parts.first().cloned());
+                    let refit = match (cur.refit, r.refit, ctx.free) {
+                        (true, _, _) => Some(cur.nominal.clone()),
+                        (false, true, Some(free)) => Some(free.nominal.clone()),
+                        _ => None,
+                    };
+                    run_one(ctx, s, parts, refit, Some(cur.params.clone()), &cur.x0, bic_nom, val_sse_nom)
                 };
                 let mut combos: Vec<Ranked> =
                     if s.parallel { seconds.par_iter().map(f).collect() } else { seconds.iter().map(f).collect() };
@@ -684,6 +835,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         tau_slow,
         dt,
         duration: rec.duration(),
+        ..Default::default()
     };
     let weights: Vec<f64> = (0..p)
         .map(|i| {
@@ -713,9 +865,11 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         o.finite.then_some(o.y)
     };
     let probe = ExtendedModel::new(sys, &[], dt, k0)?.simulate(&w, dt, &x0_init);
+    let scales = scales.with_nominal(&probe.x, &probe.y, &y, k_est);
     let xmax = probe.x_rms.iter().copied().fold(0.0, f64::max).max(1e-9);
     let x_scale_free: Vec<f64> = probe.x_rms.iter().map(|v| v.max(1e-3 * xmax)).collect();
     let x_scale: Vec<f64> = if x0_fixed { vec![] } else { x_scale_free.clone() };
+    let free_nominal = if s.refit_nominal { FreeNominal::of(sys) } else { None };
     let mk_ctx = |hold: InputHold, k: usize, x_scale: Vec<f64>| Ctx {
         sys,
         scales: scales.clone(),
@@ -733,6 +887,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         x0_init: x0_init.clone(),
         hold,
         z0: z0.clone(),
+        free: free_nominal.as_ref(),
     };
     let fit_nominal = |ctx: &Ctx| fit::fit(&ctx.problem(vec![], vec![]), &ctx.x0_init, &ctx.x_scale, None, &s.fit);
     let n_res = k_est * p;
@@ -783,7 +938,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let mut disc_final: Option<SubstepCheck> = None;
     let mut notes = Vec::new();
     let mut pass = 0;
-    let (sel, e_nom, residual_nominal, nominal_adequate, nom_sim, loc, delta_bic_disc) = loop {
+    let (sel, e_nom, residual_nominal, nominal_adequate, nom_sim, loc, delta_bic_disc) = 'hold: loop {
         let nom_sim =
             ctx.problem(vec![], vec![]).simulate(&[], &nom.x0, None).ok_or(DiscoveryError::Unstable { mu })?;
         let e_nom: Vec<f64> = ctx.y.iter().zip(&nom_sim.y).map(|(a, b)| a - b).collect();
@@ -797,40 +952,55 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         let err = disc.error_rms.max(disc_final.as_ref().map_or(0.0, |d| d.error_rms));
         let delta_bic_disc = discretisation::delta_bic_of_error(err, nom.sse / n_res as f64, n_res);
         let margin = s.select.margin_bic + delta_bic_disc;
+        // State scales and the nominal run for data-derived bounds and starts (hypothesis.rs).
+        ctx.scales = ctx.scales.clone().with_nominal(&nom_sim.x, &nom_sim.y, &ctx.y, k_est);
         let singles = fit_singles(&ctx, s, sys, &nom);
-        // Auto hold: does the best effect confirm the nominal's choice? The nominal's
-        // preference can be an artefact of the missing effect.
+        // Auto hold: do the best effects confirm the nominal's choice? The nominal's
+        // preference can be an artefact of the missing effect. The best few singles are
+        // asked (a flexible wrong effect, e.g. a cogging force, can rank first under the
+        // wrong hold and fit no better under the other).
         if s.input_hold == HoldChoice::Auto && hold_report.effect_delta_bic.is_none() && !nominal_adequate {
-            if let Some(c) = singles.first().filter(|c| nominal_scores(&ctx, &nom).0 - c.bic >= margin) {
+            // Another hold must beat the best single of this one (not only the effect's own fit).
+            let best_bic = singles.first().map_or(f64::INFINITY, |b| b.bic);
+            let leading = singles.iter().filter(|c| nominal_scores(&ctx, &nom).0 - c.bic >= margin).take(3);
+            for (i, c) in leading.enumerate() {
                 let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
                 let ctx_o = mk_ctx(other, ctx.substeps, x_scale.clone());
                 let fo = fit::FitSettings { max_iter: 10, ..s.fit.clone() };
-                let r_o =
-                    fit::fit(&ctx_o.problem(vec![], c.parts.clone()), &c.x0, &ctx_o.x_scale, Some(&c.params), &fo);
-                let d = select::bic(c.sse_estimation, n_res, 0) - select::bic(r_o.sse, n_res, 0);
-                hold_report.effect_delta_bic = Some(d);
+                let r_o = fit::fit(&ctx_o.problem_of(c), &c.x0, &ctx_o.x_scale, Some(&c.params), &fo);
+                let d = select::bic(c.sse_estimation, n_res, 0) - select::bic(r_o.sse, n_res, 0) - (c.bic - best_bic);
+                if i == 0 {
+                    hold_report.effect_delta_bic = Some(d);
+                }
                 // With an input delay, hold and delay are confounded (a zero-order hold acts like
                 // a first-order hold delayed by h/2): the nominal's preference says nothing and
                 // the effect's comparison decides, by any margin.
-                let has_delay = c.parts.iter().any(|h| h.kind == Kind::InputDelay);
+                let has_delay = c.parts.iter().any(|h| {
+                    matches!(
+                        h.kind,
+                        Kind::InputDelay | Kind::InputOn { op: crate::fit::input_effects::InputOp::Delay, .. }
+                    )
+                });
                 let threshold = if has_delay { 0.0 } else { s.select.tie_bic };
                 if d > threshold {
                     notes.push(format!(
-                        "Input hold: the nominal model preferred {} (by {:.1} in BIC), but the best effect ({}) fits better with {} by {d:.1}: the missing effect had biased the nominal's choice; the diagnosis was redone with {}.",
+                        "Input hold: the nominal model preferred {} (by {:.1} in BIC), but {} fitted with {} beats the best effect with {} by {d:.1} in BIC: the missing effect had biased the nominal's choice; the diagnosis was redone with {}.",
                         hold.name(),
                         hold_report.delta_bic.unwrap_or(0.0),
                         c.label,
                         other.name(),
+                        hold.name(),
                         other.name()
                     ));
                     hold = other;
+                    hold_report.effect_delta_bic = Some(d);
                     hold_report.chosen = other.name();
                     hold_report.switched = true;
                     disc = discretisation::converge(|k| sim_nominal(hold, k), ctx.substeps, max_sub, &weights, tol);
                     ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
                     nom = fit_nominal(&ctx);
                     disc_final = None;
-                    continue;
+                    continue 'hold;
                 }
             }
         }
@@ -839,9 +1009,13 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         if let Some(c) = &sel.chosen {
             let effects = ctx.problem(vec![], c.parts.clone()).effects(&c.params);
             let x0c = c.x0.clone();
+            let sys_c = match (c.refit, &free_nominal) {
+                (true, Some(f)) => f.system_at(&c.nominal),
+                _ => sys.clone(),
+            };
             let chk = discretisation::converge(
                 |k| {
-                    let ext = ExtendedModel::new(sys, &effects, dt, k).ok()?.with_hold(hold);
+                    let ext = ExtendedModel::new(&sys_c, &effects, dt, k).ok()?.with_hold(hold);
                     let o = ext.simulate_from(&w, dt, &x0c, z0.as_deref());
                     o.finite.then_some(o.y)
                 },
@@ -870,7 +1044,38 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let substeps = ctx.substeps;
     let bic_nom = select::bic(nom.sse, n_res, ctx.x_scale.len());
     let fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, dt);
-    let Selection { ranking, chosen, ties, cv_rejected } = sel;
+    let Selection { ranking, mut chosen, mut ties, cv_rejected } = sel;
+    // Recorded columns the model does not use: does the residual follow one of them?
+    let missing_inputs: Vec<MissingInput> = if nominal_adequate || rec.extra.is_empty() {
+        vec![]
+    } else {
+        let best = ranking
+            .iter()
+            .filter(|r| r.sse_estimation.is_finite())
+            .min_by(|a, b| a.sse_estimation.total_cmp(&b.sse_estimation));
+        let (best_share, best_label) = best
+            .map(|r| ((1.0 - r.sse_estimation / nom.sse.max(1e-300)).max(0.0), r.label.clone()))
+            .unwrap_or((0.0, "none".into()));
+        rec.extra
+            .iter()
+            .filter_map(|(name, u)| {
+                let share = missing_input::explained_share(sys, u, &e_nom, &ctx.weights, k_est, dt, substeps, hold)?;
+                Some(MissingInput {
+                    column: name.clone(),
+                    explained: share,
+                    best_hypothesis_explained: best_share,
+                    best_hypothesis: best_label.clone(),
+                    missing: share >= MISSING_SHARE && share > best_share + MISSING_MARGIN,
+                })
+            })
+            .collect()
+    };
+    let missing: Vec<&MissingInput> = missing_inputs.iter().filter(|c| c.missing).collect();
+    if !missing.is_empty() {
+        // An input the model leaves out is not physics to be stood in for by an effect.
+        chosen = None;
+        ties.clear();
+    }
     // Initial state report (with the model file's x0: how much freeing it would gain).
     let initial_state = if x0_fixed {
         let free = fit_nominal(&mk_ctx(hold, substeps, x_scale_free.clone()));
@@ -912,10 +1117,9 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             delta_bic_disc
         ));
     }
-    for (l, r) in &cv_rejected {
+    for (l, r, req) in &cv_rejected {
         notes.push(format!(
-            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {:.2} required): rejected.",
-            1.0 - s.select.min_val_gain
+            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {req:.2} required): rejected."
         ));
     }
 
@@ -927,18 +1131,51 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         }
         None => (vec![], nom.x0.clone()),
     };
-    let fit_pb = ctx.problem(effects_chosen.clone(), vec![]);
-    let fit_sim = fit_pb.simulate(&[], &x0_fit, None).unwrap_or(nom_sim.clone());
+    let fit_sim = match &chosen {
+        Some(c) => ctx.problem_of(c).simulate(&c.params, &c.x0, None),
+        None => None,
+    }
+    .unwrap_or(nom_sim.clone());
     let fit_after = metrics::fit(&ctx.y, &fit_sim.y, p, k_est, n_samp, dt);
     let e_fit: Vec<f64> = ctx.y.iter().zip(&fit_sim.y).map(|(a, b)| a - b).collect();
     let lag_step = ((tau_slow / dt) / 10.0).floor().max(1.0) as usize;
     let residual_fitted = tests_for(&e_fit, &ctx.w, n_samp, m, p, s.lags, lag_step);
     let mut fitted_sys = sys.clone();
+    // Grey-box refit: the fitted nominal parameters replace the model file's, and each is
+    // recorded with its nominal value and uncertainty (`[fit.result]`).
+    let nominal_refit: Vec<NominalValue> = match (&chosen, &free_nominal) {
+        (Some(c), Some(f)) if c.refit => f
+            .params
+            .iter()
+            .enumerate()
+            .map(|(i, fp)| NominalValue {
+                name: fp.name.clone(),
+                nominal: f.nominal[i],
+                value: c.nominal[i],
+                std: c.nominal_std[i],
+                relative_change: (f.nominal[i] != 0.0).then(|| c.nominal[i] / f.nominal[i] - 1.0),
+                bounds: fp.bounds,
+            })
+            .collect(),
+        _ => vec![],
+    };
+    if let (Some(f), false) = (&free_nominal, nominal_refit.is_empty()) {
+        fitted_sys = f.apply(&fitted_sys, &nominal_refit.iter().map(|v| v.value).collect::<Vec<_>>());
+        fitted_sys.fit.result = nominal_refit
+            .iter()
+            .map(|v| model::model_file::FitRecord {
+                name: v.name.clone(),
+                nominal: v.nominal,
+                value: v.value,
+                std: v.std,
+            })
+            .collect();
+    }
     fitted_sys.effects.list.extend(effects_chosen.iter().cloned());
     fitted_sys.x0 = nalgebra::DVector::from_column_slice(&x0_fit);
     fitted_sys.z0 = match &z0 {
         Some(z) => nalgebra::DVector::from_column_slice(z),
-        None => &sys.C * &fitted_sys.x0,
+        None => &fitted_sys.C * &fitted_sys.x0,
     };
     fitted_sys.name = format!("{} (fitted by moreau diagnose)", sys.name);
     // The recording's input (on the uniform grid the fit used, time from 0) and the fit's
@@ -946,26 +1183,43 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     // file's input is interpolated linearly between its samples: a zero-order hold is
     // written as two samples per interval (at t_k and one sub-step before t_{k+1}), so that
     // only the last sub-step of each interval ramps.
-    let sub_w = substeps.max(2);
-    let h_sub = dt / sub_w as f64;
+    // Per-input effects (several inputs) are applied to the written input: the input the
+    // plant sees on the sub-step grid, written as samples of that grid.
+    let input_ops = match &chosen {
+        Some(c) => ctx.problem(vec![], c.parts.clone()).input_ops(&c.params),
+        None => vec![],
+    };
+    let (w_rows, n_rows, dt_rows, sub_rows): (Vec<Vec<f64>>, usize, f64, usize) = if input_ops.is_empty() {
+        (rec.w.clone(), n_samp, dt, substeps)
+    } else {
+        let wf = crate::fit::input_effects::transform(&ctx.w, m, dt, substeps, hold, &input_ops);
+        let nf = wf.len() / m;
+        notes.push(format!(
+            "{} act(s) on one input only, which a model file cannot state: fitted.toml's input file ({FITTED_INPUT_FILE}) holds the input as the plant sees it (after these effects, on the grid of {substeps} sub-step(s) per sample), and its effect list omits them.",
+            input_ops.iter().map(|o| o.0.label(o.1)).collect::<Vec<_>>().join(", ")
+        ));
+        (wf.chunks(m).map(|r| r.to_vec()).collect(), nf, dt / substeps as f64, 1)
+    };
+    let sub_w = sub_rows.max(2);
+    let h_sub = dt_rows / sub_w as f64;
     let (t_in, w_in): (Vec<f64>, Vec<Vec<f64>>) = match hold {
-        InputHold::Foh => ((0..n_samp).map(|k| k as f64 * dt).collect(), rec.w.clone()),
+        InputHold::Foh => ((0..n_rows).map(|k| k as f64 * dt_rows).collect(), w_rows),
         InputHold::Zoh => {
-            let mut t = Vec::with_capacity(2 * n_samp);
-            let mut wv = Vec::with_capacity(2 * n_samp);
-            for k in 0..n_samp {
-                t.push(k as f64 * dt);
-                wv.push(rec.w[k].clone());
-                if k + 1 < n_samp {
-                    t.push((k + 1) as f64 * dt - h_sub);
-                    wv.push(rec.w[k].clone());
+            let mut t = Vec::with_capacity(2 * n_rows);
+            let mut wv = Vec::with_capacity(2 * n_rows);
+            for (k, row) in w_rows.iter().enumerate() {
+                t.push(k as f64 * dt_rows);
+                wv.push(row.clone());
+                if k + 1 < n_rows {
+                    t.push((k + 1) as f64 * dt_rows - h_sub);
+                    wv.push(row.clone());
                 }
             }
             (t, wv)
         }
     };
     fitted_sys.input = Input::Samples { path: FITTED_INPUT_FILE.into(), t: t_in, w: w_in, period: None };
-    let sim_dt = if hold == InputHold::Zoh { h_sub } else { dt / substeps as f64 };
+    let sim_dt = if hold == InputHold::Zoh { h_sub } else { dt_rows / sub_rows as f64 };
     fitted_sys.sim = SimDefaults { dt: sim_dt, periods: 1, t_end: Some((n_samp - 1) as f64 * dt) };
     if hold == InputHold::Zoh {
         notes.push(format!(
@@ -1007,29 +1261,67 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         None => vec![],
     };
     let untestable = chosen.as_ref().is_some_and(|c| c.cv.as_ref().is_some_and(|v| v.status == "not_testable"));
+    let units: Vec<String> = (0..p).map(|i| sys.signals.y_unit(i).to_string()).collect();
+    let use_rmse = match s.metric {
+        Metric::Rmse => true,
+        Metric::Fit => false,
+        Metric::Auto => metrics::saturated(&fit_before, &fit_after, SERVO_FIT_PERCENT),
+    };
+    let headline_metric = if use_rmse || !fit_before.constant_outputs.is_empty() { "rmse" } else { "fit" };
+    let headline = if use_rmse {
+        metrics::headline_rmse(&fit_before, &fit_after, &units)
+    } else if fit_before.constant_outputs.is_empty() {
+        format!("validation fit {} -> {} %", fmt_opt(&fit_before.fit_percent), fmt_opt(&fit_after.fit_percent))
+    } else {
+        format!(
+            "validation RMSE {} -> {}; fit % undefined, the validation output is constant",
+            fmt_units(&fit_before.rmse, &units),
+            fmt_units(&fit_after.rmse, &units)
+        )
+    };
+    if use_rmse && s.metric == Metric::Auto {
+        notes.push(format!(
+            "The validation fit % exceeds {SERVO_FIT_PERCENT} % (a tightly tracking loop saturates it): the verdict states the RMSE in the output's units{} and the derived velocity's RMSE and fit % (5-point moving average, then central difference, the same filter on measurement and simulation).",
+            if units.iter().all(|u| u.is_empty()) { " (no `[signals] y` unit in the model file: unitless)" } else { "" }
+        ));
+    }
+    let refit_only = chosen.as_ref().is_some_and(|c| c.refit && c.parts.is_empty());
     let verdict = if nominal_adequate {
         "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)"
             .to_string()
+    } else if !missing.is_empty() {
+        missing
+            .iter()
+            .map(|c| {
+                format!(
+                    "input {} is missing from the model: fed through the nominal dynamics it explains {:.0} % of the nominal residual (the best hypothesis of the library, {}, {:.0} %); add it to the model's inputs (a column of B) instead of fitting an effect",
+                    c.column,
+                    100.0 * c.explained,
+                    c.best_hypothesis,
+                    100.0 * c.best_hypothesis_explained
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
     } else if let Some(c) = &chosen {
         let tail = if untestable {
             " (supported by the estimation data; not testable on validation: its effect lies in one fold of the record)"
         } else {
             ""
         };
-        if fit_before.constant_outputs.is_empty() {
+        if refit_only {
             format!(
-                "missing physics: {}{tail} (validation fit {} -> {} %)",
-                c.label,
-                fmt_opt(&fit_before.fit_percent),
-                fmt_opt(&fit_after.fit_percent)
+                "the plant's parameters were off, not missing physics: {}{tail} ({headline})",
+                fmt_nominal(&nominal_refit)
+            )
+        } else if c.refit {
+            let effects_label = c.parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>().join(" + ");
+            format!(
+                "missing physics: {effects_label}{tail}, with the plant's parameters refitted ({}) ({headline})",
+                fmt_nominal(&nominal_refit)
             )
         } else {
-            format!(
-                "missing physics: {}{tail} (validation RMSE {} -> {}; fit % undefined, the validation output is constant)",
-                c.label,
-                fmt_e(&fit_before.rmse),
-                fmt_e(&fit_after.rmse)
-            )
+            format!("missing physics: {}{tail} ({headline})", c.label)
         }
     } else if !cv_rejected.is_empty() {
         format!(
@@ -1046,12 +1338,43 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             metrics::TOL_CONSTANT
         ));
     }
-    if fit_before.fit_percent.iter().flatten().any(|f| *f > 97.0) {
+    if let Some(free) = &free_nominal {
+        if nominal_refit.is_empty() {
+            let r = ranking.iter().find(|r| r.refit && r.parts.is_empty());
+            notes.push(format!(
+                "The model file frees {} ([fit] free); refitting them was not selected{}: the nominal values stand.",
+                free.names().join(", "),
+                r.map_or(String::new(), |r| format!(
+                    " ({NOMINAL_REFIT}: delta BIC {:.1} against the nominal, evidence {})",
+                    r.delta_bic, r.evidence
+                ))
+            ));
+        } else {
+            notes.push(format!(
+                "Grey-box refit of {} (the model file's [fit] free): fitted jointly with the effects by the same Levenberg-Marquardt, ranked as the hypothesis `{NOMINAL_REFIT}` against the effects and cross-validated like them; the fitted values replace the nominal ones in fitted.toml ([fit.result] keeps both). Uncertainties as for effects; a parameter that the record does not excite has a large or undefined one.",
+                free.names().join(", ")
+            ));
+            let loose: Vec<String> = nominal_refit
+                .iter()
+                .filter(|v| !(v.std.is_finite() && v.std < v.value.abs().max(1e-300)))
+                .map(|v| v.name.clone())
+                .collect();
+            if !loose.is_empty() {
+                notes.push(format!(
+                    "{} {} not identifiable from this record (1-sigma uncertainty above the value, or undefined): the record does not excite it, or it trades off against another freed parameter (with Theta = {{0}}, `A` and `E` enter only through F = A + E C). Free fewer parameters or give bounds.",
+                    loose.join(", "),
+                    if loose.len() == 1 { "is" } else { "are" }
+                ));
+            }
+        }
+    }
+    if fit_before.fit_percent.iter().flatten().any(|f| *f > 97.0) && !use_rmse {
         notes.push("Plain fit % is above 97 % (a tightly tracking loop saturates it): judge by the RMSE ratio (validation_ratio), the velocity fit and BIC instead.".into());
     }
-    let twin =
-        matches!(chosen.as_ref().map(|c| c.parts[0].kind), Some(Kind::ConstantForce { .. } | Kind::SensorOffset))
-            || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset"));
+    let twin = matches!(
+        chosen.as_ref().and_then(|c| c.parts.first()).map(|h| h.kind),
+        Some(Kind::ConstantForce { .. } | Kind::SensorOffset)
+    ) || ties.iter().any(|t| t.starts_with("constant_force") || t.starts_with("sensor_offset"));
     if twin {
         if x0_fixed {
             notes.push("A constant force and a sensor offset are told apart here by the known initial state (the model file's x0): an offset shifts y(0) itself, a force only bends the trajectory after it.".into());
@@ -1059,6 +1382,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
             notes.push("A constant force b on state j and a sensor offset C F^{-1} e_j b are observationally equivalent when the initial state is free (the play is translation invariant): the recording cannot tell them apart; physics must (or a known x0 in the model file).".into());
         }
     }
+    notes.extend(hypothesis::friction_notes(&effects_chosen, &ties));
     if chosen.as_ref().is_some_and(|c| c.parts.iter().any(|h| h.kind == Kind::InputDelay)) {
         notes.push(format!(
             "An input delay trades off against the input hold: a zero-order hold acts like a first-order hold delayed by h/2 = {:.3e} s. The delay is reported for the {} hold; under the {} hold it is {} (effects[].other_hold).{}",
@@ -1099,6 +1423,12 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         tau_slow,
         fit_before,
         fit_after,
+        headline_metric,
+        headline,
+        units,
+        nominal_refit,
+        free_parameters: free_nominal.as_ref().map(|f| f.names()).unwrap_or_default(),
+        missing_inputs,
         residual_nominal,
         residual_fitted,
         nominal_adequate,
@@ -1182,18 +1512,21 @@ impl Report {
             self.initial_state.source,
             self.initial_state.delta_bic_free.map_or(String::new(), |d| format!(" (estimating it instead would gain {d:.1} in BIC with the nominal model)"))
         );
-        s += "## Fit on the validation segment\n\n| | fit % | RMSE | velocity fit % |\n|---|---|---|---|\n";
+        s += "## Fit on the validation segment\n\n| | fit % | RMSE | velocity fit % | velocity RMSE |\n|---|---|---|---|---|\n";
+        let vunits: Vec<String> = self.units.iter().map(|u| metrics::per_second(u)).collect();
+        for (name, f) in [("nominal", &self.fit_before), ("fitted", &self.fit_after)] {
+            s += &format!(
+                "| {name} | {} | {} | {} | {} |\n",
+                fmt_opt(&f.fit_percent),
+                fmt_units(&f.rmse, &self.units),
+                fmt_opt(&f.velocity_fit_percent),
+                fmt_units(&f.velocity_rmse, &vunits)
+            );
+        }
         s += &format!(
-            "| nominal | {} | {} | {} |\n",
-            fmt_opt(&self.fit_before.fit_percent),
-            fmt_e(&self.fit_before.rmse),
-            fmt_opt(&self.fit_before.velocity_fit_percent)
-        );
-        s += &format!(
-            "| fitted | {} | {} | {} |\n\n",
-            fmt_opt(&self.fit_after.fit_percent),
-            fmt_e(&self.fit_after.rmse),
-            fmt_opt(&self.fit_after.velocity_fit_percent)
+            "\nHeadline ({}): {}. Velocity: derived from y by a 5-point moving average and a central difference, the same filter on measurement and simulation.\n\n",
+            if self.headline_metric == "rmse" { "RMSE in the output's units" } else { "fit %" },
+            self.headline
         );
         s += "## Residual tests (nominal model)\n\n";
         let r = &self.residual_nominal;
@@ -1225,6 +1558,41 @@ impl Report {
                 100.0 * w.dominant_fraction
             );
         }
+        if !self.missing_inputs.is_empty() {
+            s += "\n## Recorded signals that are not model inputs\n\nEach fed through the linearised nominal dynamics (on every state) and regressed on the nominal residual (estimation segment); reported missing when it explains at least half the residual and 10 points more than the best hypothesis of the library.\n\n| column | residual explained | best hypothesis (explains) | missing input |\n|---|---|---|---|\n";
+            for c in &self.missing_inputs {
+                s += &format!(
+                    "| {} | {:.1} % | {} ({:.1} %) | {} |\n",
+                    c.column,
+                    100.0 * c.explained,
+                    c.best_hypothesis,
+                    100.0 * c.best_hypothesis_explained,
+                    if c.missing { "**yes**" } else { "no" }
+                );
+            }
+        }
+        if !self.free_parameters.is_empty() {
+            s += "\n## Plant parameters (grey-box refit)\n\n";
+            if self.nominal_refit.is_empty() {
+                s += &format!(
+                    "Freed in the model file: {}. Refitting them was not selected (see `{NOMINAL_REFIT}` in the ranking): the nominal values stand.\n",
+                    self.free_parameters.join(", ")
+                );
+            } else {
+                s += "| parameter | nominal | fitted | 1 sigma | change | bounds |\n|---|---|---|---|---|---|\n";
+                for v in &self.nominal_refit {
+                    s += &format!(
+                        "| {} | {} | {} | {} | {} | {} |\n",
+                        v.name,
+                        g4(v.nominal),
+                        g4(v.value),
+                        if v.std.is_finite() { format!("{:.2e}", v.std) } else { "undefined".into() },
+                        v.relative_change.map_or("-".into(), |r| format!("{:+.2} %", 100.0 * r)),
+                        v.bounds.map_or("-".into(), |(a, b)| format!("[{}, {}]", g4(a), g4(b)))
+                    );
+                }
+            }
+        }
         s += "\n## Effects added\n\n";
         if self.effects.is_empty() {
             s += "None.\n\n";
@@ -1251,10 +1619,17 @@ impl Report {
         s += "\n## Ranking of all hypotheses\n\nSelection: BIC gain of at least the margin (plus the discretisation allowance) on the estimation segment, then blocked cross-validation over contiguous folds of the whole record (each held out in turn, the hypothesis and the model it extends refitted on the others). A stuck fit (zero gradient, clipped at a bound) is inconclusive, not evidence against its effect.\n\n| hypothesis | params | delta BIC | validation fit % | validation SSE ratio | CV SSE ratio | fit | evidence |\n|---|---|---|---|---|---|---|---|\n";
         for r in &self.ranking {
             let inconclusive = r.evidence.starts_with("inconclusive");
+            let params = if r.refit {
+                let nom: Vec<String> = r.nominal.iter().map(|v| g4(*v)).collect();
+                let eff = fmt_e(&r.params);
+                format!("{}plant: {}", if eff.is_empty() { String::new() } else { format!("{eff}; ") }, nom.join(", "))
+            } else {
+                fmt_e(&r.params)
+            };
             s += &format!(
                 "| {} | {} | {} | {} | {:.3} | {} | {:?} | {} |\n",
                 r.label,
-                fmt_e(&r.params),
+                params,
                 if inconclusive { "n/a".to_string() } else { format!("{:.1}", r.delta_bic) },
                 fmt_opt(&r.validation.fit_percent),
                 r.validation_ratio,
@@ -1277,6 +1652,42 @@ impl Report {
         }
         s
     }
+}
+
+/// Refitted nominal parameters for a verdict: `name nominal -> value +- std (change %)`.
+fn fmt_nominal(v: &[NominalValue]) -> String {
+    v.iter()
+        .map(|x| {
+            format!(
+                "{} {} -> {} +- {}{}",
+                x.name,
+                g4(x.nominal),
+                g4(x.value),
+                if x.std.is_finite() { format!("{:.2e}", x.std) } else { "undefined".into() },
+                x.relative_change.map_or(String::new(), |r| format!(" ({:+.1} %)", 100.0 * r))
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Four significant digits.
+fn g4(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+        let d = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.d$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// Values with their units (see [`metrics::fmt_quantity`]).
+fn fmt_units(v: &[f64], units: &[String]) -> String {
+    v.iter()
+        .enumerate()
+        .map(|(i, x)| metrics::fmt_quantity(*x, units.get(i).map_or("", |s| s.as_str())))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn fmt_e(v: &[f64]) -> String {

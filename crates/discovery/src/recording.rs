@@ -1,5 +1,7 @@
 //! A recording of the real machine: CSV with header `t,w,y` or `t,w1..wm,y1..yp`, optional
-//! `z` (or `z1..zp`). Checked on reading (missing columns, non-finite values, non-increasing
+//! `z` (or `z1..zp`). Any other column that is numeric throughout is kept as an *extra*
+//! signal ([`Recording::extra`]): not a model input, but the diagnosis checks whether the
+//! residual follows it (an input missing from the model). Checked on reading (missing columns, non-finite values, non-increasing
 //! time, constant inputs) and put on a uniform time grid: irregular time stamps are resampled
 //! by linear interpolation at the median sampling interval.
 use crate::DiscoveryError;
@@ -23,6 +25,8 @@ pub struct Recording {
     pub resampled: bool,
     /// Number of rows in the file.
     pub rows_in_file: usize,
+    /// Other numeric columns of the file (name, samples on the uniform grid), in file order.
+    pub extra: Vec<(String, Vec<f64>)>,
 }
 
 /// Minimum number of samples of a recording.
@@ -100,6 +104,10 @@ impl Recording {
             return Err(missing("y"));
         }
         let iz = col_names("z", &header);
+        // Extra columns: everything else, kept while every value parses as a finite number.
+        let mut ix: Vec<usize> =
+            (0..header.len()).filter(|i| *i != it && !iw.contains(i) && !iy.contains(i) && !iz.contains(i)).collect();
+        let mut xcols: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
         let mut t = Vec::new();
         let mut w = Vec::new();
         let mut y = Vec::new();
@@ -139,6 +147,13 @@ impl Recording {
             if !iz.is_empty() {
                 z.push(iz.iter().map(|&i| get(i)).collect::<Result<Vec<_>, _>>()?);
             }
+            ix.retain(|&i| match rec[i].parse::<f64>() {
+                Ok(v) if v.is_finite() => {
+                    xcols[i].push(v);
+                    true
+                }
+                _ => false,
+            });
         }
         if t.len() < MIN_SAMPLES {
             return Err(DiscoveryError::TooFewSamples { path, rows: t.len(), min: MIN_SAMPLES });
@@ -165,11 +180,25 @@ impl Recording {
             }
         }
         let z = if iz.is_empty() { None } else { Some(z) };
-        Ok(Self::from_samples(source, &t, w, y, z))
+        let extra: Vec<(String, Vec<f64>)> =
+            ix.iter().map(|&i| (header[i].clone(), std::mem::take(&mut xcols[i]))).collect();
+        Ok(Self::from_samples_with_extra(source, &t, w, y, z, extra))
     }
 
     /// Builds a recording from (possibly irregular) samples; times must increase strictly.
     pub fn from_samples(source: &str, t: &[f64], w: Vec<Vec<f64>>, y: Vec<Vec<f64>>, z: Option<Vec<Vec<f64>>>) -> Self {
+        Self::from_samples_with_extra(source, t, w, y, z, vec![])
+    }
+
+    /// As [`Recording::from_samples`] with extra columns (name, one value per time stamp).
+    pub fn from_samples_with_extra(
+        source: &str,
+        t: &[f64],
+        w: Vec<Vec<f64>>,
+        y: Vec<Vec<f64>>,
+        z: Option<Vec<Vec<f64>>>,
+        extra: Vec<(String, Vec<f64>)>,
+    ) -> Self {
         let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
         d.sort_by(f64::total_cmp);
         let dt = d[d.len() / 2];
@@ -177,7 +206,7 @@ impl Recording {
         let irregular = (hi - lo) > 0.01 * dt;
         let rows_in_file = t.len();
         if !irregular {
-            return Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: false, rows_in_file };
+            return Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: false, rows_in_file, extra };
         }
         let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
         let interp = |s: &Vec<Vec<f64>>| -> Vec<Vec<f64>> {
@@ -194,7 +223,14 @@ impl Recording {
             out
         };
         let (w, y, z) = (interp(&w), interp(&y), z.as_ref().map(interp));
-        Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: true, rows_in_file }
+        let extra = extra
+            .into_iter()
+            .map(|(name, v)| {
+                let rows: Vec<Vec<f64>> = v.into_iter().map(|x| vec![x]).collect();
+                (name, interp(&rows).into_iter().map(|r| r[0]).collect())
+            })
+            .collect();
+        Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: true, rows_in_file, extra }
     }
 
     /// Writes the recording as CSV text (`t,w..,y..`).

@@ -159,8 +159,15 @@ fn small_friction_problem() -> (model::System, Vec<f64>, Vec<f64>, f64, Scales) 
     let w: Vec<f64> = (0..n).map(|k| 0.5 * (k as f64 * dt).sin() + 0.2 * (0.6 * k as f64 * dt + 1.0).sin()).collect();
     let y0 = ExtendedModel::new(&sys, &[], dt, 4).unwrap().simulate(&w, dt, &[0.0, 0.0]).y;
     let yr = y0.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y0.iter().copied().fold(f64::INFINITY, f64::min);
-    let scales =
-        Scales { y_range: vec![yr], w_range: vec![3.0], w_absmax: 1.5, tau_slow: 6.7, dt, duration: n as f64 * dt };
+    let scales = Scales {
+        y_range: vec![yr],
+        w_range: vec![3.0],
+        w_absmax: 1.5,
+        tau_slow: 6.7,
+        dt,
+        duration: n as f64 * dt,
+        ..Default::default()
+    };
     let bound = yr; // static gain 1: the hypothesis' bound is range(y)
     let level = 0.002 * bound; // 0.2 % of the bound
     let y = ExtendedModel::new(&sys, &[Effect::CoulombFriction { state: 1, level }], dt, 4)
@@ -196,6 +203,7 @@ fn starts_over_decades_find_a_small_friction_and_stuck_fits_are_flagged() {
         hold: InputHold::Foh,
         z0: None,
         exclude: None,
+        refit: None,
     };
     // Known initial state (empty x scale).
     let r = fit::fit(&pb(&h), &[0.0, 0.0], &[], None, &FitSettings::default());

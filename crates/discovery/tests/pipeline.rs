@@ -62,6 +62,9 @@ fn every_effect_at_zero_equals_the_nominal_model() {
         Effect::InputDelay { delay: 0.0 },
         Effect::InputSaturation { limit: 1e9 },
         Effect::SensorOffset { offset: vec![0.0] },
+        Effect::StribeckFriction { state: 1, level: 0.0, static_level: 0.0, stribeck_velocity: 0.1, viscous: 0.0 },
+        Effect::AsymmetricCoulomb { state: 1, level_positive: 0.0, level_negative: 0.0 },
+        Effect::Cogging { state: 1, position_state: 0, amplitude: 0.0, period: 0.2, phase: 0.5 },
     ];
     for e in zeros {
         let y = ExtendedModel::new(sys, &[e.clone()], dt, 2).unwrap().simulate(&w, dt, &x0).y;

@@ -2,7 +2,7 @@
 //! the `discovery` crate to express what a recording shows and the nominal model lacks.
 //! Each effect equals the nominal model when its parameters are zero (or it is absent), so a
 //! fitted model is an ordinary model file.
-use crate::toml_access::{check_keys, describe, f64_at, key, str_at, vec_at, vec_value};
+use crate::toml_access::{check_keys, describe, f64_at, key, opt_f64, str_at, vec_at, vec_value};
 use crate::ModelError;
 use toml::{Table, Value};
 
@@ -36,6 +36,18 @@ pub enum Effect {
     InputSaturation { limit: f64 },
     /// The sensor reads `y + offset`.
     SensorOffset { offset: Vec<f64> },
+    /// Friction with a static (breakaway) level and a Stribeck curve on velocity state
+    /// `state`: at rest it holds any force up to `static_level`; sliding at velocity `v` it
+    /// opposes the motion with `level + (static_level - level) exp(-(v/stribeck_velocity)^2)
+    /// + viscous |v|`. With `static_level == level` and `viscous == 0` it is Coulomb friction.
+    StribeckFriction { state: usize, level: f64, static_level: f64, stribeck_velocity: f64, viscous: f64 },
+    /// Coulomb friction whose level depends on the direction of motion of velocity state
+    /// `state`: `level_positive` while it moves up (and the most it holds against a push up),
+    /// `level_negative` while it moves down. Equal levels are `coulomb_friction`.
+    AsymmetricCoulomb { state: usize, level_positive: f64, level_negative: f64 },
+    /// A position-periodic (cogging, detent) force `amplitude sin(2 pi x_pos / period + phase)`
+    /// on the derivative of velocity state `state`, `x_pos` being state `position_state`.
+    Cogging { state: usize, position_state: usize, amplitude: f64, period: f64, phase: f64 },
 }
 
 impl Effect {
@@ -50,6 +62,9 @@ impl Effect {
             Effect::InputDelay { .. } => "input_delay",
             Effect::InputSaturation { .. } => "input_saturation",
             Effect::SensorOffset { .. } => "sensor_offset",
+            Effect::StribeckFriction { .. } => "stribeck_friction",
+            Effect::AsymmetricCoulomb { .. } => "asymmetric_coulomb",
+            Effect::Cogging { .. } => "cogging",
         }
     }
 }
@@ -69,15 +84,23 @@ fn nonneg(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
 }
 
 fn state_index(t: &Table, prefix: &str, n: usize) -> Result<usize, ModelError> {
-    let v = f64_at(t, prefix, "state")?;
+    index_at(t, prefix, "state", n)
+}
+
+fn index_at(t: &Table, prefix: &str, k: &str, n: usize) -> Result<usize, ModelError> {
+    let v = f64_at(t, prefix, k)?;
     if v < 0.0 || v.fract() != 0.0 || v as usize >= n {
-        return Err(ModelError::OutOfRange {
-            key: key(prefix, "state"),
-            value: v,
-            reason: "must be a state index 0..n-1",
-        });
+        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be a state index 0..n-1" });
     }
     Ok(v as usize)
+}
+
+fn positive(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
+    let v = f64_at(t, prefix, k)?;
+    if v <= 0.0 {
+        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be positive" });
+    }
+    Ok(v)
 }
 
 impl Effects {
@@ -148,10 +171,59 @@ impl Effects {
                     }
                     Effect::SensorOffset { offset: o }
                 }
+                "stribeck_friction" => {
+                    check_keys(t, &prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
+                    let state = state_index(t, &prefix, n)?;
+                    let level = nonneg(t, &prefix, "level")?;
+                    let static_level = nonneg(t, &prefix, "static_level")?;
+                    if static_level < level {
+                        return Err(ModelError::Invalid {
+                            key: key(&prefix, "static_level"),
+                            value: static_level,
+                            reason: format!("must be at least `level` = {level} (the breakaway level is never below the sliding level)"),
+                        });
+                    }
+                    let stribeck_velocity = positive(t, &prefix, "stribeck_velocity")?;
+                    let viscous = match opt_f64(t, &prefix, "viscous")? {
+                        None => 0.0,
+                        Some(v) if v < 0.0 => {
+                            return Err(ModelError::OutOfRange { key: key(&prefix, "viscous"), value: v, reason: "must be non-negative" })
+                        }
+                        Some(v) => v,
+                    };
+                    Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous }
+                }
+                "asymmetric_coulomb" => {
+                    check_keys(t, &prefix, "kind, state, level_positive, level_negative")?;
+                    Effect::AsymmetricCoulomb {
+                        state: state_index(t, &prefix, n)?,
+                        level_positive: nonneg(t, &prefix, "level_positive")?,
+                        level_negative: nonneg(t, &prefix, "level_negative")?,
+                    }
+                }
+                "cogging" => {
+                    check_keys(t, &prefix, "kind, state, position_state, amplitude, period, phase")?;
+                    let state = state_index(t, &prefix, n)?;
+                    let position_state = index_at(t, &prefix, "position_state", n)?;
+                    if position_state == state {
+                        return Err(ModelError::Invalid {
+                            key: key(&prefix, "position_state"),
+                            value: position_state as f64,
+                            reason: format!("must differ from `state` = {state} (the force acts on the velocity, the period is in the position)"),
+                        });
+                    }
+                    Effect::Cogging {
+                        state,
+                        position_state,
+                        amplitude: f64_at(t, &prefix, "amplitude")?,
+                        period: positive(t, &prefix, "period")?,
+                        phase: opt_f64(t, &prefix, "phase")?.unwrap_or(0.0),
+                    }
+                }
                 other => {
                     return Err(ModelError::WrongType {
                         key: key(&prefix, "kind"),
-                        expected: "one of backlash, gap_width, coulomb_friction, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
+                        expected: "one of backlash, gap_width, coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
                         found: format!("{other:?}"),
                     })
                 }
@@ -202,6 +274,27 @@ impl Effects {
                     }
                     Effect::SensorOffset { offset } => {
                         t.insert("offset".into(), vec_value(offset));
+                    }
+                    Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
+                        t.insert("state".into(), Value::Integer(*state as i64));
+                        t.insert("level".into(), Value::Float(*level));
+                        t.insert("static_level".into(), Value::Float(*static_level));
+                        t.insert("stribeck_velocity".into(), Value::Float(*stribeck_velocity));
+                        if *viscous != 0.0 {
+                            t.insert("viscous".into(), Value::Float(*viscous));
+                        }
+                    }
+                    Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
+                        t.insert("state".into(), Value::Integer(*state as i64));
+                        t.insert("level_positive".into(), Value::Float(*level_positive));
+                        t.insert("level_negative".into(), Value::Float(*level_negative));
+                    }
+                    Effect::Cogging { state, position_state, amplitude, period, phase } => {
+                        t.insert("state".into(), Value::Integer(*state as i64));
+                        t.insert("position_state".into(), Value::Integer(*position_state as i64));
+                        t.insert("amplitude".into(), Value::Float(*amplitude));
+                        t.insert("period".into(), Value::Float(*period));
+                        t.insert("phase".into(), Value::Float(*phase));
                     }
                 }
                 Value::Table(t)

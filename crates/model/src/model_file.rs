@@ -28,6 +28,22 @@
 //! `polytope` (`normals`, `offsets`: `normals[i] . x <= offsets[i]`); `box` (`lower`,
 //! `upper`); `point` (`{0}`). Input `csv`: `file` (relative to the model file) with header
 //! `t,w` or `t,w1,...,wm`, optional `period`.
+//!
+//! Optional tables for `moreau diagnose` (ignored by every other command):
+//!
+//! ```toml
+//! [fit]                       # grey-box refit: nominal parameters freed (0-based indices)
+//! free = ["plant.A[1][1]", "plant.B[1][0]"]
+//! [fit.bounds]                # optional, per parameter: [lower, upper], the nominal inside
+//! "plant.A[1][1]" = [-10.0, 0.0]
+//! [fit.result."plant.A[1][1]"]  # written by diagnose into fitted.toml (informational)
+//! nominal = -0.6
+//! value = -0.45
+//! std = 0.003
+//! [signals]                   # units for reports: one string for all, or one per column
+//! y = "m"
+//! w = ["m", "V"]
+//! ```
 use crate::toml_access::*;
 use crate::{Effects, Input, ModelError, SimDefaults, System};
 use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, GeometryError, Interval, Polytope, Shape};
@@ -278,7 +294,7 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
     let root: Table = text
         .parse::<Table>()
         .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
-    check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects")?;
+    check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects, fit, signals")?;
     let name = match root.get("name") {
         Some(Value::String(s)) => s.clone(),
         Some(other) => {
@@ -347,8 +363,10 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
         }
     }
     let effects = Effects::parse(root.get("effects"), n, p)?;
-    let sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
+    let mut sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
     crate::system::check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
+    sys.fit = parse_fit(sub("fit")?, &sys)?;
+    sys.signals = parse_signals(sub("signals")?, sys.m(), sys.p())?;
     Ok(sys)
 }
 
@@ -442,5 +460,348 @@ pub fn to_toml_string(s: &System) -> String {
     if let Some(e) = s.effects.to_value() {
         root.insert("effects".into(), e);
     }
+    if let Some(f) = fit_table(&s.fit) {
+        root.insert("fit".into(), Value::Table(f));
+    }
+    if let Some(t) = signals_table(&s.signals) {
+        root.insert("signals".into(), Value::Table(t));
+    }
     toml::to_string(&root).expect("a TOML table always serialises")
+}
+
+/// The plant matrix a freed nominal parameter lives in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlantMatrix {
+    A,
+    B,
+    C,
+    E,
+}
+
+impl PlantMatrix {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlantMatrix::A => "A",
+            PlantMatrix::B => "B",
+            PlantMatrix::C => "C",
+            PlantMatrix::E => "E",
+        }
+    }
+    fn of<'s>(&self, sys: &'s System) -> &'s nalgebra::DMatrix<f64> {
+        match self {
+            PlantMatrix::A => &sys.A,
+            PlantMatrix::B => &sys.B,
+            PlantMatrix::C => &sys.C,
+            PlantMatrix::E => &sys.E,
+        }
+    }
+    fn of_mut<'s>(&self, sys: &'s mut System) -> &'s mut nalgebra::DMatrix<f64> {
+        match self {
+            PlantMatrix::A => &mut sys.A,
+            PlantMatrix::B => &mut sys.B,
+            PlantMatrix::C => &mut sys.C,
+            PlantMatrix::E => &mut sys.E,
+        }
+    }
+}
+
+/// One nominal parameter freed by `[fit] free`: the entry `plant.X[row][col]` (0-based) with
+/// optional bounds `[fit.bounds]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FreeParam {
+    /// Canonical name, e.g. `plant.A[1][1]`.
+    pub name: String,
+    pub matrix: PlantMatrix,
+    pub row: usize,
+    pub col: usize,
+    /// `(lower, upper)`, the nominal value inside.
+    pub bounds: Option<(f64, f64)>,
+}
+
+impl FreeParam {
+    /// The parameter's value in `sys`.
+    pub fn get(&self, sys: &System) -> f64 {
+        self.matrix.of(sys)[(self.row, self.col)]
+    }
+    /// Sets the parameter in `sys`.
+    pub fn set(&self, sys: &mut System, v: f64) {
+        self.matrix.of_mut(sys)[(self.row, self.col)] = v;
+    }
+}
+
+/// A grey-box refit recorded in a fitted model (`[fit.result."plant.A[1][1]"]`): the value
+/// of the model file it was fitted from, the fitted value (the one in `[plant]`) and its
+/// 1-sigma uncertainty (`NaN`, and not written, where not identifiable). Informational:
+/// nothing reads it back into the dynamics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitRecord {
+    pub name: String,
+    pub nominal: f64,
+    pub value: f64,
+    pub std: f64,
+}
+
+/// `[fit]`: the nominal parameters `moreau diagnose` may refit (empty: none).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FitSpec {
+    pub free: Vec<FreeParam>,
+    pub result: Vec<FitRecord>,
+}
+
+impl FitSpec {
+    pub fn is_empty(&self) -> bool {
+        self.free.is_empty() && self.result.is_empty()
+    }
+}
+
+/// `[signals]`: units of the recorded outputs and inputs, for reports (empty: unitless).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Signals {
+    /// One unit per output (`y = "m"` gives every output the same unit).
+    pub y: Vec<String>,
+    /// One unit per input.
+    pub w: Vec<String>,
+}
+
+impl Signals {
+    /// Unit of output `i` (`""` when not stated).
+    pub fn y_unit(&self, i: usize) -> &str {
+        self.y.get(i).map_or("", |s| s.as_str())
+    }
+    /// Unit of input `j` (`""` when not stated).
+    pub fn w_unit(&self, j: usize) -> &str {
+        self.w.get(j).map_or("", |s| s.as_str())
+    }
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty() && self.w.is_empty()
+    }
+}
+
+const FREE_FORM: &str =
+    "a nominal parameter `plant.X[row][col]` with X one of A, B, C, E and 0-based indices, e.g. \"plant.A[1][1]\"";
+
+/// `plant.X[i][j]` -> `(X, i, j)`; `None` when malformed.
+pub fn parse_param_name(s: &str) -> Option<(PlantMatrix, usize, usize)> {
+    let rest = s.trim().strip_prefix("plant.")?;
+    let mut ch = rest.chars();
+    let mat = match ch.next()? {
+        'A' => PlantMatrix::A,
+        'B' => PlantMatrix::B,
+        'C' => PlantMatrix::C,
+        'E' => PlantMatrix::E,
+        _ => return None,
+    };
+    let rest = ch.as_str().strip_prefix('[')?;
+    let (i, rest) = rest.split_once(']')?;
+    let rest = rest.strip_prefix('[')?;
+    let (j, rest) = rest.split_once(']')?;
+    if !rest.is_empty() {
+        return None;
+    }
+    let idx = |v: &str| -> Option<usize> {
+        (!v.is_empty() && v.chars().all(|c| c.is_ascii_digit())).then(|| v.parse().ok()).flatten()
+    };
+    Some((mat, idx(i)?, idx(j)?))
+}
+
+fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
+    let Some(t) = t else { return Ok(FitSpec::default()) };
+    check_keys(t, "fit", "free, bounds, result")?;
+    let mut free: Vec<FreeParam> = Vec::new();
+    if let Some(v) = t.get("free") {
+        let Value::Array(items) = v else {
+            return Err(ModelError::WrongType {
+                key: "fit.free".into(),
+                expected: "an array of parameter names",
+                found: describe(v),
+            });
+        };
+        for (k, it) in items.iter().enumerate() {
+            let key = format!("fit.free[{k}]");
+            let Value::String(s) = it else {
+                return Err(ModelError::WrongType { key, expected: FREE_FORM, found: describe(it) });
+            };
+            let Some((matrix, row, col)) = parse_param_name(s) else {
+                return Err(ModelError::WrongType { key, expected: FREE_FORM, found: describe(it) });
+            };
+            let m = matrix.of(sys);
+            if row >= m.nrows() || col >= m.ncols() {
+                return Err(ModelError::Dimension {
+                    key,
+                    expected: format!(
+                        "row < {} and column < {} (plant.{} is {}x{}; indices are 0-based)",
+                        m.nrows(),
+                        m.ncols(),
+                        matrix.name(),
+                        m.nrows(),
+                        m.ncols()
+                    ),
+                    got: format!("{s:?}"),
+                });
+            }
+            let name = format!("plant.{}[{row}][{col}]", matrix.name());
+            if let Some(i) = free.iter().position(|f| f.name == name) {
+                return Err(ModelError::WrongType {
+                    key,
+                    expected: "each parameter at most once",
+                    found: format!("{s:?}, already fit.free[{i}]"),
+                });
+            }
+            free.push(FreeParam { name, matrix, row, col, bounds: None });
+        }
+    }
+    let lookup = |free: &[FreeParam], key: &str, raw: &str| -> Result<usize, ModelError> {
+        parse_param_name(raw)
+            .and_then(|(m, i, j)| free.iter().position(|f| f.matrix == m && f.row == i && f.col == j))
+            .ok_or_else(|| ModelError::WrongType {
+                key: key.into(),
+                expected: "a parameter listed in fit.free",
+                found: format!("{raw:?} (fit.free: {:?})", free.iter().map(|f| f.name.as_str()).collect::<Vec<_>>()),
+            })
+    };
+    if let Some(v) = t.get("bounds") {
+        let Value::Table(b) = v else {
+            return Err(ModelError::WrongType { key: "fit.bounds".into(), expected: "a table", found: describe(v) });
+        };
+        for (raw, bv) in b {
+            let key = format!("fit.bounds.{raw:?}");
+            let i = lookup(&free, &key, raw)?;
+            let lu = vector(bv, &key)?;
+            if lu.len() != 2 {
+                return Err(ModelError::Dimension {
+                    key,
+                    expected: "[lower, upper]".into(),
+                    got: format!("length {}", lu.len()),
+                });
+            }
+            let (lo, hi) = (lu[0], lu[1]);
+            if lo >= hi {
+                return Err(ModelError::Invalid {
+                    key,
+                    value: lo,
+                    reason: format!("the lower bound {lo} must lie below the upper bound {hi}"),
+                });
+            }
+            let v0 = free[i].get(sys);
+            if !(lo..=hi).contains(&v0) {
+                return Err(ModelError::Invalid {
+                    key,
+                    value: v0,
+                    reason: format!("the nominal value of {} lies outside the bounds [{lo}, {hi}]", free[i].name),
+                });
+            }
+            free[i].bounds = Some((lo, hi));
+        }
+    }
+    let mut result = Vec::new();
+    if let Some(v) = t.get("result") {
+        let Value::Table(r) = v else {
+            return Err(ModelError::WrongType { key: "fit.result".into(), expected: "a table", found: describe(v) });
+        };
+        for (raw, rv) in r {
+            let key = format!("fit.result.{raw:?}");
+            let i = lookup(&free, &key, raw)?;
+            let Value::Table(rt) = rv else {
+                return Err(ModelError::WrongType {
+                    key,
+                    expected: "a table (nominal, value, std)",
+                    found: describe(rv),
+                });
+            };
+            check_keys(rt, &key, "nominal, value, std")?;
+            result.push(FitRecord {
+                name: free[i].name.clone(),
+                nominal: f64_at(rt, &key, "nominal")?,
+                value: f64_at(rt, &key, "value")?,
+                std: opt_f64(rt, &key, "std")?.unwrap_or(f64::NAN),
+            });
+        }
+    }
+    Ok(FitSpec { free, result })
+}
+
+fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, ModelError> {
+    let Some(t) = t else { return Ok(Signals::default()) };
+    check_keys(t, "signals", "y, w")?;
+    let units = |k: &str, n: usize, what: &str| -> Result<Vec<String>, ModelError> {
+        let key = format!("signals.{k}");
+        match t.get(k) {
+            None => Ok(vec![]),
+            Some(Value::String(s)) => Ok(vec![s.clone(); n]),
+            Some(Value::Array(a)) => {
+                let v: Vec<String> = a
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| match x {
+                        Value::String(s) => Ok(s.clone()),
+                        other => Err(ModelError::WrongType {
+                            key: format!("{key}[{i}]"),
+                            expected: "a unit (string)",
+                            found: describe(other),
+                        }),
+                    })
+                    .collect::<Result<_, _>>()?;
+                if v.len() != n {
+                    return Err(ModelError::Dimension {
+                        key,
+                        expected: format!("one unit per {what} ({n})"),
+                        got: format!("length {}", v.len()),
+                    });
+                }
+                Ok(v)
+            }
+            Some(other) => Err(ModelError::WrongType {
+                key,
+                expected: "a unit (string) or an array of units",
+                found: describe(other),
+            }),
+        }
+    };
+    Ok(Signals { y: units("y", p, "output")?, w: units("w", m, "input")? })
+}
+
+fn fit_table(f: &FitSpec) -> Option<Table> {
+    if f.is_empty() {
+        return None;
+    }
+    let mut t = Table::new();
+    t.insert("free".into(), Value::Array(f.free.iter().map(|p| Value::String(p.name.clone())).collect()));
+    let mut b = Table::new();
+    for p in &f.free {
+        if let Some((lo, hi)) = p.bounds {
+            b.insert(p.name.clone(), vec_value(&[lo, hi]));
+        }
+    }
+    if !b.is_empty() {
+        t.insert("bounds".into(), Value::Table(b));
+    }
+    let mut r = Table::new();
+    for rec in &f.result {
+        let mut e = Table::new();
+        e.insert("nominal".into(), Value::Float(rec.nominal));
+        e.insert("value".into(), Value::Float(rec.value));
+        if rec.std.is_finite() {
+            e.insert("std".into(), Value::Float(rec.std));
+        }
+        r.insert(rec.name.clone(), Value::Table(e));
+    }
+    if !r.is_empty() {
+        t.insert("result".into(), Value::Table(r));
+    }
+    Some(t)
+}
+
+fn signals_table(s: &Signals) -> Option<Table> {
+    if s.is_empty() {
+        return None;
+    }
+    let mut t = Table::new();
+    let arr = |v: &[String]| Value::Array(v.iter().map(|u| Value::String(u.clone())).collect());
+    if !s.y.is_empty() {
+        t.insert("y".into(), arr(&s.y));
+    }
+    if !s.w.is_empty() {
+        t.insert("w".into(), arr(&s.w));
+    }
+    Some(t)
 }

@@ -59,6 +59,11 @@ pub struct System {
     pub z0: DVector<f64>,
     pub sim: SimDefaults,
     pub effects: Effects,
+    /// `[fit]`: nominal parameters freed for a grey-box refit by `moreau diagnose` (empty:
+    /// the nominal is taken as known).
+    pub fit: crate::model_file::FitSpec,
+    /// `[signals]`: units of the recorded signals, for reports (empty: unitless).
+    pub signals: crate::model_file::Signals,
 }
 
 fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
@@ -286,7 +291,21 @@ impl System {
                 reason: "must be at least 1",
             });
         }
-        Ok(Self { name: name.into(), A, B, C, E, theta, input, x0, z0, sim, effects })
+        Ok(Self {
+            name: name.into(),
+            A,
+            B,
+            C,
+            E,
+            theta,
+            input,
+            x0,
+            z0,
+            sim,
+            effects,
+            fit: Default::default(),
+            signals: Default::default(),
+        })
     }
 
     /// State dimension `n`.

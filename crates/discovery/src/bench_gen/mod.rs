@@ -27,6 +27,7 @@
 //! The classic profile draws exactly the random numbers it always did (old seeds reproduce);
 //! the digital profile's extra draws come from a second stream.
 pub mod plant_sim;
+pub mod servo_loop;
 
 use crate::recording::Recording;
 use model::effects::{Effect, PlayLocation};
@@ -48,6 +49,38 @@ pub const CLASSES: [&str; 9] = [
     "input_saturation",
     "sensor_offset",
 ];
+
+/// The classes of the friction library (issue 14): Stribeck friction with a static level,
+/// direction-dependent Coulomb levels and a cogging force. Kept apart from [`CLASSES`] so that
+/// the original benchmark keeps its classes (and its seeds their cases); [`all_classes`]
+/// lists both.
+pub const FRICTION_CLASSES: [&str; 3] = ["stribeck_friction", "asymmetric_coulomb", "cogging"];
+
+/// [`CLASSES`] followed by [`FRICTION_CLASSES`].
+pub fn all_classes() -> Vec<&'static str> {
+    CLASSES.iter().chain(FRICTION_CLASSES.iter()).copied().collect()
+}
+
+/// Shape of the friction-library effects beyond their magnitude (drawn per case from a
+/// stream of their own, so that no other class's draws change).
+#[derive(Debug, Clone, Copy)]
+struct FrictionShape {
+    /// `static_level / level` of Stribeck friction, in [1.8, 3].
+    static_ratio: f64,
+    /// Stribeck velocity over the RMS velocity of the nominal run, in [0.05, 0.25].
+    stribeck_frac: f64,
+    /// Weaker over stronger direction-dependent level, in [0.2, 0.6].
+    asym_ratio: f64,
+    /// Whether the stronger level opposes upward motion.
+    asym_up: bool,
+    /// Cogging periods over the nominal position range, in [3, 10].
+    cog_periods: f64,
+    /// Cogging phase, uniform in [0, 2 pi).
+    cog_phase: f64,
+    /// RMS velocity and position range of the nominal run (set after it).
+    v_rms: f64,
+    pos_range: f64,
+}
 
 /// Which kind of recording the generator makes (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -239,9 +272,29 @@ fn random_signal(rng: &mut ChaCha8Rng, w0: f64, duration: f64) -> (Signal, &'sta
     }
 }
 
-/// The true effect of `class` at magnitude `a >= 0` (`sign` for signed effects).
-fn effect_at(class: &str, a: f64, sign: f64, wmax: f64, vel: usize) -> Option<Effect> {
+/// The true effect of `class` at magnitude `a >= 0` (`sign` for signed effects; `fr` shapes
+/// the friction-library effects: `a` is the sliding level of Stribeck friction, the stronger
+/// directional level and the cogging amplitude; the cogging acts with position state 0).
+fn effect_at(class: &str, a: f64, sign: f64, wmax: f64, vel: usize, fr: &FrictionShape) -> Option<Effect> {
     Some(match class {
+        "stribeck_friction" => Effect::StribeckFriction {
+            state: vel,
+            level: a,
+            static_level: a * fr.static_ratio,
+            stribeck_velocity: fr.stribeck_frac * fr.v_rms,
+            viscous: 0.0,
+        },
+        "asymmetric_coulomb" => {
+            let (up, down) = if fr.asym_up { (a, a * fr.asym_ratio) } else { (a * fr.asym_ratio, a) };
+            Effect::AsymmetricCoulomb { state: vel, level_positive: up, level_negative: down }
+        }
+        "cogging" => Effect::Cogging {
+            state: vel,
+            position_state: 0,
+            amplitude: a,
+            period: fr.pos_range / fr.cog_periods,
+            phase: fr.cog_phase,
+        },
         "backlash" => Effect::Backlash { width: a, location: PlayLocation::Loop },
         "gap_width" => Effect::GapWidth { relative_change: a },
         "coulomb_friction" => Effect::CoulombFriction { state: vel, level: a },
@@ -268,10 +321,21 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
 
 /// Generates case number `index` of `class` from `seed` in `profile`.
 pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
-    let mix = seed
-        ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1))
-        ^ (CLASSES.iter().position(|c| *c == class).unwrap_or(0) as u64) << 40;
+    let class_index = all_classes().iter().position(|c| *c == class).unwrap_or(0);
+    let mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
+    // The friction library's shape draws (a third stream).
+    let mut rf = ChaCha8Rng::seed_from_u64(mix ^ 0xF41C_7100_0000_0002);
+    let mut fshape = FrictionShape {
+        static_ratio: rf.random_range(1.8..3.0),
+        stribeck_frac: rf.random_range(0.05..0.25),
+        asym_ratio: rf.random_range(0.2..0.6),
+        asym_up: rf.random::<bool>(),
+        cog_periods: rf.random_range(3.0..10.0),
+        cog_phase: rf.random_range(0.0..TAU),
+        v_rms: 0.0,
+        pos_range: 0.0,
+    };
     // The digital profile's own draws (a second stream: the classic stream is untouched).
     let mut rd = ChaCha8Rng::seed_from_u64(mix ^ 0xD161_7A1D_0000_0001);
     let digital = profile == Profile::Digital;
@@ -318,6 +382,12 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
         let m = clean_nom.iter().sum::<f64>() / ns as f64;
         (clean_nom.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ns as f64).sqrt()
     };
+    // Velocity and position scales of the nominal run (y is the position, x_1 its rate).
+    fshape.v_rms = ((1..ns - 1).map(|k| ((clean_nom[k + 1] - clean_nom[k - 1]) / (2.0 * dt)).powi(2)).sum::<f64>()
+        / (ns - 2) as f64)
+        .sqrt();
+    fshape.pos_range = clean_nom.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - clean_nom.iter().copied().fold(f64::INFINITY, f64::min);
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let mut noise: Vec<f64> = (0..ns).map(|_| gauss(&mut rng) * noise_std).collect();
     if noise_rho > 0.0 {
@@ -336,7 +406,8 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
             .map(|(a, b)| a + b)
             .collect()
     };
-    let fit_at = |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel).as_ref()), &clean_nom);
+    let fit_at =
+        |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel, &fshape).as_ref()), &clean_nom);
     let truth_a = if class == "none" {
         0.0
     } else {
@@ -366,7 +437,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
         }
         (0.5 * (lo + hi)).min(cap)
     };
-    let truth = effect_at(class, truth_a, sign, wmax, plant.vel);
+    let truth = effect_at(class, truth_a, sign, wmax, plant.vel, &fshape);
     let y = measure(truth.as_ref());
     let nominal_fit = fit_percent(&y, &clean_nom);
     let theta = if nominal_has_play {

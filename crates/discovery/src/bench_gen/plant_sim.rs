@@ -1,8 +1,11 @@
 //! The generator's own simulator (independent of [`crate::simulate`]): explicit midpoint
 //! (RK2) on a grid 20 times finer than the samples, forces and the play held over each fine
 //! step, Coulomb friction by a semi-implicit velocity update (stick when the friction-free
-//! velocity change cannot reverse the sign), backlash inertia by semi-implicit Euler, input
-//! effects on the continuous signal or on its zero-order-held samples.
+//! velocity change cannot reverse the sign), the friction library likewise (the static level
+//! from rest or through a reversal, the Stribeck level at the old speed while sliding, levels
+//! per direction; cogging as a force in the derivative, evaluated at the RK2 stages),
+//! backlash inertia by semi-implicit Euler, input effects on the continuous signal or on its
+//! zero-order-held samples.
 use super::{Plant, Signal};
 use model::effects::{Effect, PlayLocation};
 
@@ -38,6 +41,23 @@ pub fn simulate(
         Some(Effect::SensorOffset { offset: o }) => offset = o[0],
         _ => {}
     }
+    // The friction library: (sliding up, sliding down, static excess, Stribeck velocity) and
+    // the cogging force (amplitude, wavenumber, phase) with position state 0.
+    let lib: Option<(f64, f64, f64, f64)> = match eff {
+        Some(Effect::StribeckFriction { level, static_level, stribeck_velocity, .. }) => {
+            Some((*level, *level, static_level - level, *stribeck_velocity))
+        }
+        Some(Effect::AsymmetricCoulomb { level_positive, level_negative, .. }) => {
+            Some((*level_positive, *level_negative, 0.0, 1.0))
+        }
+        _ => None,
+    };
+    let cog: Option<(f64, f64, f64, usize)> = match eff {
+        Some(Effect::Cogging { amplitude, period, phase, position_state, .. }) => {
+            Some((*amplitude, std::f64::consts::TAU / period, *phase, *position_state))
+        }
+        _ => None,
+    };
     let input = |t: f64| {
         let s = t - delay;
         // Held: the sample at or before `s` (a hair of tolerance so that the fine grid's
@@ -51,6 +71,9 @@ pub fn simulate(
             out[i] = (0..n).map(|j| pl.A[(i, j)] * x[j]).sum::<f64>() + pl.B[(i, 0)] * w + pl.E[(i, 0)] * z;
         }
         out[pl.vel] += force;
+        if let Some((a, k, ph, ip)) = cog {
+            out[pl.vel] += a * (k * x[ip] + ph).sin();
+        }
     };
     let mut x = x0.to_vec();
     let mut z = cy(&x);
@@ -82,6 +105,20 @@ pub fn simulate(
                 } else {
                     v_free - dv * v_free.signum()
                 };
+            }
+            if let Some((up, down, excess, vs)) = lib {
+                // Stick unless the friction-free velocity change beats the static level (at
+                // rest or reversing within the step) or the Stribeck level at the old speed.
+                let v_free = x[pl.vel];
+                let dir = v_free.signum();
+                let base = if dir > 0.0 { up } else { down };
+                let level = if v_old == 0.0 || v_old * v_free <= 0.0 {
+                    base + excess
+                } else {
+                    base + excess * (-(v_old / vs).powi(2)).exp()
+                };
+                let dv = level * h;
+                x[pl.vel] = if v_free.abs() <= dv { 0.0 } else { v_free - dv * dir };
             }
             let y = cy(&x);
             if hw > 0.0 {

@@ -2,7 +2,9 @@
 //!
 //! Variables: effect parameters in unit coordinates `u in [0, 1]` (linear
 //! `(theta - lower) / (upper - lower)`, or logarithmic for scale-like parameters, see
-//! [`crate::hypothesis::Hypothesis::param_at`]) kept in the box by projection, and `x0 / x_scale`. Jacobian by forward differences (step `tol_fd`
+//! [`crate::hypothesis::Hypothesis::param_at`]) kept in the box by projection, freed nominal
+//! parameters over their scales (grey-box refit, [`crate::fit::nominal`]; user bounds kept by
+//! projection) and `x0 / x_scale`. Jacobian by forward differences (step `tol_fd`
 //! in normalised units: large enough to see through the kinks of plays and stick-slip).
 //! Step: `(J^T J + lambda diag(J^T J)) d = -J^T r`; accepted when the cost decreases.
 //!
@@ -64,6 +66,10 @@ pub struct FitResult {
     pub theta: Vec<f64>,
     /// Their standard deviations (Gauss-Newton); `NaN` where not identifiable.
     pub std: Vec<f64>,
+    /// Freed nominal parameters (grey-box refit; empty without one), physical units.
+    pub nominal: Vec<f64>,
+    /// Their standard deviations, as `std`.
+    pub nominal_std: Vec<f64>,
     pub x0: Vec<f64>,
     /// Weighted sum of squared residuals on the estimation segment.
     pub sse: f64,
@@ -79,26 +85,44 @@ struct Vars<'p, 'a> {
     xs: Vec<f64>,
     x0_fixed: Vec<f64>,
     k: usize,
+    /// Freed nominal parameters: count, scales and scaled bounds.
+    kn: usize,
+    ns: Vec<f64>,
+    nlo: Vec<f64>,
+    nhi: Vec<f64>,
 }
 
 impl Vars<'_, '_> {
-    fn split(&self, v: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    fn split(&self, v: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let theta = self.pb.params_at(&v[..self.k]);
+        let nom: Vec<f64> = (0..self.kn).map(|i| v[self.k + i] * self.ns[i]).collect();
+        let off = self.k + self.kn;
         let x0 = if self.xs.is_empty() {
             self.x0_fixed.clone()
         } else {
-            (0..self.xs.len()).map(|i| v[self.k + i] * self.xs[i]).collect()
+            (0..self.xs.len()).map(|i| v[off + i] * self.xs[i]).collect()
         };
-        (theta, x0)
+        (theta, nom, x0)
     }
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
         *evals += 1;
-        let (t, x) = self.split(v);
-        self.pb.residual(&t, &x)
+        let (t, n, x) = self.split(v);
+        self.pb.residual_with(&t, &n, &x)
     }
     fn clamp(&self, v: &mut [f64]) {
         for x in v.iter_mut().take(self.k) {
             *x = x.clamp(0.0, 1.0);
+        }
+        for i in 0..self.kn {
+            v[self.k + i] = v[self.k + i].clamp(self.nlo[i], self.nhi[i]);
+        }
+    }
+    /// Whether variable `c` is a freed nominal parameter on one of its bounds.
+    fn nominal_at_bound(&self, v: &[f64], c: usize) -> bool {
+        c >= self.k && c < self.k + self.kn && {
+            let i = c - self.k;
+            let tol = 1e-9 * (1.0 + v[c].abs());
+            v[c] <= self.nlo[i] + tol || v[c] >= self.nhi[i] - tol
         }
     }
 }
@@ -113,7 +137,13 @@ fn jacobian(vars: &Vars, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DM
     for c in 0..nv {
         let mut vp = v.to_vec();
         // Step towards the interior for bounded variables.
-        let step = if c < vars.k && v[c] + h > 1.0 { -h } else { h };
+        let step = if (c < vars.k && v[c] + h > 1.0)
+            || (c >= vars.k && c < vars.k + vars.kn && v[c] + h > vars.nhi[c - vars.k])
+        {
+            -h
+        } else {
+            h
+        };
         vp[c] += step;
         if let Some(rp) = vars.res(&vp, evals) {
             for i in 0..r0.len() {
@@ -259,9 +289,18 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     let lo = pb.lower();
     let k = lo.len();
     let xs: Vec<f64> = x_scale.iter().map(|v| v.max(1e-9)).collect();
-    let vars = Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k };
+    let (kn, ns, nlo, nhi, nom0) = match &pb.refit {
+        Some(r) => {
+            let (a, b) = r.free.bounds_scaled();
+            (r.free.k(), r.free.scale.clone(), a, b, r.values.clone())
+        }
+        None => (0, vec![], vec![], vec![], vec![]),
+    };
+    // Start of the freed nominal parameters (scaled, inside their bounds).
+    let nomv: Vec<f64> = (0..kn).map(|i| (nom0[i] / ns[i]).clamp(nlo[i], nhi[i])).collect();
+    let vars = Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k, kn, ns: ns.clone(), nlo, nhi };
     let mut evals = 0;
-    if k == 0 && xs.is_empty() {
+    if k == 0 && kn == 0 && xs.is_empty() {
         // Nothing to fit: the nominal model from a known initial state.
         let r = vars.res(&[], &mut evals);
         let (cost, n_res, status) = match &r {
@@ -271,6 +310,8 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         return FitResult {
             theta: vec![],
             std: vec![],
+            nominal: vec![],
+            nominal_std: vec![],
             x0: x0_init.to_vec(),
             sse: cost,
             n_res,
@@ -297,12 +338,14 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
                 }
                 off += h.k();
             }
+            v.extend(nomv.iter());
             v.extend(x0v.iter());
             starts.push(v);
         }
     } else {
         for i in 0..nstart {
             let mut v: Vec<f64> = pb.parts.iter().flat_map(|h| h.starts[i % h.starts.len()].clone()).collect();
+            v.extend(nomv.iter());
             v.extend(x0v.iter());
             starts.push(v);
         }
@@ -325,6 +368,8 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         return FitResult {
             theta: lo,
             std: vec![f64::NAN; k],
+            nominal: nom0,
+            nominal_std: vec![f64::NAN; kn],
             x0: x0_init.to_vec(),
             sse: f64::INFINITY,
             n_res: 0,
@@ -340,29 +385,34 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     let s2 = cost / dof;
     let JtJ = J.transpose() * &J;
     let slope = pb.slope(&v[..k]);
-    let std: Vec<f64> = match JtJ.clone().try_inverse() {
+    // Physical units per solver unit: effect slopes, then the nominal scales.
+    let unit: Vec<f64> = slope.iter().map(|s| s.abs()).chain(ns.iter().copied()).collect();
+    let std_all: Vec<f64> = match JtJ.clone().try_inverse() {
         Some(inv) => {
             // The larger of the white-noise and the coloured-residual (batch-means sandwich)
             // variances: the report never claims more precision than either supports.
             let sandwich = &inv * long_run_score_covariance(&J, &r, pb.p) * &inv;
-            (0..k).map(|i| (s2 * inv[(i, i)]).max(sandwich[(i, i)]).max(0.0).sqrt() * slope[i].abs()).collect()
+            (0..k + kn).map(|i| (s2 * inv[(i, i)]).max(sandwich[(i, i)]).max(0.0).sqrt() * unit[i]).collect()
         }
-        None => vec![f64::NAN; k],
+        None => vec![f64::NAN; k + kn],
     };
-    let (theta, x0) = vars.split(&v);
-    // Stuck fits: a parameter without influence, or one clipped at its upper bound.
+    let std = std_all[..k].to_vec();
+    let nominal_std = std_all[k..].to_vec();
+    let (theta, nominal, x0) = vars.split(&v);
+    // Stuck fits: a parameter without influence, or one clipped at its upper bound (a freed
+    // nominal parameter: at either of its bounds).
     let col_norm = |c: usize| J.column(c).norm();
     let scale = (0..v.len()).map(col_norm).fold(0.0, f64::max);
-    let status = if (0..k).any(|c| col_norm(c) <= 1e-9 * scale.max(1e-300) || col_norm(c) == 0.0) {
+    let status = if (0..k + kn).any(|c| col_norm(c) <= 1e-9 * scale.max(1e-300) || col_norm(c) == 0.0) {
         FitStatus::ZeroGradient
-    } else if (0..k).any(|c| v[c] >= 1.0 - 1e-9) {
+    } else if (0..k).any(|c| v[c] >= 1.0 - 1e-9) || (k..k + kn).any(|c| vars.nominal_at_bound(&v, c)) {
         FitStatus::AtBound
     } else if conv {
         FitStatus::Converged
     } else {
         FitStatus::MaxIterations
     };
-    FitResult { theta, std, x0, sse: cost, n_res: nres, status, evaluations: evals }
+    FitResult { theta, std, nominal, nominal_std, x0, sse: cost, n_res: nres, status, evaluations: evals }
 }
 
 /// Starts iterated after screening (see [`fit`]).

@@ -5,7 +5,12 @@
 //! with `sigma_i` the standard deviation of output `i`, so outputs weigh alike. A held-out
 //! block `exclude = [b0, b1)` (blocked cross-validation) is left out of the residual; the
 //! simulation still runs through it (the input there is known, the output is not used).
-use crate::hypothesis::{Hypothesis, Scales};
+//!
+//! Grey-box refit ([`Refit`]): freed nominal parameters are further unknowns, in their own
+//! block of the solver (see [`crate::fit::nominal`]); without a refit the problem is as before.
+use crate::fit::input_effects::{self, InputOp};
+use crate::fit::nominal::Refit;
+use crate::hypothesis::{Hypothesis, Kind, Scales};
 use crate::simulate::{ExtendedModel, InputHold, SimOutput, StepMaps};
 use model::effects::Effect;
 use model::System;
@@ -34,6 +39,8 @@ pub struct Problem<'a> {
     pub z0: Option<Vec<f64>>,
     /// Samples `[b0, b1)` left out of the residual (a held-out fold).
     pub exclude: Option<(usize, usize)>,
+    /// Freed nominal parameters (`None`: the nominal is fixed).
+    pub refit: Option<Refit<'a>>,
 }
 
 impl<'a> Problem<'a> {
@@ -41,12 +48,27 @@ impl<'a> Problem<'a> {
     pub fn k(&self) -> usize {
         self.parts.iter().map(|h| h.k()).sum()
     }
-    /// Effects for parameter vector `theta` (physical units, parts concatenated).
+    /// Effects for parameter vector `theta` (physical units, parts concatenated); per-input
+    /// input effects are not among them (see [`Problem::input_ops`]).
     pub fn effects(&self, theta: &[f64]) -> Vec<Effect> {
         let mut out = self.fixed.clone();
         let mut off = 0;
         for h in &self.parts {
-            out.push(h.effect(&theta[off..off + h.k()], self.scales));
+            if !matches!(h.kind, Kind::InputOn { .. }) {
+                out.push(h.effect(&theta[off..off + h.k()], self.scales));
+            }
+            off += h.k();
+        }
+        out
+    }
+    /// Per-input input effects `(op, input, value)` for parameter vector `theta`.
+    pub fn input_ops(&self, theta: &[f64]) -> Vec<(InputOp, usize, f64)> {
+        let mut out = Vec::new();
+        let mut off = 0;
+        for h in &self.parts {
+            if let Kind::InputOn { op, input } = h.kind {
+                out.push((op, input, theta[off]));
+            }
             off += h.k();
         }
         out
@@ -98,18 +120,68 @@ impl<'a> Problem<'a> {
             })
             .collect()
     }
-    /// Simulates with `theta`, `x0` over the first `len` samples (`None`: the whole record).
+    /// Number of freed nominal parameters.
+    pub fn k_nominal(&self) -> usize {
+        self.refit.as_ref().map_or(0, |r| r.free.k())
+    }
+    /// Simulates with `theta`, `x0` over the first `len` samples (`None`: the whole record);
+    /// freed nominal parameters at their values in [`Problem::refit`].
     pub fn simulate(&self, theta: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
-        let ext = ExtendedModel::from_maps(self.sys, &self.effects(theta), self.maps.clone(), self.substeps)
-            .ok()?
-            .with_hold(self.hold);
+        let nom = self.refit.as_ref().map(|r| r.values.clone()).unwrap_or_default();
+        self.simulate_with(theta, &nom, x0, len)
+    }
+    /// As [`Problem::simulate`] with freed nominal parameters at `nom`.
+    pub fn simulate_with(&self, theta: &[f64], nom: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
+        let effects = self.effects(theta);
+        let refitted: Option<System> = self.refit.as_ref().map(|r| r.free.system_at(nom));
+        let sys = refitted.as_ref().unwrap_or(self.sys);
+        let maps = match &refitted {
+            None => self.maps.clone(),
+            Some(s) => {
+                let maps = StepMaps::new(&s.F(), &s.B, &s.E, self.dt / self.substeps.max(1) as f64);
+                if !maps.Phi.iter().chain(&maps.PsiB).chain(&maps.PsiE).all(|x| x.is_finite()) {
+                    return None;
+                }
+                maps
+            }
+        };
         let len = len.unwrap_or(self.w.len() / self.m);
-        let out = ext.simulate_from(&self.w[..len * self.m], self.dt, x0, self.z0.as_deref());
-        out.finite.then_some(out)
+        let ops = self.input_ops(theta);
+        if ops.is_empty() {
+            let ext = ExtendedModel::from_maps(sys, &effects, maps, self.substeps).ok()?.with_hold(self.hold);
+            let out = ext.simulate_from(&self.w[..len * self.m], self.dt, x0, self.z0.as_deref());
+            return out.finite.then_some(out);
+        }
+        // Per-input effects: the transformed input on the sub-step grid, one linear step per
+        // point (the same step maps), then back to the samples.
+        let sub = self.substeps.max(1);
+        let (m, p, n) = (self.m, self.p, x0.len());
+        let wf = input_effects::transform(&self.w[..len * m], m, self.dt, sub, self.hold, &ops);
+        let ext = ExtendedModel::from_maps(sys, &effects, maps, 1).ok()?.with_hold(self.hold);
+        let fine = ext.simulate_from(&wf, self.dt / sub as f64, x0, self.z0.as_deref());
+        if !fine.finite {
+            return None;
+        }
+        let pick = |v: &[f64], c: usize| -> Vec<f64> {
+            (0..len).flat_map(|k| v[k * sub * c..(k * sub + 1) * c].to_vec()).collect()
+        };
+        Some(SimOutput {
+            y: pick(&fine.y, p),
+            contact: (0..len).map(|k| fine.contact[k * sub]).collect(),
+            z: pick(&fine.z, p),
+            finite: true,
+            x_rms: fine.x_rms.clone(),
+            x: pick(&fine.x, n),
+        })
     }
     /// Weighted residual on the estimation samples (None if the simulation blew up).
     pub fn residual(&self, theta: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
-        let out = self.simulate(theta, x0, Some(self.k_est))?;
+        let nom = self.refit.as_ref().map(|r| r.values.clone()).unwrap_or_default();
+        self.residual_with(theta, &nom, x0)
+    }
+    /// As [`Problem::residual`] with freed nominal parameters at `nom`.
+    pub fn residual_with(&self, theta: &[f64], nom: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
+        let out = self.simulate_with(theta, nom, x0, Some(self.k_est))?;
         let p = self.p;
         let (b0, b1) = self.exclude.unwrap_or((0, 0));
         Some(

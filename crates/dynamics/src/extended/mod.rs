@@ -6,7 +6,8 @@
 //!   zero-order hold on the backlash deviation `q = z - y` and on forces).
 //! - [`model`]: the extended model ([`ExtendedModel`]) and its fixed-step simulator:
 //!   catching-up projection `z_{k+1} = y_{k+1} + P_Theta(z_k - y_{k+1})` for the play,
-//!   implicit (Moreau-Jean) stick-slip for Coulomb friction, coasting backlash output for
+//!   implicit (Moreau-Jean) stick-slip for friction (Coulomb, Stribeck with a static
+//!   breakaway level, direction-dependent levels), a cogging force, coasting backlash output for
 //!   backlash inertia, and the input effects (delay, saturation, play at the input).
 //!
 //! The one simulator of models with `[[effects]]`: `moreau simulate`, `periodic`,

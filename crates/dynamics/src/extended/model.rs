@@ -8,10 +8,21 @@
 //! - `Theta` is the nominal set scaled by `1 + relative_change` (`gap_width`) and widened by a
 //!   play of width `width` (`backlash` in the loop; 1-D, or a ball of radius `width/2` when the
 //!   nominal has no play);
-//! - `b_j` is a constant force (`constant_force`) and `f_j in -level Sign(x_j)` Coulomb
-//!   friction (`coulomb_friction`), resolved implicitly per step: with `a` the velocity
-//!   reached without friction and `g = Psi_jj`, the state sticks (`x_j = 0`, `|f| <= level`)
-//!   when `|a| <= level g`, otherwise `f = -level sign(a)` (Moreau-Jean time stepping);
+//! - `b_j` is a constant force (`constant_force`) plus a cogging force
+//!   `A sin(2 pi x_pos / P + phase)` (`cogging`, evaluated at the step's midpoint position
+//!   of the force-free step and held over the step);
+//! - `f_j` is friction on velocity state `x_j` (`coulomb_friction`, `stribeck_friction`,
+//!   `asymmetric_coulomb`; several on one state add up), a set-valued law: at rest
+//!   `f in [-S_+, S_-]` (the static, breakaway levels; `S = level` for Coulomb), sliding in
+//!   direction `d` `f = -d L_d(|v|)` with the sliding curve
+//!   `L_d(u) = c_d + sum_i (s_i - c) exp(-(u / v_i)^2) + viscous u` (Stribeck). It is resolved
+//!   implicitly per step (Moreau-Jean time stepping): with `a` the velocity reached without
+//!   friction and `g = Psi_jj`, the state sticks (`x_j = 0`, `f = -a / g`) when
+//!   `-g S_- <= a <= g S_+`, otherwise it slides with the `u > 0` solving
+//!   `u + g L_d(u) = |a|` (closed form for Coulomb levels, safeguarded Newton on the bracket
+//!   `[(|a| - g S_d), (|a| - g c_d)] / (1 + g viscous)` otherwise), `f = -d L_d(u)`.
+//!   Static friction is thus the breakaway threshold from rest, the Stribeck curve the
+//!   force while sliding, and a mass that slows down to zero is caught by the static level;
 //! - the play is the catching-up scheme `z_{k+1} = y_{k+1} + P_Theta(z_pred - y_{k+1})`, where
 //!   `z_pred = z_k` for a massless backlash output and, with `backlash_inertia`, `z` coasts
 //!   with velocity `v` decaying at rate `damping / mass` between contacts (the contact is
@@ -46,7 +57,10 @@ pub struct ExtendedModel {
     substeps: usize,
     play: Play,
     input_play: Option<f64>,
-    coulomb: Vec<(usize, f64)>,
+    /// Friction laws, one per velocity state (effects on the same state merged).
+    friction: Vec<Friction>,
+    /// Cogging forces.
+    cogging: Vec<Cog>,
     /// Constant force per state (length n).
     force: Vec<f64>,
     has_force: bool,
@@ -115,7 +129,8 @@ impl ExtendedModel {
             substeps,
             play: Play::None,
             input_play: None,
-            coulomb: Vec::new(),
+            friction: Vec::new(),
+            cogging: Vec::new(),
             force: vec![0.0; n],
             has_force: false,
             inertia_tau: 0.0,
@@ -158,7 +173,84 @@ impl ExtendedModel {
                             value: *state as f64,
                         });
                     }
-                    me.coulomb.push((*state, level.abs()));
+                    me.friction_on(*state).add_coulomb(level.abs(), level.abs());
+                }
+                Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
+                    if *state >= n {
+                        return Err(DynamicsError::BadEffect {
+                            kind: "asymmetric_coulomb",
+                            reason: "state index out of range",
+                            value: *state as f64,
+                        });
+                    }
+                    for v in [level_positive, level_negative] {
+                        if !(*v >= 0.0 && v.is_finite()) {
+                            return Err(DynamicsError::BadEffect {
+                                kind: "asymmetric_coulomb",
+                                reason: "levels must be finite and non-negative",
+                                value: *v,
+                            });
+                        }
+                    }
+                    if *level_positive > 0.0 || *level_negative > 0.0 {
+                        me.friction_on(*state).add_coulomb(*level_positive, *level_negative);
+                    }
+                }
+                Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
+                    let bad =
+                        |reason, value| Err(DynamicsError::BadEffect { kind: "stribeck_friction", reason, value });
+                    if *state >= n {
+                        return bad("state index out of range", *state as f64);
+                    }
+                    if !(*level >= 0.0 && level.is_finite()) {
+                        return bad("level must be finite and non-negative", *level);
+                    }
+                    if !(*static_level >= *level && static_level.is_finite()) {
+                        return bad("static_level must be finite and at least level", *static_level);
+                    }
+                    if !(*viscous >= 0.0 && viscous.is_finite()) {
+                        return bad("viscous must be finite and non-negative", *viscous);
+                    }
+                    let excess = static_level - level;
+                    if excess > 0.0 && !(*stribeck_velocity > 0.0 && stribeck_velocity.is_finite()) {
+                        return bad("stribeck_velocity must be finite and positive", *stribeck_velocity);
+                    }
+                    if *static_level > 0.0 || *viscous > 0.0 {
+                        let fr = me.friction_on(*state);
+                        fr.add_coulomb(*level, *level);
+                        if excess > 0.0 {
+                            fr.excess.push((excess, 1.0 / stribeck_velocity));
+                            fr.static_extra += excess;
+                        }
+                        fr.viscous += viscous;
+                    }
+                }
+                Effect::Cogging { state, position_state, amplitude, period, phase } => {
+                    let bad = |reason, value| Err(DynamicsError::BadEffect { kind: "cogging", reason, value });
+                    if *state >= n {
+                        return bad("state index out of range", *state as f64);
+                    }
+                    if *position_state >= n {
+                        return bad("position_state index out of range", *position_state as f64);
+                    }
+                    if !(*period > 0.0 && period.is_finite()) {
+                        return bad("period must be finite and positive", *period);
+                    }
+                    if !(amplitude.is_finite() && phase.is_finite()) {
+                        return bad(
+                            "amplitude and phase must be finite",
+                            if amplitude.is_finite() { *phase } else { *amplitude },
+                        );
+                    }
+                    if *amplitude != 0.0 {
+                        me.cogging.push(Cog {
+                            state: *state,
+                            pos: *position_state,
+                            amplitude: *amplitude,
+                            wavenumber: std::f64::consts::TAU / period,
+                            phase: *phase,
+                        });
+                    }
                 }
                 Effect::ConstantForce { state, force } => {
                     if *state >= n {
@@ -515,12 +607,23 @@ impl ExtendedModel {
                         }
                         xn[i] = acc;
                     }
-                    for &(j, level) in &self.coulomb {
-                        let a = xn[j];
-                        let g = mp.Psi[j * n + j];
-                        let f = if a.abs() <= level * g { -a / g } else { -level * a.signum() };
-                        for i in 0..n {
-                            xn[i] += mp.Psi[i * n + j] * f;
+                    for cg in &self.cogging {
+                        // Midpoint position of the force-free step.
+                        let xp = 0.5 * (x[cg.pos] + xn[cg.pos]);
+                        let f = cg.amplitude * (cg.wavenumber * xp + cg.phase).sin();
+                        for (i, v) in xn.iter_mut().enumerate() {
+                            *v += mp.Psi[i * n + cg.state] * f;
+                        }
+                    }
+                    for fr in &self.friction {
+                        let j = fr.state;
+                        let (f, stuck) = fr.force(xn[j], mp.Psi[j * n + j]);
+                        for (i, v) in xn.iter_mut().enumerate() {
+                            *v += mp.Psi[i * n + j] * f;
+                        }
+                        if stuck {
+                            // Exactly at rest (`a - g (a / g)` may round to a few ulps).
+                            xn[j] = 0.0;
                         }
                     }
                     std::mem::swap(&mut x, &mut xn);
@@ -563,6 +666,118 @@ impl ExtendedModel {
         }
         out.x_rms.iter_mut().for_each(|v| *v = (*v / ns as f64).sqrt());
         out
+    }
+}
+
+/// Friction on one velocity state (see the module documentation): Coulomb levels per
+/// direction, Stribeck excess terms and a viscous increment.
+#[derive(Debug, Clone)]
+struct Friction {
+    state: usize,
+    /// Sliding (Coulomb) level while moving up / down.
+    pos: f64,
+    neg: f64,
+    /// Stribeck terms `(s_i - c, 1 / v_i)`.
+    excess: Vec<(f64, f64)>,
+    /// `sum_i (s_i - c)`: static levels are `pos + static_extra`, `neg + static_extra`.
+    static_extra: f64,
+    viscous: f64,
+}
+
+impl Friction {
+    fn add_coulomb(&mut self, pos: f64, neg: f64) {
+        self.pos += pos;
+        self.neg += neg;
+    }
+
+    /// Sliding level at speed `u >= 0` above the Coulomb level `c`, and its derivative.
+    #[inline]
+    fn curve(&self, u: f64) -> (f64, f64) {
+        let (mut l, mut dl) = (self.viscous * u, self.viscous);
+        for &(ds, iv) in &self.excess {
+            let r = u * iv;
+            let e = ds * (-r * r).exp();
+            l += e;
+            dl -= 2.0 * r * iv * e;
+        }
+        (l, dl)
+    }
+
+    /// The friction force over a step whose friction-free end velocity is `a`, with
+    /// `g = Psi_jj` (implicit: the end velocity is `a + g f`), and whether the state sticks.
+    #[inline]
+    fn force(&self, a: f64, g: f64) -> (f64, bool) {
+        let (s_pos, s_neg) = (self.pos + self.static_extra, self.neg + self.static_extra);
+        if a <= g * s_pos && a >= -g * s_neg {
+            // Sticks (the static levels hold the remaining force).
+            return (-a / g, true);
+        }
+        let (d, c) = if a > 0.0 { (1.0, self.pos) } else { (-1.0, self.neg) };
+        if self.excess.is_empty() && self.viscous == 0.0 {
+            return (-c * d, false);
+        }
+        // Slides: u + g (c + curve(u)) = |a|, u in [lo, hi].
+        let t = a.abs();
+        let den = 1.0 + g * self.viscous;
+        let (mut lo, mut hi) = (((t - g * (c + self.static_extra)) / den).max(0.0), ((t - g * c) / den).max(0.0));
+        let phi = |u: f64| {
+            let (l, dl) = self.curve(u);
+            (u + g * (c + l) - t, 1.0 + g * dl)
+        };
+        let mut u = hi;
+        for _ in 0..60 {
+            let (r, dr) = phi(u);
+            if r == 0.0 {
+                break;
+            }
+            if r > 0.0 {
+                hi = u;
+            } else {
+                lo = u;
+            }
+            let mut un = u - r / dr;
+            if !(dr > 0.0 && un > lo && un < hi) {
+                un = 0.5 * (lo + hi);
+            }
+            if (un - u).abs() <= 1e-15 * (1.0 + u.abs()) || hi - lo <= 1e-15 * (1.0 + hi) {
+                u = un;
+                break;
+            }
+            u = un;
+        }
+        let (l, _) = self.curve(u);
+        (-d * (c + l), false)
+    }
+}
+
+/// A cogging force on `state`: `amplitude sin(wavenumber x_pos + phase)`.
+#[derive(Debug, Clone)]
+struct Cog {
+    state: usize,
+    pos: usize,
+    amplitude: f64,
+    wavenumber: f64,
+    phase: f64,
+}
+
+impl ExtendedModel {
+    /// The friction law of `state`, created empty on first use.
+    fn friction_on(&mut self, state: usize) -> &mut Friction {
+        let i = match self.friction.iter().position(|f| f.state == state) {
+            Some(i) => i,
+            None => {
+                self.friction.push(Friction {
+                    state,
+                    pos: 0.0,
+                    neg: 0.0,
+                    excess: Vec::new(),
+                    static_extra: 0.0,
+                    viscous: 0.0,
+                });
+                self.friction.len() - 1
+            }
+        };
+        &mut self.friction[i]
     }
 }
 

@@ -35,6 +35,15 @@ pub struct Args {
     /// a stated x0, and z0, is used as known).
     #[arg(long)]
     pub estimate_x0: bool,
+    /// Headline of the verdict: `auto` (RMSE in the output's units, from the model file's
+    /// `[signals] y`, when the validation fit % exceeds 99 %, as for a tightly tracking servo
+    /// loop; else fit %), `fit` or `rmse`.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "fit", "rmse"])]
+    pub metric: String,
+    /// Keep the nominal parameters that the model file frees (`[fit] free`) at their values:
+    /// no grey-box refit.
+    #[arg(long)]
+    pub no_refit: bool,
 }
 
 /// The initial state the model file states (`[initial] x0`, optional `z0`), if any.
@@ -72,6 +81,8 @@ pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
     let col = |v: &[f64], i: usize| -> Vec<f64> { v.iter().skip(i).step_by(p).copied().collect() };
     let mut out = Vec::new();
     let windows: Vec<(f64, f64)> = r.windows.iter().map(|w| (w.t_start, w.t_end)).collect();
+    // Units from the model file's `[signals] y`.
+    let unit = r.units.first().filter(|u| !u.is_empty()).map_or(String::new(), |u| format!(" ({u})"));
     let y0 = col(&s.y, 0);
     let en: Vec<f64> = col(&s.y, 0).iter().zip(col(&s.yhat_nominal, 0)).map(|(a, b)| a - b).collect();
     let ef: Vec<f64> = col(&s.y, 0).iter().zip(col(&s.yhat_fitted, 0)).map(|(a, b)| a - b).collect();
@@ -87,7 +98,7 @@ pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
                 r.validation_segment[0]
             ),
             x_label: "t (s)".into(),
-            y_label: "residual".into(),
+            y_label: format!("residual{unit}"),
             series: vec![mk("nominal", &en), mk("fitted", &ef)],
             windows: windows.clone(),
             size: (1200, 500),
@@ -98,7 +109,7 @@ pub fn figures(r: &Report) -> Vec<(&'static str, LinePlot)> {
         LinePlot {
             title: format!("Measured vs nominal vs fitted (output 1): {}", r.selected()),
             x_label: "t (s)".into(),
-            y_label: "y".into(),
+            y_label: format!("y{unit}"),
             series: vec![
                 mk("measured", &y0),
                 mk("nominal", &col(&s.yhat_nominal, 0)),
@@ -146,6 +157,8 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         input_hold: discovery::HoldChoice::parse(&a.input_hold).unwrap_or_default(),
         initial_state: stated_initial_state(&a.model, &sys)?,
         estimate_x0: a.estimate_x0,
+        metric: discovery::diagnose::Metric::parse(&a.metric).unwrap_or_default(),
+        refit_nominal: !a.no_refit,
         ..Default::default()
     };
     let start = std::time::Instant::now();
@@ -168,19 +181,55 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let pct = |v: &[Option<f64>]| {
         v.iter().map(|x| x.map_or("undefined".to_string(), |x| format!("{x:.1}"))).collect::<Vec<_>>().join(", ")
     };
-    println!(
-        "validation fit % (nominal -> fitted): [{}] -> [{}]; RMSE {:?} -> {:?}",
-        pct(&r.fit_before.fit_percent),
-        pct(&r.fit_after.fit_percent),
-        r.fit_before.rmse,
-        r.fit_after.rmse
-    );
+    if r.headline_metric == "rmse" {
+        println!("{}", r.headline);
+    } else {
+        let rmse = |v: &[f64]| v.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>().join(", ");
+        println!(
+            "validation fit % (nominal -> fitted): {} -> {}; RMSE {} -> {}",
+            pct(&r.fit_before.fit_percent),
+            pct(&r.fit_after.fit_percent),
+            rmse(&r.fit_before.rmse),
+            rmse(&r.fit_after.rmse)
+        );
+    }
+    for v in &r.nominal_refit {
+        println!(
+            "  {}: {} -> {} +- {} (refitted plant parameter)",
+            v.name,
+            sig4(v.nominal),
+            sig4(v.value),
+            sig4(v.std)
+        );
+    }
     if !r.fit_before.constant_outputs.is_empty() {
         println!("fit % undefined: the validation output is constant; judge by the RMSE");
     }
     for e in &r.effects {
-        println!("  {}: {:?}", e.label, e.params);
+        // "width = 0.553 +- 0.012" per parameter, the uncertainty where the fit gives one
+        let params: Vec<String> = e
+            .params
+            .iter()
+            .map(|(name, v)| match e.uncertainty.iter().find(|(n, _)| n == name) {
+                Some((_, s)) => format!("{name} = {} +- {}", sig4(*v), sig4(*s)),
+                None => format!("{name} = {}", sig4(*v)),
+            })
+            .collect();
+        println!("  {}: {}", e.label, params.join(", "));
     }
     println!("{} hypotheses ranked in {secs:.2} s; report in {}", r.ranking.len(), a.out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// `v` with 4 significant digits, plain for moderate magnitudes, scientific otherwise.
+fn sig4(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32;
+    if (-3..5).contains(&e) {
+        format!("{:.*}", (3 - e).max(0) as usize, v)
+    } else {
+        format!("{v:.3e}")
+    }
 }

@@ -1,6 +1,6 @@
 //! `moreau discover-bench --cases N --seed S`: the concealed-effect benchmark of `discovery`
-//! (N cases of each of the 9 classes: none and the 8 effects), printing the confusion matrix,
-//! the false-alarm rate on `none` and the parameter errors. `--profile digital` generates
+//! (N cases of each of the 9 classes: none and the 8 effects, or of the `--classes` given),
+//! printing the confusion matrix, the false-alarm rate on `none` and the parameter errors. `--profile digital` generates
 //! zero-order-held inputs, 1-10 ms sampling, white or AR(1) noise and lightly damped plants.
 use anyhow::Context;
 use std::path::PathBuf;
@@ -19,6 +19,11 @@ pub struct Args {
     /// AR(1)-coloured noise, half the plants lightly damped).
     #[arg(long, default_value = "classic", value_parser = ["classic", "digital"])]
     pub profile: String,
+    /// Classes: `classic` (none and the 8 original effects), `friction` (none,
+    /// coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging), `all`, or a
+    /// comma-separated list of class names.
+    #[arg(long, default_value = "classic")]
+    pub classes: String,
     /// Estimate the initial state although each case's model states the true one.
     #[arg(long)]
     pub estimate_x0: bool,
@@ -41,13 +46,20 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         a.cases as f64,
         crate::budget::MAX_BENCH_CASES as f64,
         1e6,
-        "per class, 9 classes",
+        "per class",
     )?;
     let profile = discovery::bench_gen::Profile::parse(&a.profile).unwrap_or(discovery::bench_gen::Profile::Classic);
+    let classes = discovery::bench::class_set(&a.classes).with_context(|| {
+        format!(
+            "--classes {:?}: expected classic, friction, all or a comma-separated list of {}",
+            a.classes,
+            discovery::bench_gen::all_classes().join(", ")
+        )
+    })?;
     if let Some(dir) = &a.write_cases {
         let st = crate::output::StagedDir::new(dir)?;
         for i in 0..a.cases {
-            for &c in discovery::bench_gen::CLASSES.iter() {
+            for &c in classes.iter() {
                 let case = discovery::bench_gen::generate_profile(c, a.seed, i, profile);
                 let mut m = case.nominal.clone();
                 m.name = format!("{} [{}]", m.name, case.description);
@@ -60,7 +72,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let settings = discovery::DiagnoseSettings { estimate_x0: a.estimate_x0, ..Default::default() };
-    let r = discovery::bench::run_with(a.cases, a.seed, profile, &settings, |c| {
+    let r = discovery::bench::run_classes(&classes, a.cases, a.seed, profile, &settings, |c| {
         eprintln!(
             "{:>18} #{:<3} -> {:<34} {} ({:.1} s; {})",
             c.class,

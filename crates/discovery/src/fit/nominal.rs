@@ -1,0 +1,99 @@
+//! Grey-box refit: nominal parameters freed by the model file's `[fit] free` (entries of
+//! `A`, `B`, `C`, `E`), fitted jointly with the effects of a hypothesis.
+//!
+//! Coordinates: the solver works on `value / scale` with `scale = |nominal|` (or, for a zero
+//! nominal, half the width of its bounds, else the largest entry of its matrix, else 1), so a
+//! unit step is a relative change; user bounds are kept by projection. Each evaluation builds
+//! the modified system (a copy without the model's input) and its exact step maps (`F = A + E C`
+//! changes with the parameters), so the exact discretisation and the hold stay as for the
+//! nominal.
+use model::model_file::FreeParam;
+use model::{Input, System};
+
+/// The freed nominal parameters of a diagnosis.
+#[derive(Debug, Clone)]
+pub struct FreeNominal {
+    pub params: Vec<FreeParam>,
+    /// Values in the model file.
+    pub nominal: Vec<f64>,
+    /// Solver scales (see the module documentation).
+    pub scale: Vec<f64>,
+    /// The model without its input (cheap to copy per evaluation).
+    base: System,
+}
+
+impl FreeNominal {
+    /// The parameters `sys.fit.free` (`None` when the model frees none).
+    pub fn of(sys: &System) -> Option<Self> {
+        if sys.fit.free.is_empty() {
+            return None;
+        }
+        let params = sys.fit.free.clone();
+        let nominal: Vec<f64> = params.iter().map(|f| f.get(sys)).collect();
+        let amax = |f: &FreeParam| {
+            let m = match f.matrix {
+                model::model_file::PlantMatrix::A => &sys.A,
+                model::model_file::PlantMatrix::B => &sys.B,
+                model::model_file::PlantMatrix::C => &sys.C,
+                model::model_file::PlantMatrix::E => &sys.E,
+            };
+            m.amax()
+        };
+        let scale = params
+            .iter()
+            .zip(&nominal)
+            .map(|(f, v)| {
+                if v.abs() > 0.0 {
+                    v.abs()
+                } else if let Some((lo, hi)) = f.bounds {
+                    0.5 * (hi - lo)
+                } else if amax(f) > 0.0 {
+                    amax(f)
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        let mut base = sys.clone();
+        base.input = Input::Zero { m: sys.m() };
+        Some(Self { params, nominal, scale, base })
+    }
+    pub fn k(&self) -> usize {
+        self.params.len()
+    }
+    pub fn names(&self) -> Vec<String> {
+        self.params.iter().map(|p| p.name.clone()).collect()
+    }
+    /// The model (without its input) at parameter values `v`.
+    pub fn system_at(&self, v: &[f64]) -> System {
+        let mut s = self.base.clone();
+        for (p, x) in self.params.iter().zip(v) {
+            p.set(&mut s, *x);
+        }
+        s
+    }
+    /// `sys` (with its input) at parameter values `v`.
+    pub fn apply(&self, sys: &System, v: &[f64]) -> System {
+        let mut s = sys.clone();
+        for (p, x) in self.params.iter().zip(v) {
+            p.set(&mut s, *x);
+        }
+        s
+    }
+    /// Solver coordinates of the bounds (`-inf`, `inf` where unbounded).
+    pub fn bounds_scaled(&self) -> (Vec<f64>, Vec<f64>) {
+        self.params
+            .iter()
+            .zip(&self.scale)
+            .map(|(p, s)| p.bounds.map_or((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi)| (lo / s, hi / s)))
+            .unzip()
+    }
+}
+
+/// The freed parameters of one problem and the values they take when not fitted (the start
+/// of a fit, and the values a simulation of an already fitted hypothesis uses).
+#[derive(Debug, Clone)]
+pub struct Refit<'a> {
+    pub free: &'a FreeNominal,
+    pub values: Vec<f64>,
+}

@@ -1,0 +1,99 @@
+//! The friction library in the diagnosis (issue 14 items 4 and 7): the generator's classes
+//! `stribeck_friction`, `asymmetric_coulomb` and `cogging` are named and their parameters
+//! recovered; the cogging period scan finds the period.
+//!
+//! The full measurement (8 plants per class, none and coulomb_friction alongside) is
+//! `cargo test --release -p discovery --test friction_library -- --ignored` (seeds from
+//! `FRICTION_BENCH_SEEDS`, default the held-out 401,402; about 1 min), equivalently
+//! `cargo run --release -p discovery --example bench_one 8 SEED classic friction`.
+use discovery::bench_gen::{self, FRICTION_CLASSES};
+use discovery::hypothesis::{self, Kind, Scales};
+use discovery::simulate::ExtendedModel;
+use discovery::DiagnoseSettings;
+use model::effects::Effect;
+
+#[test]
+fn cogging_scan_finds_the_period_and_the_hypothesis_is_offered() {
+    let case = bench_gen::generate("cogging", 101, 0);
+    let Some(Effect::Cogging { period, amplitude, .. }) = case.truth else { panic!("{:?}", case.truth) };
+    let sys = &case.nominal;
+    let (w, y): (Vec<f64>, Vec<f64>) =
+        case.recording.w.iter().zip(&case.recording.y).map(|(a, b)| (a[0], b[0])).unzip();
+    let dt = case.recording.dt;
+    let nom = ExtendedModel::new(sys, &[], dt, 4).unwrap().simulate(&w, dt, sys.x0.as_slice());
+    let yr = y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min);
+    let base = Scales {
+        y_range: vec![yr],
+        w_range: vec![2.0],
+        w_absmax: 1.0,
+        tau_slow: 5.0,
+        dt,
+        duration: 60.0,
+        ..Default::default()
+    };
+    let k_est = (0.7 * y.len() as f64) as usize;
+    let scales = base.clone().with_nominal(&nom.x, &nom.y, &y, k_est);
+    let (p, a_s, a_c) = hypothesis::cogging_scan(sys, &scales, 0, 1).expect("a scan");
+    assert!((p / period - 1.0).abs() < 0.02, "period {p} vs {period}");
+    assert!((a_s.hypot(a_c) / amplitude - 1.0).abs() < 0.5, "amplitude {} vs {amplitude}", a_s.hypot(a_c));
+    let kinds: Vec<Kind> = hypothesis::candidates(sys, &scales).iter().map(|h| h.kind).collect();
+    for k in [
+        Kind::StribeckFriction { state: 1 },
+        Kind::AsymmetricCoulomb { state: 1 },
+        Kind::Cogging { state: 1, position_state: 0 },
+    ] {
+        assert!(kinds.contains(&k), "{k:?} missing from {kinds:?}");
+    }
+    // Without the nominal run there is no scan and no cogging hypothesis.
+    assert!(hypothesis::cogging_scan(sys, &base, 0, 1).is_none());
+    assert!(!hypothesis::candidates(sys, &base).iter().any(|h| matches!(h.kind, Kind::Cogging { .. })));
+}
+
+#[test]
+fn friction_classes_fixed_seed_slice() {
+    // One plant per class (development seed 101, case 3); the measurement is the ignored test.
+    let s = DiagnoseSettings::default();
+    for c in FRICTION_CLASSES {
+        let r = discovery::bench::run_case(c, 101, 3, &s);
+        assert!(r.error.is_none(), "{c}: {:?}", r.error);
+        assert!(r.correct, "{c} named {} (ties {:?})", r.selected, r.ties);
+        let e = r.param_error.expect("named correctly");
+        assert!(e <= 0.15, "{c}: main parameter off by {:.1} %: {r:?}", 100.0 * e);
+        assert!(r.fit_after > r.fit_before, "{c}: {r:?}");
+    }
+}
+
+#[test]
+#[ignore = "about 1 minute in release: the friction classes' measurement"]
+fn friction_benchmark_eight_plants_per_class() {
+    // The held-out seeds of BENCHMARKS.md (classic profile); `FRICTION_BENCH_SEEDS=101,102`
+    // gives the development seeds, where stribeck_friction is named in 14/16 only.
+    let seeds: Vec<u64> = std::env::var("FRICTION_BENCH_SEEDS")
+        .unwrap_or_else(|_| "401,402".into())
+        .split(',')
+        .map(|s| s.trim().parse().expect("FRICTION_BENCH_SEEDS: comma-separated integers"))
+        .collect();
+    let classes = discovery::bench::class_set("friction").unwrap();
+    let mut cases = Vec::new();
+    for seed in seeds {
+        let r = discovery::bench::run_classes(
+            &classes,
+            8,
+            seed,
+            bench_gen::Profile::Classic,
+            &DiagnoseSettings::default(),
+            |_| {},
+        );
+        eprintln!("seed {seed}:\n{}", r.to_text());
+        cases.extend(r.cases);
+    }
+    for c in FRICTION_CLASSES {
+        let rows: Vec<_> = cases.iter().filter(|x| x.class == c).collect();
+        let named = rows.iter().filter(|x| x.correct_or_tied).count();
+        let within = rows.iter().filter(|x| x.param_error.is_some_and(|e| e <= 0.15)).count();
+        assert!(named * 10 >= rows.len() * 9, "{c}: named {named}/{}", rows.len());
+        assert!(within * 10 >= rows.iter().filter(|x| x.correct).count() * 9, "{c}: within 15 %: {within}");
+    }
+    let none = cases.iter().filter(|x| x.class == "none" && x.predicted != "none").count();
+    assert!(none <= 1, "{none} false alarms on none");
+}
