@@ -59,6 +59,7 @@ pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 /// `gamma_k = k u / (1 - k u)` (Higham, *Accuracy and Stability*, eq. (3.8)): a sum or dot
 /// product of `k` terms evaluated in any order is within `gamma_k sum |terms|` of the exact
 /// value. `+inf` when `k u >= 1`.
+#[inline]
 pub fn gamma(k: usize) -> f64 {
     let ku = k as f64 * UNIT_ROUNDOFF;
     if ku >= 1.0 {
@@ -70,6 +71,7 @@ pub fn gamma(k: usize) -> f64 {
 
 /// `true` when `x` is zero or a normal number far from under- and overflow, so that the exactness
 /// tests below (which read the sign of an `fma` residual) cannot be fooled by underflow.
+#[inline]
 fn tame(x: f64) -> bool {
     x == 0.0 || (x.is_finite() && x.abs() >= 1e-140 && x.abs() <= 1e140)
 }
@@ -105,6 +107,7 @@ pub fn div_up(a: f64, b: f64) -> f64 {
 }
 
 /// `sqrt(x)` rounded upward (`x >= 0`).
+#[inline]
 pub fn sqrt_up(x: f64) -> f64 {
     let s = x.sqrt();
     if !(tame(x) && tame(s)) {

@@ -10,6 +10,7 @@
 //! Used by `theta::assemble` and by the Theorem 2 properties of the `theorems` campaign, so the
 //! campaign checks the numbers that the report prints.
 use crate::error::BoundsError;
+use crate::tube::xi_support::SemigroupData;
 use crate::tube::{Horizon, TubeKernel, TubeSettings};
 use geometry::{sublinear_sphere_max, Bounds, ConvexSet, Shape, SphereMaxSettings};
 use nalgebra::{DMatrix, DVector};
@@ -47,11 +48,28 @@ pub fn tube_diameters(
     tube: &TubeSettings,
     sphere: &SphereMaxSettings,
 ) -> Result<TubeDiameters, BoundsError> {
-    let p = C.nrows();
     let d_theta = theta.deviation_from_origin().upper;
-    let tube_C = TubeKernel::new(C, F, E, theta, Horizon::Infinite, tube)?;
+    tube_diameters_with(C, F, E, theta, d_theta, &SemigroupData::new(F), tube, sphere)
+}
+
+/// [`tube_diameters`] with `d_theta = theta.deviation_from_origin().upper` and
+/// `sg = SemigroupData::new(F)` computed once by the caller (see
+/// [`TubeKernel::with_shared`]); the same numbers, bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn tube_diameters_with(
+    C: &DMatrix<f64>,
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    theta: &Shape,
+    d_theta: f64,
+    sg: &SemigroupData,
+    tube: &TubeSettings,
+    sphere: &SphereMaxSettings,
+) -> Result<TubeDiameters, BoundsError> {
+    let p = C.nrows();
+    let tube_C = TubeKernel::with_shared(C, F, E, theta, d_theta, sg, Horizon::Infinite, tube)?;
     let CF = C * F;
-    let tube_CF = TubeKernel::new(&CF, F, E, theta, Horizon::Infinite, tube)?;
+    let tube_CF = TubeKernel::with_shared(&CF, F, E, theta, d_theta, sg, Horizon::Infinite, tube)?;
 
     let lip_d = 2.0 * (tube_C.lipschitz() + d_theta);
     let d_b = sublinear_sphere_max(

@@ -7,6 +7,6 @@ pub mod diameters;
 pub mod localisation;
 pub mod xi_support;
 
-pub use diameters::{tube_diameters, OutputTube, TubeDiameters};
+pub use diameters::{tube_diameters, tube_diameters_with, OutputTube, TubeDiameters};
 pub use geometry::sublinear_sphere_max;
-pub use xi_support::{dxx_bound, exp_norm_integral, Horizon, TubeKernel, TubeSettings};
+pub use xi_support::{dxx_bound, exp_norm_integral, Horizon, SemigroupData, TubeKernel, TubeSettings};

@@ -382,7 +382,12 @@ pub fn exp_norm_integral(F: &DMatrix<f64>) -> Result<f64, BoundsError> {
 /// and `q >= ||e^{tau F}||` (module docs) and, when `q < 1/2`, `sup_{s>=0} ||e^{sF}|| <= M`,
 /// `int_0^inf ||e^{rF}|| dr <= tau M / (1 - q)`.
 pub fn exp_norm_bounds(F: &DMatrix<f64>) -> Result<ExpNormBounds, BoundsError> {
-    let mu = lmi::spectral_abscissa(F).map_err(BoundsError::Lmi)?;
+    exp_norm_bounds_mu(F, lmi::spectral_abscissa(F).map_err(BoundsError::Lmi))
+}
+
+/// [`exp_norm_bounds`] given the spectral abscissa of `F` (or the error computing it).
+fn exp_norm_bounds_mu(F: &DMatrix<f64>, mu: Result<f64, BoundsError>) -> Result<ExpNormBounds, BoundsError> {
+    let mu = mu?;
     if mu >= 0.0 {
         return Err(BoundsError::NotHurwitz { mu });
     }
@@ -402,8 +407,8 @@ pub fn exp_norm_bounds(F: &DMatrix<f64>) -> Result<ExpNormBounds, BoundsError> {
 
 /// Proven `sup_{[0, t]} ||e^{sF}||_2` for any `F` (the semigroup bound of a Hurwitz `F`, else a
 /// grid on `[0, t (1 + 2^-20)]` with `max(256, t ||F||)` steps, a power of two, at most 4096).
-fn exp_sup_on(F: &DMatrix<f64>, t: f64) -> f64 {
-    if let Ok(b) = exp_norm_bounds(F) {
+fn exp_sup_on(F: &DMatrix<f64>, t: f64, bounds: &Result<ExpNormBounds, BoundsError>) -> f64 {
+    if let Ok(b) = bounds {
         return b.sup;
     }
     let t = t * (1.0 + 2f64.powi(-20));
@@ -423,6 +428,68 @@ pub fn dxx_bound(F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, t: f64) -> R
     Ok(theta.deviation_from_origin().upper * frob(E) * (frob(&X) + err) * b.integral * (1.0 + 1e-10))
 }
 
+/// What every kernel with the same `F` (resp. the same `Theta`) computes first: the spectral
+/// abscissa of `F`, its proven semigroup bounds ([`exp_norm_bounds`]) and `D(Theta, {0})` from
+/// above. Computed once by a caller that builds several kernels (the Theorem 2 and Lemma 2
+/// checks of the campaign, [`crate::tube::tube_diameters`]) and handed to
+/// [`TubeKernel::with_shared`]: the kernels are the same, bit for bit, as [`TubeKernel::new`]'s.
+/// It also memoises the short-step exponentials `exp_step(F, h)` (with their error bounds) by
+/// the exact bits of `h`: a finite-horizon kernel uses one step for every block, and kernels on
+/// the same `F` (the checkpoints of Lemma 2, `C Xi_inf` and `C F Xi_inf`) start with the same
+/// steps.
+#[derive(Debug)]
+pub struct SemigroupData {
+    f: DMatrix<f64>,
+    mu: Result<f64, BoundsError>,
+    bounds: Result<ExpNormBounds, BoundsError>,
+    steps: std::sync::Mutex<Vec<(u64, DMatrix<f64>, f64)>>,
+}
+
+/// Most memoised steps per [`SemigroupData`].
+const STEP_MEMO: usize = 64;
+
+impl Clone for SemigroupData {
+    fn clone(&self) -> Self {
+        let steps = self.steps.lock().map(|v| v.clone()).unwrap_or_default();
+        Self {
+            f: self.f.clone(),
+            mu: self.mu.clone(),
+            bounds: self.bounds.clone(),
+            steps: std::sync::Mutex::new(steps),
+        }
+    }
+}
+
+impl SemigroupData {
+    /// Spectral abscissa and [`exp_norm_bounds`] of `F`.
+    pub fn new(F: &DMatrix<f64>) -> Self {
+        let mu = lmi::spectral_abscissa(F).map_err(BoundsError::Lmi);
+        let bounds = exp_norm_bounds_mu(F, mu.clone());
+        Self { f: F.clone(), mu, bounds, steps: std::sync::Mutex::new(Vec::new()) }
+    }
+    /// `exp_step(F, h)`, memoised (the same value, bit for bit: a deterministic function of
+    /// `F` and `h`).
+    fn exp_step(&self, h: f64) -> (DMatrix<f64>, f64) {
+        let key = h.to_bits();
+        if let Ok(v) = self.steps.lock() {
+            if let Some((_, S, e)) = v.iter().find(|(k, _, _)| *k == key) {
+                return (S.clone(), *e);
+            }
+        }
+        let r = exp_step(&self.f, h);
+        if let Ok(mut v) = self.steps.lock() {
+            if v.len() < STEP_MEMO {
+                v.push((key, r.0.clone(), r.1));
+            }
+        }
+        r
+    }
+    /// The proven bounds of `e^{sF}` (or why they could not be proven).
+    pub fn bounds(&self) -> &Result<ExpNormBounds, BoundsError> {
+        &self.bounds
+    }
+}
+
 impl TubeKernel {
     /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
     pub fn new(
@@ -434,9 +501,35 @@ impl TubeKernel {
         settings: &TubeSettings,
     ) -> Result<Self, BoundsError> {
         settings.validate()?;
+        let d_theta = theta.deviation_from_origin().upper;
+        Self::with_shared(L, F, E, theta, d_theta, &SemigroupData::new(F), horizon, settings)
+    }
+
+    /// [`Self::new`] with the quantities shared between kernels computed once by the caller:
+    /// `d_theta` must be `theta.deviation_from_origin().upper` and `sg` must be
+    /// `SemigroupData::new(F)` (same `F`), else the enclosure is not proven.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_shared(
+        L: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        d_theta: f64,
+        sg: &SemigroupData,
+        horizon: Horizon,
+        settings: &TubeSettings,
+    ) -> Result<Self, BoundsError> {
+        settings.validate()?;
+        // A `sg` of another F (misuse) is replaced by the right one: never a wrong enclosure.
+        let own;
+        let sg = if sg.f == *F {
+            sg
+        } else {
+            own = SemigroupData::new(F);
+            &own
+        };
         let p = E.ncols();
         let r = L.nrows();
-        let d_theta = theta.deviation_from_origin().upper;
         let zero_in_theta = theta.contains(&vec![0.0; p], 0.0);
         let nF = frob(F);
         let nE = frob(E);
@@ -454,13 +547,13 @@ impl TubeKernel {
                         reason: "must be finite and >= 0",
                     });
                 }
-                let i_inf = exp_norm_bounds(F).ok().map(|b| b.integral);
-                (t, 0.0, exp_sup_on(F, t), i_inf)
+                let i_inf = sg.bounds.as_ref().ok().map(|b| b.integral);
+                (t, 0.0, exp_sup_on(F, t, &sg.bounds), i_inf)
             }
             Horizon::Infinite => {
-                let b = exp_norm_bounds(F)?;
+                let b = sg.bounds.clone()?;
                 let i_inf = b.integral;
-                let mu = lmi::spectral_abscissa(F).map_err(BoundsError::Lmi)?;
+                let mu = sg.mu.clone()?;
                 let mut S = 8.0 / -mu;
                 let mut tail;
                 loop {
@@ -497,13 +590,14 @@ impl TubeKernel {
         // e^{mu s} h^3), capped at 1 / ||F||; h0 shrinks (remainder ~ h0^2) until the summed
         // remainders are below tol / 2. The grading only affects efficiency, not rigour.
         let grade = match horizon {
-            Horizon::Infinite => (-lmi::spectral_abscissa(F).map_err(BoundsError::Lmi)?).max(0.0) / 3.0,
+            Horizon::Infinite => (-sg.mu.clone()?).max(0.0) / 3.0,
             Horizon::Finite(_) => 0.0,
         };
         let h_cap = 1.0 / nF.max(1e-300);
         let mut h0 = (0.05_f64).min(0.5 * h_cap);
         loop {
             let k = Self::build(
+                sg,
                 L,
                 &LF,
                 &LF2,
@@ -554,6 +648,7 @@ impl TubeKernel {
 
     #[allow(clippy::too_many_arguments)]
     fn build(
+        sg: &SemigroupData,
         L: &DMatrix<f64>,
         LF: &DMatrix<f64>,
         LF2: &DMatrix<f64>,
@@ -622,12 +717,12 @@ impl TubeKernel {
             }
             let rr = 0.5 * hb;
             let grow = (rr * nF).exp();
-            let (step, e_step) = exp_step(F, hb);
+            let (step, e_step) = sg.exp_step(hb);
             let n_step = frob(&step);
             // First centre of the block.
             P = Some(match P.take() {
                 None => {
-                    let (P0, e0) = exp_step(F, rr);
+                    let (P0, e0) = sg.exp_step(rr);
                     cum_loc += e0;
                     advance(&mut t_hi, &mut t_lo, &mut t_lo_abs, rr);
                     P0
@@ -635,7 +730,7 @@ impl TubeKernel {
                 Some(Pp) => {
                     let (g, e) = two_sum(prev_rr, rr);
                     defects += e.abs();
-                    let (G, eG) = exp_step(F, g);
+                    let (G, eG) = sg.exp_step(g);
                     cum_loc += frob(&Pp) * (eG + gn * frob(&G));
                     advance(&mut t_hi, &mut t_lo, &mut t_lo_abs, g);
                     &Pp * &G
@@ -749,10 +844,7 @@ impl TubeKernel {
     pub fn support_bounds(&self, v: &[f64]) -> geometry::Bounds {
         let mut buf = vec![0.0; self.p];
         let nv = geometry::linalg::norm(v) * (1.0 + 2.0 * gamma(self.r + 2));
-        let up = self.sum(&self.minus, v, &mut buf, true)
-            + self.sum(&self.plus, v, &mut buf, true)
-            + nv * (self.remainder + self.tail + self.rounding_up) * (1.0 + 8.0 * U);
-        let up = if up.is_finite() { up.next_up() } else { up };
+        let up = self.upper_value(v, nv, &mut buf);
         let lo_tail = if self.zero_in_theta { 0.0 } else { nv * self.tail };
         let lo = 2.0 * self.sum(&self.mid, v, &mut buf, false)
             - nv * (self.remainder + self.rounding_lo) * (1.0 + 8.0 * U)
@@ -760,9 +852,66 @@ impl TubeKernel {
         geometry::Bounds::new(lo, up.max(lo))
     }
 
-    /// Upper bound of `sigma_{L Xi}(v)`.
+    /// `(sum_j w_j sup(M_j^T v))` over `minus` and over `plus` in one pass, each accumulated in
+    /// the order of [`Self::sum`] (the same values, bit for bit), `sup` monomorphised.
+    #[inline]
+    fn upper_sums_with(&self, v: &[f64], buf: &mut [f64], sup: impl Fn(&[f64]) -> f64) -> (f64, f64) {
+        let (p, r) = (self.p, self.r);
+        let (mut am, mut ap) = (0.0, 0.0);
+        for (j, &w) in self.half.iter().enumerate() {
+            let M = &self.minus[j * p * r..(j + 1) * p * r];
+            for (i, b) in buf.iter_mut().enumerate() {
+                *b = M[i * r..(i + 1) * r].iter().zip(v).map(|(a, x)| a * x).sum();
+            }
+            am += w * sup(buf);
+            let M = &self.plus[j * p * r..(j + 1) * p * r];
+            for (i, b) in buf.iter_mut().enumerate() {
+                *b = M[i * r..(i + 1) * r].iter().zip(v).map(|(a, x)| a * x).sum();
+            }
+            ap += w * sup(buf);
+        }
+        (am, ap)
+    }
+
+    /// The upper sums over `minus` and `plus` with `sigma_Theta` from above: the closed forms of
+    /// `geometry::Shape::support_upper` inlined per shape, else [`ThetaSupport::support_upper`].
+    fn upper_sums(&self, v: &[f64], buf: &mut [f64]) -> (f64, f64) {
+        use geometry::shapes::upper::{ball_support_upper, ellipsoid_support_upper, mul_up};
+        match &self.theta {
+            ThetaSupport::Shape(Shape::Interval(i)) => {
+                self.upper_sums_with(v, buf, |u| mul_up(u[0], if u[0] >= 0.0 { i.hi } else { i.lo }))
+            }
+            ThetaSupport::Shape(Shape::Ball(b)) => {
+                self.upper_sums_with(v, buf, |u| ball_support_upper(&b.centre, b.radius, u))
+            }
+            ThetaSupport::Shape(Shape::Ellipsoid(e)) => {
+                self.upper_sums_with(v, buf, |u| ellipsoid_support_upper(e.centre(), e.matrix(), u))
+            }
+            other => self.upper_sums_with(v, buf, |u| other.support_upper(u)),
+        }
+    }
+
+    /// The proven upper value of [`Self::support_bounds`] (`nv`: `|v|` rounded up as there).
+    fn upper_value(&self, v: &[f64], nv: f64, buf: &mut [f64]) -> f64 {
+        let (am, ap) = self.upper_sums(v, buf);
+        let up = am + ap + nv * (self.remainder + self.tail + self.rounding_up) * (1.0 + 8.0 * U);
+        if up.is_finite() {
+            up.next_up()
+        } else {
+            up
+        }
+    }
+
+    /// Upper bound of `sigma_{L Xi}(v)`: the upper value of [`Self::support_bounds`] (proven,
+    /// module docs) without the lower sum, which only an indication needs.
     pub fn support_upper(&self, v: &[f64]) -> f64 {
-        self.support_bounds(v).upper
+        let nv = geometry::linalg::norm(v) * (1.0 + 2.0 * gamma(self.r + 2));
+        if self.p <= 8 {
+            let mut buf = [0.0; 8];
+            self.upper_value(v, nv, &mut buf[..self.p])
+        } else {
+            self.upper_value(v, nv, &mut vec![0.0; self.p])
+        }
     }
 
     /// Lipschitz constant (in `v`) of [`Self::support_upper`] and of the true support function:

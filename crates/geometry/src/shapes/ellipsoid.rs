@@ -28,6 +28,20 @@ pub struct Ellipsoid {
     /// Proven enclosure of `lambda_min(M)` from below and `lambda_max(M)` from above (`None` when
     /// the verification failed: `R` is then only a numerical estimate).
     enclosure: Option<EigenEnclosure>,
+    /// [`ConvexSet::deviation_from_origin`] once computed (a sphere maximum for an off-centre
+    /// ellipsoid; asked for several times per system by `model` and the tube kernels of
+    /// `bounds`). A function of the fields above, which never change after construction.
+    deviation: DeviationCache,
+}
+
+/// Memo of a deterministic function of the ellipsoid: ignored by `==`.
+#[derive(Debug, Clone, Default)]
+struct DeviationCache(std::sync::OnceLock<Bounds>);
+
+impl PartialEq for DeviationCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl Ellipsoid {
@@ -74,7 +88,7 @@ impl Ellipsoid {
         }
         let m: Vec<f64> = (0..p * p).map(|ij| sym[(ij / p, ij % p)]).collect();
         let enclosure = symmetric_eigen_enclosure(&m, p, lam[0], lam[p - 1]);
-        Ok(Self { centre, m, lam, v, m_inv, enclosure })
+        Ok(Self { centre, m, lam, v, m_inv, enclosure, deviation: DeviationCache::default() })
     }
 
     /// Axis-aligned ellipsoid with the given semi-axes.
@@ -180,6 +194,18 @@ impl Ellipsoid {
             t = tn;
         }
         t
+    }
+}
+
+impl Ellipsoid {
+    /// `D(E, {0})` by its definition (see [`ConvexSet::deviation_from_origin`]), not memoised.
+    fn deviation_from_origin_uncached(&self) -> Bounds {
+        let up = self.a_max_upper();
+        let cn = norm(&self.centre);
+        if cn == 0.0 {
+            return Bounds::new(self.lam[self.lam.len() - 1].sqrt().min(up), up);
+        }
+        crate::sphere_max(self.dim(), |u| self.support(u), (cn + up) * (1.0 + 1e-12), &Default::default())
     }
 }
 
@@ -330,12 +356,7 @@ impl ConvexSet for Ellipsoid {
     /// `max_{|u|=1} c^T u + sqrt(u^T M u)`; `a_max` (from above) when `c = 0`, otherwise
     /// certified by [`crate::sphere_max`].
     fn deviation_from_origin(&self) -> Bounds {
-        let up = self.a_max_upper();
-        let cn = norm(&self.centre);
-        if cn == 0.0 {
-            return Bounds::new(self.lam[self.lam.len() - 1].sqrt().min(up), up);
-        }
-        crate::sphere_max(self.dim(), |u| self.support(u), (cn + up) * (1.0 + 1e-12), &Default::default())
+        *self.deviation.0.get_or_init(|| self.deviation_from_origin_uncached())
     }
     /// `R = lambda_max / sqrt(lambda_min)` from the verified eigenvalue enclosure, rounded upward:
     /// `Exact` for a diagonal `M` (exact eigenvalues), `UpperBound` otherwise; `Numerical` (not a

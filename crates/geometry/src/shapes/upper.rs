@@ -24,6 +24,7 @@ pub(crate) fn up(x: f64) -> f64 {
 }
 
 /// `a b` rounded upward (exactness of the nearest product checked with `fma`).
+#[inline]
 pub fn mul_up(a: f64, b: f64) -> f64 {
     let p = a * b;
     if !p.is_finite() {
@@ -40,6 +41,7 @@ pub fn mul_up(a: f64, b: f64) -> f64 {
 }
 
 /// Upper bound of `sigma_{B_r(c)}(u) = c^T u + r |u|`.
+#[inline]
 pub fn ball_support_upper(c: &[f64], r: f64, u: &[f64]) -> f64 {
     let p = u.len();
     let (mut d, mut ad, mut ss) = (0.0, 0.0, 0.0);
@@ -54,6 +56,7 @@ pub fn ball_support_upper(c: &[f64], r: f64, u: &[f64]) -> f64 {
 }
 
 /// Upper bound of `sigma(u) = c^T u + sqrt(u^T M u)` (ellipsoid, `M` row-major `p x p`).
+#[inline]
 pub fn ellipsoid_support_upper(c: &[f64], m: &[f64], u: &[f64]) -> f64 {
     let p = u.len();
     let (mut q, mut aq) = (0.0, 0.0);

@@ -18,7 +18,7 @@ use super::sets_prelude::*;
 use super::simulation::{linear_response_exact, simulate};
 use crate::strategies::inputs::InputStrategyConfig;
 use crate::strategies::systems::{system_params, SystemParams, SystemStrategyConfig};
-use bounds::tube::{Horizon, TubeKernel, TubeSettings};
+use bounds::tube::{Horizon, SemigroupData, TubeKernel, TubeSettings};
 use nalgebra::DVector;
 
 /// Step of the scheme and of the quadrature.
@@ -81,15 +81,28 @@ pub fn eval(case: &Lemma2Case, variant: Variant) -> Eval {
     let I = nalgebra::DMatrix::<f64>::identity(n, n);
     let p = sys.p();
     let unit_ball = geometry::Shape::Ball(geometry::Ball::new(vec![0.0; p], 1.0).expect("unit ball"));
+    // Computed once for the 2 x CHECKPOINTS kernels (`TubeKernel::with_shared`: the same
+    // kernels as `TubeKernel::new`): D(Theta, {0}), D(unit ball, {0}), the semigroup bounds of F.
     let d_theta = sys.theta.deviation_from_origin().upper;
+    let d_ball = unit_ball.deviation_from_origin().upper;
+    let sg = SemigroupData::new(&F);
     let mut worst: Option<Eval> = None;
     for c in 1..=CHECKPOINTS {
         let k = (c * steps).div_ceil(CHECKPOINTS);
         let t = k as f64 * H;
         let tube = TubeSettings { tol_abs: 1e-6 * d_theta.max(1e-300), ..TubeSettings::default() };
         let (Ok(xi_t), Ok(norm_t)) = (
-            TubeKernel::new(&I, &F, &sys.E, &sys.theta, Horizon::Finite(t), &tube),
-            TubeKernel::new(&I, &F, &sys.E, &unit_ball, Horizon::Finite(t), &TubeSettings { tol_abs: 1e-6, ..tube }),
+            TubeKernel::with_shared(&I, &F, &sys.E, &sys.theta, d_theta, &sg, Horizon::Finite(t), &tube),
+            TubeKernel::with_shared(
+                &I,
+                &F,
+                &sys.E,
+                &unit_ball,
+                d_ball,
+                &sg,
+                Horizon::Finite(t),
+                &TubeSettings { tol_abs: 1e-6, ..tube },
+            ),
         ) else {
             return Eval::skipped();
         };
