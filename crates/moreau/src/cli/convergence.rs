@@ -54,7 +54,24 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         n0 * (a.levels + 1) as f64 * (sys.n() + sys.p()) as f64,
         "numbers stored per level",
     )?;
-    let s = convergence_study(&sys, &ConvergenceSettings { h0: a.h0, levels: a.levels, t_end })?;
+    // progress: the study runs as one call, so a spinner with the elapsed time and the work
+    // it does (indicatif draws nothing when stderr is not a terminal)
+    let total_steps = n0 * (2f64.powi(levels) - 1.0 + 2f64.powi(levels));
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.set_message(format!(
+        "{} levels from h0 = {} and the reference: {} steps in all",
+        a.levels,
+        num(a.h0),
+        num(total_steps)
+    ));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let s = convergence_study(&sys, &ConvergenceSettings { h0: a.h0, levels: a.levels, t_end });
+    bar.finish_and_clear();
+    let s = s?;
     if sys.effects.list.is_empty() {
         println!("{}: catching-up vs event-driven reference over [0, {:.6}] ({} events)", sys.name, s.t_end, s.events);
     } else {
