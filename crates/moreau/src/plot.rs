@@ -43,6 +43,27 @@ pub fn register_fonts() {
     });
 }
 
+/// `svg` (as plotters writes it, `font-family="sans-serif"` on each text) with the DejaVu Sans
+/// font embedded: an `@font-face` rule whose source is the font file itself as a base64 data
+/// URL (regular weight: every text of the figures is), and a style rule (which overrides the presentation attributes) setting it on every
+/// text, so the file renders with the same font on any machine, as its PNG twin does.
+pub fn embed_font(svg: String) -> String {
+    use base64::Engine;
+    static STYLE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    let style = STYLE.get_or_init(|| {
+        let b64 = |bytes: &[u8]| base64::engine::general_purpose::STANDARD.encode(bytes);
+        format!(
+            "<defs><style>@font-face{{font-family:\"DejaVu Sans\";src:url(data:font/ttf;base64,{})}} \
+             text{{font-family:\"DejaVu Sans\",sans-serif}}</style></defs>",
+            b64(dejavu::sans::regular())
+        )
+    });
+    match svg.find("<svg").and_then(|i| svg[i..].find('>').map(|j| i + j + 1)) {
+        Some(at) => format!("{}\n{}{}", &svg[..at], style, &svg[at..]),
+        None => svg,
+    }
+}
+
 fn ranges(p: &LinePlot) -> Result<((f64, f64), (f64, f64))> {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
     for s in &p.series {
@@ -133,7 +154,7 @@ pub fn to_svg_string(p: &LinePlot) -> Result<String> {
         let root = SVGBackend::with_string(&mut buf, size(p)).into_drawing_area();
         draw(root, p)?;
     }
-    Ok(buf)
+    Ok(embed_font(buf))
 }
 
 /// Writes the plot as PNG to `path` (use a staging path for atomic output).

@@ -133,10 +133,12 @@ fn figures_are_written_as_svg_and_png_with_text() {
         assert!(o.status.success(), "{kind}: {}", String::from_utf8_lossy(&o.stderr));
     }
     for (stem, text) in
-        [("fig-psi1", "ψ(γ)"), ("fig-loop", "η_T"), ("trajectory-yz", "y = C x"), ("trajectory-x", "x1")]
+        [("fig-psi1", "ψ(γ)"), ("fig-loop", "Orbit η"), ("trajectory-yz", "y = C x"), ("trajectory-x", "x1")]
     {
         let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
         assert!(svg.contains("<text") && svg.contains(text), "{stem}.svg lacks `{text}`");
+        // the font travels with the file (a data URL of DejaVu Sans), not just its name
+        assert!(svg.contains("@font-face{font-family:\"DejaVu Sans\"") && svg.contains("data:font/ttf;base64,AAEAAA"));
         let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
         assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "{stem}.png");
     }

@@ -138,6 +138,76 @@ impl Figure {
     }
 }
 
+/// `text` in runs of (text, is_subscript): `_X` with `X` a single letter or digit (not followed
+/// by another) is a subscript, as in `η_T`; `theta_best` keeps its underscore (the rule of
+/// [`super::pgf::tex_text`]).
+fn rich_runs(text: &str) -> Vec<(String, bool)> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut runs: Vec<(String, bool)> = vec![];
+    let mut i = 0;
+    while i < chars.len() {
+        let single = chars.get(i + 1).is_some_and(|c| c.is_alphanumeric())
+            && !chars.get(i + 2).is_some_and(|c| c.is_alphanumeric());
+        if chars[i] == '_' && single {
+            runs.push((chars[i + 1].to_string(), true));
+            i += 2;
+            continue;
+        }
+        match runs.last_mut() {
+            Some((s, false)) => s.push(chars[i]),
+            _ => runs.push((chars[i].to_string(), false)),
+        }
+        i += 1;
+    }
+    runs
+}
+
+/// Width in pixels of `text` drawn by [`draw_rich`] at `size`.
+fn rich_width<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, text: &str, size: u32) -> i32 {
+    rich_runs(text)
+        .iter()
+        .map(|(s, sub)| {
+            let sz = if *sub { size * 7 / 10 } else { size };
+            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
+                .map(|(w, _)| w as i32)
+                .unwrap_or(0)
+        })
+        .sum()
+}
+
+/// Draws `text` with its top-left at `at`, subscripts (see [`rich_runs`]) smaller and lower.
+fn draw_rich<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    text: &str,
+    at: (i32, i32),
+    size: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut x = at.0;
+    for (s, sub) in rich_runs(text) {
+        let (sz, dy) = if sub { (size * 7 / 10, (size * 45 / 100) as i32) } else { (size, 0) };
+        let font = ("sans-serif", sz).into_font().color(&BLACK);
+        area.draw(&Text::new(s.clone(), (x, at.1 + dy), font.clone()))?;
+        x += area
+            .estimate_text_size(&s, &TextStyle::from(("sans-serif", sz).into_font()))
+            .map(|(w, _)| w as i32)
+            .unwrap_or(0);
+    }
+    Ok(())
+}
+
+/// Axis labels (drawn by plotters, possibly rotated): `_D` with `D` a digit as the Unicode
+/// subscript digit (in the embedded DejaVu font); other subscripts are left as written.
+fn unicode_subscripts(text: &str) -> String {
+    rich_runs(text)
+        .into_iter()
+        .map(|(s, is_sub)| match (is_sub, s.chars().next().and_then(|c| c.to_digit(10))) {
+            (true, Some(d)) => char::from_u32(0x2080 + d).map_or(format!("_{s}"), String::from),
+            (true, None) => format!("_{s}"),
+            (false, _) => s,
+        })
+        .collect()
+}
+
 fn finite(p: &[(f64, f64)]) -> Vec<(f64, f64)> {
     p.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite()).collect()
 }
@@ -148,20 +218,25 @@ where
 {
     let err = |e: &dyn std::fmt::Debug| FigureError::Draw { figure: f.title.clone(), reason: format!("{e:?}") };
     root.fill(&WHITE).map_err(|e| err(&e))?;
+    // the title drawn by us (subscripts as subscripts), the panels below it
+    let body = if f.title.is_empty() {
+        root.clone()
+    } else {
+        let (top, body) = root.split_vertically(40);
+        let (w, _) = top.dim_in_pixel();
+        let tw = rich_width(&top, &f.title, 22);
+        draw_rich(&top, &f.title, ((w as i32 - tw) / 2, 10), 22).map_err(|e| err(&e))?;
+        body
+    };
     if f.below.is_empty() {
-        draw_panel(&root, f, None, true)?;
+        draw_panel(&body, f, None)?;
     } else {
         let xr = f.shared_x_range().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
-        let body = if f.title.is_empty() {
-            root.clone()
-        } else {
-            root.titled(&f.title, ("sans-serif", 22)).map_err(|e| err(&e))?
-        };
         let panels = f.panels();
         for (area, p) in body.split_evenly((panels.len(), 1)).iter().zip(panels) {
             // an empty panel (no finite data) is left blank rather than failing the figure
             if p.ranges().is_some() {
-                draw_panel(area, p, Some(xr), false)?;
+                draw_panel(area, p, Some(xr))?;
             }
         }
     }
@@ -170,12 +245,11 @@ where
 }
 
 /// One panel of `f` in `root`: its own y range, the x range `x_range` when given (stacked
-/// panels), its title when `title`.
+/// panels).
 fn draw_panel<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     f: &Figure,
     x_range: Option<(f64, f64)>,
-    title: bool,
 ) -> Result<(), FigureError>
 where
     DB::ErrorType: 'static,
@@ -184,9 +258,6 @@ where
     let ((x0, x1), (y0, y1)) = f.ranges().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
     let (x0, x1) = x_range.unwrap_or((x0, x1));
     let mut builder = ChartBuilder::on(root);
-    if title && !f.title.is_empty() {
-        builder.caption(&f.title, ("sans-serif", 22));
-    }
     let mut chart = builder
         .margin(14)
         .margin_right(14 + f.legend_width())
@@ -218,8 +289,8 @@ where
         .configure_mesh()
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
-        .x_desc(f.x_label.as_str())
-        .y_desc(f.y_label.as_str())
+        .x_desc(unicode_subscripts(&f.x_label))
+        .y_desc(unicode_subscripts(&f.y_label))
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .light_line_style(RGBColor(235, 235, 235))
@@ -288,8 +359,7 @@ where
             Element::Markers { .. } => root.draw(&Circle::new((lx + 11, ly), 5, c.filled())),
         }
         .map_err(|e| err(&e))?;
-        root.draw(&Text::new(label.clone(), (lx + 30, ly - 9), ("sans-serif", 15).into_font().color(&BLACK)))
-            .map_err(|e| err(&e))?;
+        draw_rich(root, label, (lx + 30, ly - 9), 15).map_err(|e| err(&e))?;
         ly += 22;
     }
     Ok(())
@@ -303,7 +373,7 @@ pub fn to_svg(f: &Figure) -> Result<String, FigureError> {
         let root = SVGBackend::with_string(&mut buf, f.size).into_drawing_area();
         draw(root, f)?;
     }
-    Ok(buf)
+    Ok(crate::plot::embed_font(buf))
 }
 
 /// Writes the figure as PNG to `path`.

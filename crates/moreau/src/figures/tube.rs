@@ -83,7 +83,7 @@ pub fn tube_figure(sys: &System, orbit: &EtaOrbit, tube: &OutputTube, z_periodic
     if p == 1 {
         let up: Vec<f64> = orbit.eta.iter().map(|e| e[0] + tube.support_upper(&[1.0])).collect();
         let lo: Vec<f64> = orbit.eta.iter().map(|e| e[0] - tube.support_upper(&[-1.0])).collect();
-        let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "t (one period)", "η_T, z");
+        let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "t (one period)", "output space");
         f.elements.push(Element::Band {
             label: "tube η_T + C Ξ∞ + Θ".into(),
             x: orbit.t.clone(),
