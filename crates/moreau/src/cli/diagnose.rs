@@ -221,15 +221,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `v` with 4 significant digits, plain for moderate magnitudes, scientific otherwise.
+/// 4 significant digits, as the sweep tables write numbers.
 fn sig4(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32;
-    if (-3..5).contains(&e) {
-        format!("{:.*}", (3 - e).max(0) as usize, v)
-    } else {
-        format!("{v:.3e}")
-    }
+    crate::sweep::table::sig(v, 4, false)
 }

@@ -31,6 +31,16 @@ pub enum Element {
 }
 
 impl Element {
+    /// The legend label (empty: no legend entry) and the colour.
+    pub fn label_and_color(&self) -> (&str, RGBColor) {
+        match self {
+            Element::Line { label, color, .. }
+            | Element::Band { label, color, .. }
+            | Element::Polygon { label, color, .. }
+            | Element::Markers { label, color, .. } => (label, *color),
+        }
+    }
+
     fn points(&self) -> Vec<(f64, f64)> {
         match self {
             Element::Line { pts, .. } | Element::Polygon { pts, .. } | Element::Markers { pts, .. } => pts.clone(),
@@ -74,17 +84,7 @@ impl Figure {
     /// Width in pixels of the legend column right of the plot (0 when nothing is labelled):
     /// the legend stands beside the data, never on it.
     pub fn legend_width(&self) -> u32 {
-        let chars = self
-            .elements
-            .iter()
-            .map(|e| match e {
-                Element::Line { label, .. }
-                | Element::Band { label, .. }
-                | Element::Polygon { label, .. }
-                | Element::Markers { label, .. } => label.chars().count(),
-            })
-            .max()
-            .unwrap_or(0);
+        let chars = self.elements.iter().map(|e| e.label_and_color().0.chars().count()).max().unwrap_or(0);
         if chars == 0 {
             0
         } else {
@@ -338,12 +338,7 @@ where
     let base = root.get_base_pixel();
     let (lx, mut ly) = (xr.end - base.0 + 12, yr.start - base.1 + 8);
     for e in &f.elements {
-        let (label, c) = match e {
-            Element::Line { label, color, .. }
-            | Element::Band { label, color, .. }
-            | Element::Polygon { label, color, .. }
-            | Element::Markers { label, color, .. } => (label, *color),
-        };
+        let (label, c) = e.label_and_color();
         if label.is_empty() {
             continue;
         }
