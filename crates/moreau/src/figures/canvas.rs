@@ -186,17 +186,54 @@ fn draw_rich<DB: DrawingBackend>(
     for (s, sub) in rich_runs(text) {
         let (sz, dy) = if sub { (size * 7 / 10, (size * 45 / 100) as i32) } else { (size, 0) };
         let font = ("sans-serif", sz).into_font().color(&BLACK);
-        area.draw(&Text::new(s.clone(), (x, at.1 + dy), font.clone()))?;
-        x += area
-            .estimate_text_size(&s, &TextStyle::from(("sans-serif", sz).into_font()))
-            .map(|(w, _)| w as i32)
-            .unwrap_or(0);
+        let width = |s: &str| {
+            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
+                .map(|(w, _)| w as i32)
+                .unwrap_or(0)
+        };
+        // leading blanks are dropped by the backends: skip their width instead
+        let lead = width(&s) - width(s.trim_start());
+        area.draw(&Text::new(s.trim_start().to_string(), (x + lead, at.1 + dy), font.clone()))?;
+        x += width(&s);
     }
     Ok(())
 }
 
-/// Axis labels (drawn by plotters, possibly rotated): `_D` with `D` a digit as the Unicode
-/// subscript digit (in the embedded DejaVu font); other subscripts are left as written.
+/// Draws `text` rotated a quarter turn counter-clockwise (reading upwards, as a y-axis label),
+/// centred on `centre`, subscripts (see [`rich_runs`]) smaller and set off to the reader's
+/// "below", i.e. towards the axis.
+fn draw_rich_vertical<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    text: &str,
+    centre: (i32, i32),
+    size: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let total = rich_width(area, text, size);
+    let mut y = centre.1 + total / 2;
+    for (s, sub) in rich_runs(text) {
+        let (sz, dx) = if sub { (size * 7 / 10, (size * 45 / 100) as i32) } else { (size, 0) };
+        let font = ("sans-serif", sz).into_font().transform(FontTransform::Rotate270).color(&BLACK);
+        let width = |s: &str| {
+            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
+                .map(|(w, _)| w as i32)
+                .unwrap_or(0)
+        };
+        let lead = width(&s) - width(s.trim_start());
+        area.draw(&Text::new(s.trim_start().to_string(), (centre.0 - size as i32 / 2 + dx, y - lead), font))?;
+        y -= width(&s);
+    }
+    Ok(())
+}
+
+/// Whether `text` has a subscript that is not a digit (those have no Unicode subscript glyph
+/// in general, so the axis label is drawn by [`draw_rich`] / [`draw_rich_vertical`]).
+fn has_letter_subscript(text: &str) -> bool {
+    rich_runs(text).iter().any(|(s, sub)| *sub && !s.chars().all(|c| c.is_ascii_digit()))
+}
+
+/// Axis labels drawn by plotters (possibly rotated): `_D` with `D` a digit as the Unicode
+/// subscript digit (in the embedded DejaVu font). Labels with letter subscripts are drawn by
+/// [`draw_rich`] instead (see [`has_letter_subscript`]).
 fn unicode_subscripts(text: &str) -> String {
     rich_runs(text)
         .into_iter()
@@ -285,17 +322,34 @@ where
             s
         }
     };
-    chart
-        .configure_mesh()
-        .x_label_formatter(&fx)
+    let (rich_x, rich_y) = (has_letter_subscript(&f.x_label), has_letter_subscript(&f.y_label));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_label_formatter(&fx)
         .y_label_formatter(&fy)
-        .x_desc(unicode_subscripts(&f.x_label))
-        .y_desc(unicode_subscripts(&f.y_label))
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(|e| err(&e))?;
+        .light_line_style(RGBColor(235, 235, 235));
+    if !rich_x {
+        mesh.x_desc(unicode_subscripts(&f.x_label));
+    }
+    if !rich_y {
+        mesh.y_desc(unicode_subscripts(&f.y_label));
+    }
+    mesh.draw().map_err(|e| err(&e))?;
+    {
+        // axis labels with letter subscripts: drawn by us, as the title and legend are
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        let base = root.get_base_pixel();
+        let (left, right) = (xr.start - base.0, xr.end - base.0);
+        let (top, bottom) = (yr.start - base.1, yr.end - base.1);
+        if rich_x {
+            let w = rich_width(root, &f.x_label, 17);
+            draw_rich(root, &f.x_label, ((left + right - w) / 2, bottom + 24), 17).map_err(|e| err(&e))?;
+        }
+        if rich_y {
+            draw_rich_vertical(root, &f.y_label, (left - 56, (top + bottom) / 2), 17).map_err(|e| err(&e))?;
+        }
+    }
     for e in &f.elements {
         match e {
             Element::Band { x, lo, hi, color, .. } => {
@@ -422,4 +476,46 @@ pub fn write_figure_as(figs: &[(String, Figure)], out: &Path, formats: &[Format]
     }
     staged.commit().map_err(|e| werr(out, &e))?;
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn figure(x_label: &str, y_label: &str) -> Figure {
+        let mut f = Figure::new("t", x_label, y_label);
+        let pts = (0..20).map(|k| (k as f64, (k as f64 * 0.3).sin())).collect();
+        f.elements.push(Element::Line { label: "a".into(), pts, color: BLUE, dashed: false });
+        f
+    }
+
+    /// The trimmed contents of the SVG's text elements.
+    fn svg_texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim().to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn letter_subscripts_in_axis_labels_are_drawn_as_subscripts() {
+        assert!(has_letter_subscript("η_T (s)"));
+        assert!(!has_letter_subscript("η_1, z_1"));
+        assert!(!has_letter_subscript("theta_best"));
+        let svg = to_svg(&figure("η_T (s)", "γ_k")).unwrap();
+        // the label's parts are drawn as separate texts, the underscore never
+        assert!(!svg.contains("η_T") && !svg.contains("γ_k"), "literal underscore left in an axis label");
+        let texts = svg_texts(&svg);
+        assert!(texts.iter().any(|t| t == "T") && texts.iter().any(|t| t == "(s)"), "x label parts missing: {texts:?}");
+        assert!(texts.iter().any(|t| t == "k"), "y label subscript missing: {texts:?}");
+        // negative control: a multi-letter suffix keeps its underscore (not a subscript)
+        let svg = to_svg(&figure("t", "theta_best")).unwrap();
+        assert!(svg.contains("theta_best"));
+    }
+
+    #[test]
+    fn digit_subscripts_in_axis_labels_become_unicode_subscripts() {
+        let svg = to_svg(&figure("η_1", "z_2")).unwrap();
+        assert!(svg.contains("η₁") && svg.contains("z₂"));
+    }
 }
