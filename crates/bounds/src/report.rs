@@ -154,6 +154,14 @@ pub mod defs {
         Upper,
         "chord of eq. (theta) per cell of a speed profile (beyond the paper, proofs-notes/theta-profile.md)",
     );
+    pub const THETA_ENGAGED: QuantityDef = q(
+        "theta_engaged",
+        "theta_engaged",
+        "$\\theta_{\\mathrm{eng}}$",
+        "(theta),(ydot),(diffs1)",
+        Upper,
+        "theta_profile with speed floors where the backlash is engaged, p = 1 (beyond the paper, proofs-notes/theta-engaged.md)",
+    );
     pub const PATH_BOUND: QuantityDef =
         q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");
     pub const PATH1_BOUND: QuantityDef =
@@ -190,7 +198,7 @@ pub mod defs {
     );
 
     /// All of them, in report order.
-    pub const ALL: [&QuantityDef; 29] = [
+    pub const ALL: [&QuantityDef; 30] = [
         &PERIOD,
         &MU,
         &R,
@@ -212,6 +220,7 @@ pub mod defs {
         &GAMMA_1_STAR,
         &THETA_STAR,
         &THETA_PROFILE,
+        &THETA_ENGAGED,
         &PATH_BOUND,
         &PATH1_BOUND,
         &PATH2_BOUND,
@@ -329,6 +338,7 @@ pub fn glossary(key: &str) -> Option<&'static str> {
         "gamma_1_star" => "gamma_1*, gamma_1 from the strongest proven path bound per period ((path1) or (path2) instead of (path)).",
         "theta_star" => "theta*, eq. (theta) with gamma_1* and the best certified (lambda, beta): a proven bound beyond the paper (proofs-notes/theta-star.md).",
         "theta_profile" => "theta_profile, the chord of theta applied cell by cell of the speed bound |eta_T'(t)| + D, with path bounds per interval: a proven bound beyond the paper, never above theta* (proofs-notes/theta-profile.md).",
+        "theta_engaged" => "theta_engaged, theta_profile with a floor on the backlash speed where the output has provably moved monotonically by Theta's width, so the backlash is engaged and moves with it (p = 1): a proven bound beyond the paper, never above theta_profile (proofs-notes/theta-engaged.md).",
         "path_bound" => "(path), the paper's lower bound of the backlash path per period: (osc - d)_+.",
         "path1_bound" => "(path1), the path bound over a partition of the period (sum of (|eta_T jumps| - d)_+), computed on a grid: at least (path).",
         "path2_bound" => "(path2), the path bound from a packing of the orbit by balls of radius eps > d/2.",

@@ -22,9 +22,10 @@ fn readable_report_and_json() {
         "(path1)",
         "(path2)",
         "(stat1)",
-        "Verdict: theta_profile = ",
+        "Verdict: theta_engaged = ",
         "theta*",
         "theta_profile",
+        "theta_engaged",
         // the paper's printed equation numbers next to the source labels
         "(84)",
     ] {

@@ -5,7 +5,7 @@
 //! ellipsoids, sine inputs); each is assembled with the measured side (pairs of catching-up
 //! trajectories, 30 periods after 10 of transient). A system counts as convergent when the
 //! measured exponent's 95 % interval lies below 0. For every bound (the paper's `theta`,
-//! `theta_star`, `theta_profile`, `theta_best`) it reports how many systems it certifies
+//! `theta_star`, `theta_profile`, `theta_engaged`, `theta_best`) it reports how many systems it certifies
 //! (verified `< 0`), the median of bound / measured over the certified ones, and violations
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
 use bounds::theta::{assemble, ThetaReport, ThetaSettings};
@@ -89,12 +89,12 @@ fn main() {
     let table_a: Vec<&Row> = rows.iter().collect();
     let table_b: Vec<&Row> = rows.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).collect();
     if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
-        println!("| # | n | p | Theta | measured | theta | theta* | theta_profile | best |");
-        println!("|---|---|---|---|---|---|---|---|---|");
+        println!("| # | n | p | Theta | measured | theta | theta* | theta_profile | theta_engaged | best |");
+        println!("|---|---|---|---|---|---|---|---|---|---|");
         for (i, r) in table_a.iter().enumerate() {
             let f = |v: f64, ok: bool| if ok && v < 0.0 { format!("{v:.4}") } else { format!("({v:.3})") };
             println!(
-                "| {i} | {} | {} | {} | {:.4} | {} | {} | {} | {} |",
+                "| {i} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |",
                 r.n,
                 r.p,
                 kind(r),
@@ -102,16 +102,18 @@ fn main() {
                 f(r.rep.theta, r.rep.theta_verified),
                 f(r.rep.theta_star, r.rep.theta_star_verified),
                 f(r.rep.theta_profile, r.rep.theta_profile_verified),
+                f(r.rep.theta_engaged, r.rep.theta_engaged_verified),
                 r.rep.theta_best_method
             );
         }
         println!();
     }
     type Get = fn(&ThetaReport) -> (f64, bool);
-    let bounds: [(&str, Get); 4] = [
+    let bounds: [(&str, Get); 5] = [
         ("theta (paper)", |r| (r.theta, r.theta_verified)),
         ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
         ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
+        ("theta_engaged (p = 1)", |r| (r.theta_engaged, r.theta_engaged_verified)),
         ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
     ];
     let summary = |title: &str, set: &[&Row]| {

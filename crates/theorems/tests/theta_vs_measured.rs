@@ -63,6 +63,9 @@ fn verified_cases() -> (Vec<(String, f64, f64, f64)>, usize) {
         if full.theta_profile_verified {
             out.push((format!("case {i} theta_profile (n = {})", sys.n()), full.theta_profile, m.ci_low, m.ci_high));
         }
+        if full.theta_engaged_verified {
+            out.push((format!("case {i} theta_engaged (n = {})", sys.n()), full.theta_engaged, m.ci_low, m.ci_high));
+        }
     }
     (out, tried)
 }

@@ -182,6 +182,29 @@ impl EtaOrbit {
         Some((bounds, nodes))
     }
 
+    /// Enclosures `[low_c, high_c]` of the scalar `eta_T'` (p = 1) on `cells` equal cells (as
+    /// [`EtaOrbit::eta_dot_cells`]: sampled extremes widened by the Lipschitz constant times half
+    /// the sample spacing and the samples' rounding margin; enclosures when `verified`). `None`
+    /// unless the output is scalar and `cells` divides the number of sample intervals.
+    pub fn deta_cells_scalar(&self, cells: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+        let K = self.t.len() - 1;
+        if cells == 0 || K % cells != 0 || self.deta.first().map(Vec::len) != Some(1) {
+            return None;
+        }
+        let per = K / cells;
+        let dt = self.period / K as f64;
+        let slack = (0.5 * dt * self.deta_lipschitz + 2.0 * self.rel_margin * self.eta_dot_inf) * (1.0 + 1e-12);
+        let (mut low, mut high) = (Vec::with_capacity(cells), Vec::with_capacity(cells));
+        for c in 0..cells {
+            let (lo, hi) = (c * per..=(c + 1) * per)
+                .map(|k| self.deta[k][0])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+            low.push(lo - slack - 4.0 * f64::EPSILON * lo.abs());
+            high.push(hi + slack + 4.0 * f64::EPSILON * hi.abs());
+        }
+        Some((low, high))
+    }
+
     /// Every `stride`-th sample index, always including the last (`t = T`).
     pub fn subsample(&self, points: usize) -> Vec<usize> {
         let K = self.t.len() - 1;

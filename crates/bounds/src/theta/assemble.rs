@@ -174,12 +174,22 @@ pub struct ThetaReport {
     pub lambda_profile: f64,
     pub profile_intervals: usize,
     pub profile_cells: usize,
+    /// `theta_engaged` (p = 1): `theta_profile` with speed floors on the cells where the backlash
+    /// is provably engaged (beyond the paper, [`crate::theta::speed_profile`],
+    /// proofs-notes/theta-engaged.md), `<= theta_profile`. Equal to `theta_profile` and not
+    /// verified when `p > 1` or no cell is engaged.
+    pub theta_engaged: f64,
+    pub theta_engaged_verified: bool,
+    /// The certified `lambda` at which `theta_engaged` is attained, and the number of engaged
+    /// cells (of `profile_cells`).
+    pub lambda_engaged: f64,
+    pub engaged_cells: usize,
     /// Which path bound gives `gamma_1*`: `(path)`, `(path1)` or `(path2)`.
     pub path_best_method: &'static str,
-    /// The smallest verified bound of the exponent (`theta` or `theta*`), or `theta` when none
-    /// is verified.
+    /// The smallest verified bound of the exponent (of `theta`, `theta*`, `theta_profile`,
+    /// `theta_engaged`), or `theta` when none is verified.
     pub theta_best: f64,
-    /// `"theta"`, `"theta_star"` or `"theta_profile"`.
+    /// `"theta"`, `"theta_star"`, `"theta_profile"` or `"theta_engaged"`.
     pub theta_best_method: &'static str,
     pub theta_best_verified: bool,
     pub path_bound: f64,
@@ -371,10 +381,54 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         None => (theta_star, lambda_star, 0),
     };
     let theta_profile_verified = theta_verified && profile.is_some();
+
+    // theta_engaged (beyond the paper, p = 1): the profile with speed floors where the backlash
+    // is provably engaged (the output has moved monotonically by Theta's width), partition by
+    // dynamic programming again (the floors change which intervals matter), then the best
+    // certified (lambda, b_hat) of the curve (proofs-notes/theta-engaged.md).
+    let engaged = match (&profile, orbit.deta_cells_scalar(cells)) {
+        (Some(prof), Some((low, high))) if p == 1 => {
+            let width = (theta_set.support(&[1.0]) + theta_set.support(&[-1.0])) * (1.0 + 1e-12);
+            let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
+            (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
+        }
+        _ => None,
+    };
+    let (theta_engaged, lambda_engaged, engaged_cells) = match &engaged {
+        Some(prof) => {
+            let nodes = prof.best_partition(
+                &Psi { alpha: a_low, lambda: lambda_profile, beta: beta_at(&star_points, lambda_profile, beta_star) },
+                settings.profile_stride,
+            );
+            // the floors weigh psi at high speeds more than the chords do: a lambda search of
+            // its own (every point a verified certificate, as for theta*)
+            let mut points = star_points.clone();
+            match optimise_lambda(
+                &F,
+                E,
+                C,
+                |l, b| prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes),
+                &settings.lambda,
+            ) {
+                Ok(s3) => {
+                    points.extend(s3.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))))
+                }
+                Err(e) => notes.push(format!("third lambda search (for theta_engaged) failed: {e}")),
+            }
+            let (v, l) = points
+                .iter()
+                .map(|&(l, b)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
+                .fold((f64::INFINITY, f64::NAN), |a, c| if c.0 < a.0 { c } else { a });
+            (v.min(theta_profile), if v <= theta_profile { l } else { lambda_profile }, prof.engaged_cells())
+        }
+        None => (theta_profile, lambda_profile, 0),
+    };
+    let theta_engaged_verified = theta_profile_verified && engaged.is_some();
     let candidates = [
         (theta, "theta", theta_verified),
         (theta_star, "theta_star", theta_star_verified),
         (theta_profile, "theta_profile", theta_profile_verified),
+        (theta_engaged, "theta_engaged", theta_engaged_verified),
     ];
     let (theta_best, theta_best_method, theta_best_verified) = candidates
         .iter()
@@ -492,6 +546,10 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         lambda_profile,
         profile_intervals,
         profile_cells: if profile.is_some() { cells } else { 0 },
+        theta_engaged,
+        theta_engaged_verified,
+        lambda_engaged,
+        engaged_cells,
         path_bound: path_b,
         path1_bound: path1,
         path1_grid: sub.len(),
@@ -549,6 +607,16 @@ impl ThetaReport {
                 "time-resolved chord: {} cells, {} intervals, lambda = {:.6}",
                 self.profile_cells, self.profile_intervals, self.lambda_profile
             )),
+            THETA_ENGAGED.with(self.theta_engaged, self.theta_engaged_verified).note(if self.engaged_cells > 0 {
+                format!(
+                    "speed floors on {} of {} cells where the backlash is engaged, lambda = {:.6}",
+                    self.engaged_cells, self.profile_cells, self.lambda_engaged
+                )
+            } else if self.p == 1 {
+                "no cell provably engaged: equals theta_profile".to_string()
+            } else {
+                "p = 1 only: equals theta_profile".to_string()
+            }),
             PATH_BOUND.with(self.path_bound, orb && self.d_verified),
             PATH1_BOUND
                 .with(self.path1_bound, orb && self.d_verified)
@@ -621,6 +689,7 @@ impl ThetaReport {
         m.insert("theta_verified".into(), json!(self.theta_verified));
         m.insert("theta_star_verified".into(), json!(self.theta_star_verified));
         m.insert("theta_profile_verified".into(), json!(self.theta_profile_verified));
+        m.insert("theta_engaged_verified".into(), json!(self.theta_engaged_verified));
         m.insert("theta_best".into(), json!(f(self.theta_best)));
         m.insert("theta_best_method".into(), json!(self.theta_best_method));
         m.insert("theta_best_verified".into(), json!(self.theta_best_verified));
@@ -660,4 +729,9 @@ fn down(x: f64) -> f64 {
 /// `F` of eq. (F) (convenience re-export for callers holding only the report's system).
 pub fn linearised_matrix(sys: &System) -> DMatrix<f64> {
     sys.F()
+}
+
+/// `b_hat` of the certified point with this `lambda` (`default` when none matches).
+fn beta_at(points: &[(f64, f64)], lambda: f64, default: f64) -> f64 {
+    points.iter().find(|p| p.0 == lambda).map_or(default, |p| p.1)
 }

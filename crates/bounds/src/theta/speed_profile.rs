@@ -21,6 +21,15 @@
 //! over a grid of cell boundaries. With a single cell (`g_c = gamma_inf` everywhere) and the
 //! partition of (path1) the bound is `theta*`; it is never larger than `theta*` for the same
 //! partition, since every `s_c` is at least the global chord's slope.
+//!
+//! **Engaged cells (`theta_engaged`, p = 1, proofs-notes/theta-engaged.md).** With an interval
+//! `Theta = [lo, hi]` the backlash output is pinned to the output once the output has moved
+//! monotonically by the width `hi - lo`: if `sigma y` is nondecreasing on `[a, t]` (`sigma = +-1`)
+//! and `sigma (y(t') - y(a)) >= hi - lo` for some `t' <= t`, then `z = y + lo` (or `y + hi`) and
+//! `z' = y'` on `[t', t]`. With (ydot), `sigma y' >= sigma eta_T' - D`, so on a cell where this
+//! holds from an earlier time `u >= l_c := (min_c sigma eta_T' - D) / R`. A cell then carries the
+//! chord of `psi` over `[l_c, g_c]` instead of `[0, g_c]`, and the path bound of an interval only
+//! has to be met by the speed above the floors. With every `l_c = 0` the bound is `theta_profile`.
 use crate::theta::psi::Psi;
 use geometry::linalg::dist;
 
@@ -37,6 +46,9 @@ pub struct SpeedProfile {
     pub d: f64,
     /// `R` (upper bound) used to scale the path bounds.
     pub R: f64,
+    /// `l_c`: a lower bound of `u` on cell `c` (asymptotically); all `0` unless set by
+    /// [`SpeedProfile::with_floors`].
+    pub floor: Vec<f64>,
 }
 
 impl SpeedProfile {
@@ -48,7 +60,56 @@ impl SpeedProfile {
         let cells = eta_dot_cell.len();
         assert_eq!(eta.len(), cells + 1, "one more boundary than cells");
         let g = eta_dot_cell.iter().map(|e| up((e + d_ftheta) / R)).collect();
-        Self { h: T / cells as f64, g, eta, d, R }
+        Self { h: T / cells as f64, g, eta, d, R, floor: vec![0.0; cells] }
+    }
+
+    /// The profile with the speed floors of engaged cells (p = 1; module docs): `deta_low[c]`
+    /// and `deta_high[c]` enclose `eta_T'` on cell `c`, `d_ftheta` is `D` from above and `width`
+    /// is `hi - lo` of `Theta = [lo, hi]` from above. A cell gets the floor
+    /// `(min_c sigma eta_T' - D) / R` (rounded down) when, for one sign `sigma`, every cell of a
+    /// cyclic run ending with it has `min sigma eta_T' > D` and the run's cells before it carry
+    /// at least `width` of guaranteed monotone motion of `sigma y`.
+    pub fn with_floors(mut self, deta_low: &[f64], deta_high: &[f64], d_ftheta: f64, width: f64) -> Self {
+        let K = self.cells();
+        assert!(deta_low.len() == K && deta_high.len() == K, "one enclosure per cell");
+        let mut floor = vec![0.0f64; K];
+        for sigma in [1.0f64, -1.0] {
+            // guaranteed rate of sigma y on each cell (rounded down), positive or not
+            let rate: Vec<f64> = (0..K)
+                .map(|c| {
+                    let m = if sigma > 0.0 { deta_low[c] } else { -deta_high[c] };
+                    let v = m - d_ftheta;
+                    v - 4.0 * f64::EPSILON * (m.abs() + d_ftheta.abs())
+                })
+                .collect();
+            // Start each run after a cell with no guaranteed motion; with none the speed bound
+            // never leaves the band of D around 0 from one side, impossible for a periodic orbit
+            // unless rate is positive everywhere, which would make the run a full cycle: skip.
+            let Some(start) = (0..K).find(|&c| rate[c] <= 0.0) else { continue };
+            let mut moved = 0.0f64;
+            for k in 1..=K {
+                let c = (start + k) % K;
+                if rate[c] <= 0.0 {
+                    moved = 0.0;
+                    continue;
+                }
+                if moved > width {
+                    floor[c] = floor[c].max(rate[c] / self.R * (1.0 - 1e-12));
+                }
+                moved += rate[c] * self.h * (1.0 - 1e-12);
+            }
+        }
+        // a floor never exceeds the cell's speed bound (both are bounds of the same u)
+        for (f, g) in floor.iter_mut().zip(&self.g) {
+            *f = f.min(*g);
+        }
+        self.floor = floor;
+        self
+    }
+
+    /// Number of cells with a positive floor.
+    pub fn engaged_cells(&self) -> usize {
+        self.floor.iter().filter(|&&f| f > 0.0).count()
     }
 
     pub fn cells(&self) -> usize {
@@ -62,16 +123,21 @@ impl SpeedProfile {
         (m * (1.0 - 1e-12)).max(0.0)
     }
 
-    /// Chord slopes `s_c` for `psi`, rounded down (`psi` values are rounded up, and a smaller
-    /// slope gives a larger, still valid, upper chord).
+    /// Chord slopes `s_c` of `psi` over `[l_c, g_c]`, rounded down (`psi` values are rounded
+    /// up, and a smaller slope gives a larger, still valid, upper chord).
     pub fn slopes(&self, psi: &Psi) -> Vec<f64> {
-        let p0 = psi.at_zero();
-        self.g.iter().map(|&g| if g > 0.0 { ((p0 - psi.eval(g)) / g * (1.0 - 1e-12)).max(0.0) } else { 0.0 }).collect()
+        self.g
+            .iter()
+            .zip(&self.floor)
+            .map(|(&g, &l)| if g > l { ((psi.eval(l) - psi.eval(g)) / (g - l) * (1.0 - 1e-12)).max(0.0) } else { 0.0 })
+            .collect()
     }
 
-    /// `L` of the cells `i..j` (boundaries `i < j`) with path bound `m`: greedy fill by
-    /// increasing slope. `scratch` is reused between calls.
+    /// `L` of the cells `i..j` (boundaries `i < j`) with path bound `m`: the floors carry
+    /// `sum l_c h`, the rest is a greedy fill by increasing slope up to `(g_c - l_c) h`.
+    /// `scratch` is reused between calls.
     fn interval_loss(&self, s: &[f64], i: usize, j: usize, m: f64, scratch: &mut Vec<usize>) -> f64 {
+        let m = m - self.floor[i..j].iter().map(|l| l * self.h).sum::<f64>() * (1.0 + 1e-12);
         if m <= 0.0 {
             return 0.0;
         }
@@ -81,7 +147,7 @@ impl SpeedProfile {
         let mut left = m;
         let mut loss = 0.0;
         for &c in scratch.iter() {
-            let cap = self.g[c] * self.h;
+            let cap = (self.g[c] - self.floor[c]).max(0.0) * self.h;
             let take = cap.min(left);
             loss += s[c] * take;
             left -= take;
@@ -94,8 +160,9 @@ impl SpeedProfile {
         loss * (1.0 - 1e-12)
     }
 
-    /// The bound `psi(0) - (1/T) sum_k L_k` for the partition given by boundary indices
-    /// `nodes` (increasing, from `0` to `cells`), rounded up.
+    /// The bound `(1/T) sum_c h psi(l_c) - (1/T) sum_k L_k` (`psi(0) - (1/T) sum_k L_k` without
+    /// floors) for the partition given by boundary indices `nodes` (increasing, from `0` to
+    /// `cells`), rounded up.
     pub fn bound(&self, psi: &Psi, nodes: &[usize]) -> f64 {
         let s = self.slopes(psi);
         let mut scratch = Vec::new();
@@ -104,8 +171,16 @@ impl SpeedProfile {
             .map(|w| self.interval_loss(&s, w[0], w[1], self.path_lower(w[0], w[1]), &mut scratch))
             .sum();
         let T = self.h * self.cells() as f64;
-        let v = psi.at_zero() - total / T;
-        v + 4.0 * f64::EPSILON * (psi.at_zero().abs() + (total / T).abs())
+        let p0 = psi.at_zero();
+        // mean of psi at the floors (psi(0) where there is none), each value rounded up
+        let (base, scale) = self.floor.iter().fold((0.0f64, 0.0f64), |(b, a), &l| {
+            let v = if l > 0.0 { psi.eval(l) } else { p0 };
+            (b + v, a + v.abs())
+        });
+        let K = self.cells() as f64;
+        let base = base / K + 2.0 * K * f64::EPSILON * scale / K;
+        let v = base - total / T;
+        v + 4.0 * f64::EPSILON * (base.abs() + (total / T).abs())
     }
 
     /// The partition (boundary indices from `0` to `cells`) maximising the total loss, by
@@ -206,5 +281,66 @@ mod tests {
         let mut wrong = prof.clone();
         wrong.g.iter_mut().for_each(|g| *g *= 0.7);
         assert!(wrong.bound(&psi, &nodes) < honest - 1e-3);
+    }
+
+    /// Scalar play `z in y + [lo, hi]` driven by `y = amp sin t` (no feedback: `eta_T = y`,
+    /// `D = 0`), its profile with floors, and the true speeds `|z'|` per cell (finest sampling).
+    fn play_case(width_used: f64) -> (SpeedProfile, Vec<f64>) {
+        let (amp, lo, hi, cells, sub) = (1.0, -0.1, 0.1, 400usize, 50usize);
+        let T = std::f64::consts::TAU;
+        let h = T / cells as f64;
+        let mut prof = circle_profile(cells, amp, 0.0, hi - lo, hi);
+        // enclosures of y' = amp cos t per cell (Lipschitz amp, half the cell)
+        let (low, high): (Vec<f64>, Vec<f64>) = (0..cells)
+            .map(|c| {
+                let (a, b) = ((c as f64 * h).cos(), ((c + 1) as f64 * h).cos());
+                (amp * a.min(b) - amp * h, amp * a.max(b) + amp * h)
+            })
+            .unzip();
+        prof = prof.with_floors(&low, &high, 0.0, width_used);
+        // the play over two periods from z = 0; speeds of the second period, min per cell
+        let dt = h / sub as f64;
+        let mut z = 0.0f64;
+        let mut min_speed = vec![f64::INFINITY; cells];
+        for k in 0..2 * cells * sub {
+            let t1 = (k + 1) as f64 * dt;
+            let y1 = amp * t1.sin();
+            let z1 = z.clamp(y1 + lo, y1 + hi);
+            if k >= cells * sub {
+                let c = (k - cells * sub) / sub;
+                min_speed[c] = min_speed[c].min((z1 - z).abs() / dt / hi);
+            }
+            z = z1;
+        }
+        (prof, min_speed)
+    }
+
+    #[test]
+    fn floors_lie_below_the_true_speed_of_a_play_and_sharpen_the_bound() {
+        let psi = Psi { alpha: 0.0, lambda: 0.3, beta: 0.024 };
+        let (prof, speed) = play_case(0.2);
+        assert!(prof.engaged_cells() > prof.cells() / 2, "{} engaged", prof.engaged_cells());
+        for c in 0..prof.cells() {
+            // one sample step of slack for the discrete derivative near the catching point
+            assert!(prof.floor[c] <= speed[c] + 0.05, "cell {c}: floor {} above speed {}", prof.floor[c], speed[c]);
+        }
+        let nodes = prof.best_partition(&psi, 4);
+        let mut none = prof.clone();
+        none.floor.iter_mut().for_each(|l| *l = 0.0);
+        let (with, without) = (prof.bound(&psi, &nodes), none.bound(&psi, &nodes));
+        assert!(with < without - 0.05, "floors must help: {with} vs {without}");
+    }
+
+    #[test]
+    fn negative_control_floors_without_the_catching_width_claim_a_resting_backlash_moves() {
+        // width 0 ignores that z rests while y crosses the gap after each reversal: cells where
+        // the true speed is 0 get a floor, which the simulated play refutes.
+        let (prof, speed) = play_case(0.0);
+        let wrong = (0..prof.cells()).filter(|&c| prof.floor[c] > speed[c] + 0.05).count();
+        assert!(wrong > 10, "the unsound floors must be caught: {wrong} cells");
+        // and with no guaranteed motion at all (D larger than every |y'|) no cell is engaged
+        let (mut p2, _) = play_case(0.2);
+        p2 = p2.with_floors(&vec![-1.0; 400], &vec![1.0; 400], 2.0, 0.2);
+        assert_eq!(p2.engaged_cells(), 0);
     }
 }

@@ -3,7 +3,7 @@
 //! When the sweep has the `certified` column, the points where the best verified bound
 //! certifies convergence are drawn in the curve's colour and the others grey.
 //! Columns of different scales get their own panels, stacked with one x axis: the bounds
-//! (`theta`, `theta_star`, `theta_profile`, `theta_best`, about -0.02 on the worked example)
+//! (`theta`, `theta_star`, `theta_profile`, `theta_engaged`, `theta_best`, about -0.02 on the worked example)
 //! in one, every other column (the measured rate, about -0.3) in its own, so neither is
 //! flattened against the other's range.
 use super::canvas::{palette, Element, Figure, GREY};

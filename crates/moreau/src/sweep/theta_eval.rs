@@ -73,7 +73,7 @@ impl ThetaEvaluator {
 /// The report quantities that are sweep columns (keys of `bounds::report::defs`), in order;
 /// their names and LaTeX headers come from the declarations. The derived columns
 /// ([`DERIVED`]) follow `theta` and `path2_bound`.
-pub const QUANTITY_COLUMNS: [&str; 17] = [
+pub const QUANTITY_COLUMNS: [&str; 18] = [
     "mu",
     "r",
     "alpha",
@@ -91,6 +91,7 @@ pub const QUANTITY_COLUMNS: [&str; 17] = [
     "theta",
     "theta_star",
     "theta_profile",
+    "theta_engaged",
 ];
 
 /// Columns that are not report quantities: verified flags, the best verified bound, the
