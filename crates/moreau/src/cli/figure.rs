@@ -42,9 +42,15 @@ pub struct Args {
     /// trajectory: final time (default: the model's periods, or t_end).
     #[arg(allow_negative_numbers = true, long)]
     pub t_end: Option<f64>,
-    /// Output formats (comma separated): svg, png, pgf (pgfplots .tex + data .csv). Default: all.
+    /// Output formats (comma separated): svg, png, pgf (pgfplots .tex + data .csv), pdf (vector,
+    /// font embedded). Default: svg,png,pgf.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "svg,png,pgf")]
     pub format: Vec<figures::Format>,
+    /// PNG resolution in dots per inch: the SVG rasterised at scale dpi/96, so text and lines
+    /// scale with the image (e.g. `--dpi 300` for print). Default: plotters' bitmap at
+    /// --width x --height pixels.
+    #[arg(allow_negative_numbers = true, long)]
+    pub dpi: Option<f64>,
     /// Width and height in pixels of the SVG and PNG (the pgf code takes the paper's line width).
     #[arg(long, default_value_t = 900)]
     pub width: u32,
@@ -150,7 +156,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             (stem, f)
         })
         .collect();
-    for f in figures::write_figure_as(&figs, &a.out, &a.format)? {
+    for f in figures::write_figure_with(&figs, &a.out, &a.format, a.dpi)? {
         println!("{}", f.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -425,6 +425,44 @@ pub fn to_svg(f: &Figure) -> Result<String, FigureError> {
     Ok(crate::plot::embed_font(buf))
 }
 
+/// The figure's SVG parsed for rasterising or PDF conversion, with the embedded DejaVu Sans as
+/// its only font (the same glyphs as the PNG and the SVG).
+fn usvg_tree(f: &Figure) -> Result<svg2pdf::usvg::Tree, FigureError> {
+    let svg = to_svg(f)?;
+    let mut opt = svg2pdf::usvg::Options::default();
+    opt.fontdb_mut().load_font_data(dejavu::sans::regular().to_vec());
+    opt.font_family = "DejaVu Sans".into();
+    svg2pdf::usvg::Tree::from_str(&svg, &opt)
+        .map_err(|e| FigureError::Draw { figure: f.title.clone(), reason: format!("SVG not readable: {e}") })
+}
+
+/// The figure as a one-page vector PDF (text as text in the embedded, subset DejaVu Sans), from
+/// its SVG by `svg2pdf`.
+pub fn to_pdf(f: &Figure) -> Result<Vec<u8>, FigureError> {
+    let tree = usvg_tree(f)?;
+    svg2pdf::to_pdf(&tree, svg2pdf::ConversionOptions::default(), svg2pdf::PageOptions::default())
+        .map_err(|e| FigureError::Draw { figure: f.title.clone(), reason: format!("PDF conversion: {e}") })
+}
+
+/// The figure as PNG bytes at `dpi` dots per inch: its SVG rasterised by `resvg` at scale
+/// `dpi / 96` (CSS pixels are 1/96 inch), so every size (text, lines, margins) scales together.
+pub fn to_png_at_dpi(f: &Figure, dpi: f64) -> Result<Vec<u8>, FigureError> {
+    use svg2pdf::usvg::tiny_skia_path::Transform;
+    let bad = |reason: String| FigureError::Draw { figure: f.title.clone(), reason };
+    let scale = dpi / 96.0;
+    let (w, h) = ((f.size.0 as f64 * scale).round(), (f.size.1 as f64 * scale).round());
+    if !(scale.is_finite() && scale > 0.0 && w >= 1.0 && h >= 1.0 && w * h <= 1e8) {
+        return Err(bad(format!(
+            "--dpi {dpi} gives a {w} x {h} pixel image (at most 1e8 pixels; dpi must be positive)"
+        )));
+    }
+    let tree = usvg_tree(f)?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(w as u32, h as u32).ok_or_else(|| bad("empty image".into()))?;
+    pixmap.fill(resvg::tiny_skia::Color::WHITE);
+    resvg::render(&tree, Transform::from_scale(scale as f32, scale as f32), &mut pixmap.as_mut());
+    pixmap.encode_png().map_err(|e| bad(format!("PNG encoding: {e}")))
+}
+
 /// Writes the figure as PNG to `path`.
 pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
     crate::plot::register_fonts();
@@ -441,6 +479,8 @@ pub enum Format {
     Png,
     /// pgfplots code (`.tex`) and its data (`.csv`), set in the paper's fonts by LaTeX.
     Pgf,
+    /// One-page vector PDF (font embedded).
+    Pdf,
 }
 
 /// Writes `stem.svg`, `stem.png`, `stem.tex` (pgfplots) and `stem.csv` (data) for every
@@ -451,6 +491,17 @@ pub fn write_figure(figs: &[(String, Figure)], out: &Path) -> Result<Vec<PathBuf
 
 /// [`write_figure`] for the chosen formats only.
 pub fn write_figure_as(figs: &[(String, Figure)], out: &Path, formats: &[Format]) -> Result<Vec<PathBuf>, FigureError> {
+    write_figure_with(figs, out, formats, None)
+}
+
+/// [`write_figure_as`] with the PNG rasterised from the SVG at `png_dpi` when given
+/// ([`to_png_at_dpi`]; plotters' own bitmap at `size` pixels otherwise).
+pub fn write_figure_with(
+    figs: &[(String, Figure)],
+    out: &Path,
+    formats: &[Format],
+    png_dpi: Option<f64>,
+) -> Result<Vec<PathBuf>, FigureError> {
     let werr =
         |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
     let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
@@ -463,8 +514,17 @@ pub fn write_figure_as(figs: &[(String, Figure)], out: &Path, formats: &[Format]
             files.push(out.join(format!("{stem}.svg")));
         }
         if formats.contains(&Format::Png) {
-            write_png(f, &staged.path(&format!("{stem}.png")))?;
+            let p = staged.path(&format!("{stem}.png"));
+            match png_dpi {
+                Some(dpi) => std::fs::write(&p, to_png_at_dpi(f, dpi)?).map_err(|e| werr(&p, &e))?,
+                None => write_png(f, &p)?,
+            }
             files.push(out.join(format!("{stem}.png")));
+        }
+        if formats.contains(&Format::Pdf) {
+            let p = staged.path(&format!("{stem}.pdf"));
+            std::fs::write(&p, to_pdf(f)?).map_err(|e| werr(&p, &e))?;
+            files.push(out.join(format!("{stem}.pdf")));
         }
         if formats.contains(&Format::Pgf) {
             for (ext, text) in [("tex", super::pgf::to_pgf(f)), ("csv", super::pgf::to_csv(f))] {

@@ -15,7 +15,7 @@ pub mod sweep;
 pub mod trajectory;
 pub mod tube;
 
-pub use canvas::{write_figure, write_figure_as, Element, Figure, Format};
+pub use canvas::{to_pdf, to_png_at_dpi, write_figure, write_figure_as, write_figure_with, Element, Figure, Format};
 
 use thiserror::Error;
 
