@@ -43,6 +43,7 @@
 //! [signals]                   # units for reports: one string for all, or one per column
 //! y = "m"
 //! w = ["m", "V"]
+//! t = "s"                     # unit of time (figures' time axes)
 //! ```
 use crate::toml_access::*;
 use crate::{Effects, Input, ModelError, SimDefaults, System};
@@ -561,6 +562,8 @@ pub struct Signals {
     pub y: Vec<String>,
     /// One unit per input.
     pub w: Vec<String>,
+    /// Unit of time (`""` when not stated).
+    pub t: String,
 }
 
 impl Signals {
@@ -573,7 +576,15 @@ impl Signals {
         self.w.get(j).map_or("", |s| s.as_str())
     }
     pub fn is_empty(&self) -> bool {
-        self.y.is_empty() && self.w.is_empty()
+        self.y.is_empty() && self.w.is_empty() && self.t.is_empty()
+    }
+
+    /// The common unit of all outputs (`""` when not stated or when they differ).
+    pub fn y_common_unit(&self) -> &str {
+        match self.y.first() {
+            Some(u) if self.y.iter().all(|v| v == u) => u,
+            _ => "",
+        }
     }
 }
 
@@ -722,7 +733,7 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
 
 fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, ModelError> {
     let Some(t) = t else { return Ok(Signals::default()) };
-    check_keys(t, "signals", "y, w")?;
+    check_keys(t, "signals", "y, w, t")?;
     let units = |k: &str, n: usize, what: &str| -> Result<Vec<String>, ModelError> {
         let key = format!("signals.{k}");
         match t.get(k) {
@@ -757,7 +768,18 @@ fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, Model
             }),
         }
     };
-    Ok(Signals { y: units("y", p, "output")?, w: units("w", m, "input")? })
+    let time = match t.get("t") {
+        None => String::new(),
+        Some(Value::String(s)) => s.clone(),
+        Some(other) => {
+            return Err(ModelError::WrongType {
+                key: "signals.t".into(),
+                expected: "a unit (string)",
+                found: describe(other),
+            })
+        }
+    };
+    Ok(Signals { y: units("y", p, "output")?, w: units("w", m, "input")?, t: time })
 }
 
 fn fit_table(f: &FitSpec) -> Option<Table> {
@@ -802,6 +824,9 @@ fn signals_table(s: &Signals) -> Option<Table> {
     }
     if !s.w.is_empty() {
         t.insert("w".into(), arr(&s.w));
+    }
+    if !s.t.is_empty() {
+        t.insert("t".into(), Value::String(s.t.clone()));
     }
     Some(t)
 }

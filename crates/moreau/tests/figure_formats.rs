@@ -64,3 +64,17 @@ fn bad_dpi_is_refused_and_leaves_no_output() {
         assert!(!Path::new(&out).exists(), "--dpi {dpi} left {}", out.display());
     }
 }
+
+#[test]
+fn trajectory_axes_carry_the_model_units() {
+    let base =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml")).unwrap();
+    let settings = moreau::figures::trajectory::TrajectorySettings { t_end: Some(1.0), ..Default::default() };
+    let sys = model::parse_str(&format!("{base}\n[signals]\ny = \"rad\"\nt = \"s\"\n")).unwrap();
+    let (yz, xf) = moreau::figures::trajectory::trajectory_figures(&sys, &settings).unwrap();
+    assert_eq!((yz.x_label.as_str(), yz.y_label.as_str(), xf.x_label.as_str()), ("t (s)", "y, z (rad)", "t (s)"));
+    // control: without [signals] no unit is invented
+    let plain = model::parse_str(&base).unwrap();
+    let (yz, _) = moreau::figures::trajectory::trajectory_figures(&plain, &settings).unwrap();
+    assert_eq!((yz.x_label.as_str(), yz.y_label.as_str()), ("t", "y, z"));
+}

@@ -32,12 +32,19 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
     let steps = ((t_end / dt).ceil() as usize).max(1);
     let every = (steps / s.max_points.max(1)).max(1);
     let tr = dynamics::trajectory::simulate_model(sys, dt, steps, every)?;
-    let mut yz = Figure::new(&format!("Trajectory of `{}`: y = C x and z", sys.name), "t", "y, z");
-    let mut xf = Figure::new(&format!("Trajectory of `{}`: state x", sys.name), "t", "x");
+    // units from the model's [signals] table where stated
+    let unit = |u: &str| if u.is_empty() { String::new() } else { format!(" ({u})") };
+    let t_label = format!("t{}", unit(&sys.signals.t));
+    let mut yz = Figure::new(
+        &format!("Trajectory of `{}`: y = C x and z", sys.name),
+        &t_label,
+        &format!("y, z{}", unit(sys.signals.y_common_unit())),
+    );
+    let mut xf = Figure::new(&format!("Trajectory of `{}`: state x", sys.name), &t_label, "x");
     let ys: Vec<Vec<f64>> = (0..tr.len()).map(|i| tr.y_at(&sys.C, i)).collect();
     let p = sys.p();
     for k in 0..p {
-        let sub = if p > 1 { format!("{}", k + 1) } else { String::new() };
+        let sub = if p > 1 { format!("_{}", k + 1) } else { String::new() };
         yz.elements.push(Element::Line {
             label: format!("y{sub}"),
             pts: tr.t.iter().zip(&ys).map(|(&t, y)| (t, y[k])).collect(),
@@ -53,7 +60,7 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
     }
     for k in 0..sys.n() {
         xf.elements.push(Element::Line {
-            label: format!("x{}", k + 1),
+            label: format!("x_{}", k + 1),
             pts: tr.t.iter().enumerate().map(|(i, &t)| (t, tr.x_at(i)[k])).collect(),
             color: palette(k),
             dashed: false,
