@@ -13,6 +13,7 @@
 //! sub-steps per sample (by convergence against the noise level, see [`crate::discretisation`])
 //! and the initial state (the model file's when it states one, else estimated).
 use crate::discretisation::{self, SubstepCheck};
+use crate::fit::jackknife::{self, Jackknife};
 use crate::fit::missing_input::{self, MissingInput, MISSING_MARGIN, MISSING_SHARE};
 use crate::fit::{self, FitResult, FitSettings, FreeNominal, Problem, Refit};
 use crate::hypothesis::{self, Hypothesis, Kind, Scales};
@@ -52,6 +53,10 @@ pub struct DiagnoseSettings {
     pub max_cv: usize,
     /// LM iterations per fold refit (from the estimation fit). Default 6.
     pub cv_iter: usize,
+    /// LM iterations per fold of the jackknife of the selected model's parameters (its
+    /// model-error spread over `cv_folds` contiguous folds of the estimation segment, see
+    /// [`crate::fit::jackknife`]); 0 leaves the jackknife out. Default 6.
+    pub jackknife_iter: usize,
     /// Greatest number of effects added by forward selection. Default 2.
     pub max_effects: usize,
     /// How many of the best single hypotheses are tried as second effects. Default 4.
@@ -109,6 +114,7 @@ impl Default for DiagnoseSettings {
             cv_folds: 5,
             max_cv: 3,
             cv_iter: 6,
+            jackknife_iter: 6,
             max_effects: 2,
             max_second: 4,
             lags: 20,
@@ -216,7 +222,16 @@ pub struct FittedEffect {
     pub label: String,
     pub description: String,
     pub params: Vec<(String, f64)>,
+    /// Reported 1-sigma: `sqrt(statistical^2 + jackknife^2)` ([`crate::fit::jackknife::combine`];
+    /// the statistical part alone where the jackknife is not defined).
     pub uncertainty: Vec<(String, f64)>,
+    /// Its statistical part: the larger of Gauss-Newton and the batch-means sandwich (noise,
+    /// white or coloured, for an exact model).
+    pub uncertainty_statistical: Vec<(String, f64)>,
+    /// Its model-error part: the delete-a-group jackknife over contiguous folds of the
+    /// estimation segment, widened by [`crate::fit::jackknife::t_factor`] for its degrees of
+    /// freedom (`NaN`, JSON `null`, where not computed).
+    pub uncertainty_jackknife: Vec<(String, f64)>,
     /// `input_delay` only: the equivalent parameters under the other input hold (a zero-order
     /// hold acts as a first-order hold delayed by h/2): `(hold, params)`. Where the data do not
     /// decide the hold (see the report's `hold`), the recording cannot tell the two apart and
@@ -230,6 +245,8 @@ pub struct Ranked {
     pub label: String,
     pub kinds: Vec<String>,
     pub params: Vec<f64>,
+    /// Statistical 1-sigma (the larger of Gauss-Newton and the sandwich); the selected
+    /// model's reported sigma (`effects[].uncertainty`) adds the jackknife's model-error spread.
     pub std: Vec<f64>,
     pub sse_estimation: f64,
     pub bic: f64,
@@ -273,9 +290,19 @@ pub struct NominalValue {
     pub value: f64,
     /// 1-sigma uncertainty (as for effects; `NaN`, JSON `null`, where not identifiable).
     pub std: f64,
+    /// Its statistical and jackknife (model-error) parts, as for effects.
+    pub std_statistical: f64,
+    pub std_jackknife: f64,
     /// `value / nominal - 1` (`None` for a zero nominal).
     pub relative_change: Option<f64>,
     pub bounds: Option<(f64, f64)>,
+}
+
+/// Scales and null reference of the localisation (see [`localise`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct LocalisationInfo {
+    pub scales: localise::Scales,
+    pub null: localise::NullReference,
 }
 
 /// Time series kept for figures.
@@ -334,10 +361,19 @@ pub struct Report {
     pub nominal_adequate: bool,
     pub verdict: String,
     pub effects: Vec<FittedEffect>,
+    /// What the reported 1-sigma of the fitted parameters includes, and what it does not.
+    pub uncertainty_method: String,
+    /// The jackknife of the selected model (fold estimates), where computed.
+    pub jackknife: Option<Jackknife>,
     /// Hypotheses indistinguishable from the selected one (BIC within `tie_bic`).
     pub ties: Vec<String>,
     pub windows: Vec<Window>,
     pub regimes: Vec<RegimeShare>,
+    /// Localisation of the derived velocity residual (the servo metrics' differentiation).
+    pub velocity_windows: Vec<Window>,
+    pub velocity_regimes: Vec<RegimeShare>,
+    /// Data-derived scales and the null reference of the localisation.
+    pub localisation: LocalisationInfo,
     pub ranking: Vec<Ranked>,
     pub notes: Vec<String>,
     #[serde(skip)]
@@ -445,6 +481,7 @@ fn failed_fit(p: usize) -> Fit {
         velocity_fit_percent: vec![Some(f64::NEG_INFINITY); p],
         velocity_rmse: vec![f64::INFINITY; p],
         constant_outputs: vec![],
+        tracking_fit_percent: vec![],
     }
 }
 
@@ -947,8 +984,8 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated && residual_nominal.zero_mean;
         let nominal_ext = ExtendedModel::from_maps(sys, &[], ctx.maps.clone(), ctx.substeps)?;
         let contact = nominal_ext.has_play().then_some(&nom_sim.contact[..]);
-        let half_width = ((0.1 * tau_slow / dt).round() as usize).max(3);
-        let loc: Localisation = localise::localise(rec.t0, dt, &ctx.y, &e_nom, p, &ctx.w, m, contact, half_width, 10);
+        // window sizes from the data (velocity scale, residual correlation length), not tau_slow
+        let loc: Localisation = localise::localise(rec.t0, dt, &ctx.y, &e_nom, p, &ctx.w, m, contact, 10);
         let err = disc.error_rms.max(disc_final.as_ref().map_or(0.0, |d| d.error_rms));
         let delta_bic_disc = discretisation::delta_bic_of_error(err, nom.sse / n_res as f64, n_res);
         let margin = s.select.margin_bic + delta_bic_disc;
@@ -1043,7 +1080,10 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     };
     let substeps = ctx.substeps;
     let bic_nom = select::bic(nom.sse, n_res, ctx.x_scale.len());
-    let fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, dt);
+    let mut fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, dt);
+    let reference = &sys.signals.reference;
+    fit_before.tracking_fit_percent =
+        metrics::tracking_fit(&ctx.y, &nom_sim.y, &ctx.w, (p, ctx.m), reference, k_est, n_samp);
     let Selection { ranking, mut chosen, mut ties, cv_rejected } = sel;
     // Recorded columns the model does not use: does the residual follow one of them?
     let missing_inputs: Vec<MissingInput> = if nominal_adequate || rec.extra.is_empty() {
@@ -1123,6 +1163,49 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         ));
     }
 
+    // Reported uncertainty: the statistical sigma of the fit (the larger of Gauss-Newton and
+    // the batch-means sandwich) combined with the model-error spread of a delete-a-group
+    // jackknife over contiguous folds of the estimation segment (fit::jackknife).
+    let mut std_stat: (Vec<f64>, Vec<f64>) = (vec![], vec![]);
+    let mut jack: Option<Jackknife> = None;
+    if let Some(c) = chosen.as_mut() {
+        std_stat = (c.std.clone(), c.nominal_std.clone());
+        if s.jackknife_iter > 0 && (!c.params.is_empty() || c.refit) {
+            let nominal = c.refit.then_some(&c.nominal[..]);
+            let j = jackknife::refit_folds(
+                |f| ctx.with_refit(ctx.problem_on(vec![], c.parts.clone(), k_est, Some(f)), nominal),
+                jackknife::Estimate { theta: &c.params, nominal: &c.nominal, x0: &c.x0 },
+                &ctx.x_scale,
+                k_est,
+                s.cv_folds,
+                s.jackknife_iter,
+                &s.fit,
+                s.parallel,
+            );
+            let g = j.estimates.len();
+            for (sd, jd) in c.std.iter_mut().zip(&j.std) {
+                *sd = jackknife::combine(*sd, jackknife::jackknife_part(*jd, g));
+            }
+            for (sd, jd) in c.nominal_std.iter_mut().zip(&j.nominal_std) {
+                *sd = jackknife::combine(*sd, jackknife::jackknife_part(*jd, g));
+            }
+            jack = Some(j);
+        }
+    }
+    let jack_resolved = jack.as_ref().is_some_and(|j| j.estimates.len() >= 2);
+    let uncertainty_method = format!(
+        "1 sigma = sqrt(s_stat^2 + (c s_jack)^2): s_stat the larger of Gauss-Newton and a batch-means sandwich (noise, white or coloured), s_jack a delete-a-group jackknife over {} contiguous folds of the estimation segment (each left out in turn, the selected model refitted on the rest: the spread that model error causes across the record, noise included), c = t_{}(0.975) / 1.96 = {:.2} so that +-2 sigma keeps 95 % coverage with the jackknife's {} degrees of freedom. {}A model error that shifts every fold alike (a bias constant over the record) is not seen by any resampling and is not included.",
+        s.cv_folds,
+        s.cv_folds - 1,
+        jackknife::t_factor(s.cv_folds - 1),
+        s.cv_folds - 1,
+        match (&jack, jack_resolved) {
+            (Some(_), true) => String::new(),
+            (Some(j), false) => format!("Here the jackknife is not resolved ({} of {} fold refits moved from the full estimate, which is determined finer than the solver's steps): s_stat alone. ", j.estimates.len(), j.folds.len()),
+            (None, _) => "The jackknife was not computed here (no effect parameters, or disabled): s_stat alone. ".into(),
+        }
+    );
+
     // Fitted model and its residual.
     let (effects_chosen, x0_fit) = match &chosen {
         Some(c) => {
@@ -1136,7 +1219,9 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         None => None,
     }
     .unwrap_or(nom_sim.clone());
-    let fit_after = metrics::fit(&ctx.y, &fit_sim.y, p, k_est, n_samp, dt);
+    let mut fit_after = metrics::fit(&ctx.y, &fit_sim.y, p, k_est, n_samp, dt);
+    fit_after.tracking_fit_percent =
+        metrics::tracking_fit(&ctx.y, &fit_sim.y, &ctx.w, (p, ctx.m), reference, k_est, n_samp);
     let e_fit: Vec<f64> = ctx.y.iter().zip(&fit_sim.y).map(|(a, b)| a - b).collect();
     let lag_step = ((tau_slow / dt) / 10.0).floor().max(1.0) as usize;
     let residual_fitted = tests_for(&e_fit, &ctx.w, n_samp, m, p, s.lags, lag_step);
@@ -1153,6 +1238,11 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                 nominal: f.nominal[i],
                 value: c.nominal[i],
                 std: c.nominal_std[i],
+                std_statistical: std_stat.1.get(i).copied().unwrap_or(f64::NAN),
+                std_jackknife: jack
+                    .as_ref()
+                    .and_then(|j| j.nominal_std.get(i).map(|v| jackknife::jackknife_part(*v, j.estimates.len())))
+                    .unwrap_or(f64::NAN),
                 relative_change: (f.nominal[i] != 0.0).then(|| c.nominal[i] / f.nominal[i] - 1.0),
                 bounds: fp.bounds,
             })
@@ -1243,6 +1333,23 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                             .iter()
                             .zip(&c.std[off..off + k])
                             .map(|(n, v)| (n.to_string(), *v))
+                            .collect(),
+                        uncertainty_statistical: h
+                            .names
+                            .iter()
+                            .enumerate()
+                            .map(|(i, n)| (n.to_string(), std_stat.0.get(off + i).copied().unwrap_or(f64::NAN)))
+                            .collect(),
+                        uncertainty_jackknife: h
+                            .names
+                            .iter()
+                            .enumerate()
+                            .map(|(i, n)| {
+                                let part = jack.as_ref().and_then(|j| {
+                                    j.std.get(off + i).map(|v| jackknife::jackknife_part(*v, j.estimates.len()))
+                                });
+                                (n.to_string(), part.unwrap_or(f64::NAN))
+                            })
                             .collect(),
                         other_hold: (h.kind == Kind::InputDelay).then(|| {
                             let d = c.params[off];
@@ -1434,9 +1541,14 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         nominal_adequate,
         verdict,
         effects,
+        uncertainty_method,
+        jackknife: jack,
         ties,
         windows: loc.windows,
         regimes: loc.regimes,
+        velocity_windows: loc.velocity_windows,
+        velocity_regimes: loc.velocity_regimes,
+        localisation: LocalisationInfo { scales: loc.scales, null: loc.null },
         ranking,
         notes,
         fitted_model: Some(fitted_sys),
@@ -1535,29 +1647,12 @@ impl Report {
             r.mean, r.mean_bound, if r.zero_mean { "zero mean" } else { "offset" }, r.q_auto, r.q_auto_threshold, r.lags, r.lag_step, if r.white { "white" } else { "not white" }, fmt_vec(&r.q_cross), r.q_cross_threshold, if r.uncorrelated { "uncorrelated" } else { "correlated" },
             self.residual_fitted.white, self.residual_fitted.uncorrelated, self.residual_fitted.q_auto, fmt_vec(&self.residual_fitted.q_cross)
         );
-        s += "## Where the mismatch is\n\n| regime | share of time | share of residual energy | enrichment |\n|---|---|---|---|\n";
-        for g in &self.regimes {
-            s += &format!(
-                "| {} | {:.1} % | {:.1} % | {:.2} |\n",
-                g.regime,
-                100.0 * g.share_time,
-                100.0 * g.share_energy,
-                g.enrichment
-            );
-        }
-        s += "\n| window | start (s) | end (s) | share of energy | share of time | dominant regime |\n|---|---|---|---|---|---|\n";
-        for (i, w) in self.windows.iter().enumerate() {
-            s += &format!(
-                "| {} | {:.4} | {:.4} | {:.1} % | {:.1} % | {} ({:.0} %) |\n",
-                i + 1,
-                w.t_start,
-                w.t_end,
-                100.0 * w.share_energy,
-                100.0 * w.share_time,
-                w.dominant_regime,
-                100.0 * w.dominant_fraction
-            );
-        }
+        s += &localise::markdown(
+            [(&self.regimes, &self.windows), (&self.velocity_regimes, &self.velocity_windows)],
+            &self.localisation.scales,
+            &self.localisation.null,
+            &self.units,
+        );
         if !self.missing_inputs.is_empty() {
             s += "\n## Recorded signals that are not model inputs\n\nEach fed through the linearised nominal dynamics (on every state) and regressed on the nominal residual (estimation segment); reported missing when it explains at least half the residual and 10 points more than the best hypothesis of the library.\n\n| column | residual explained | best hypothesis (explains) | missing input |\n|---|---|---|---|\n";
             for c in &self.missing_inputs {
@@ -1596,12 +1691,17 @@ impl Report {
         s += "\n## Effects added\n\n";
         if self.effects.is_empty() {
             s += "None.\n\n";
+        } else {
+            s += &format!("Uncertainty: {}\n\n", self.uncertainty_method);
         }
         for e in &self.effects {
             s += &format!("- **{}**: {}\n", e.label, e.description);
-            for ((n, v), (_, u)) in e.params.iter().zip(&e.uncertainty) {
+            for (i, ((n, v), (_, u))) in e.params.iter().zip(&e.uncertainty).enumerate() {
+                let part = |l: &[(String, f64)]| l.get(i).map_or(f64::NAN, |x| x.1);
+                let (st, jk) = (part(&e.uncertainty_statistical), part(&e.uncertainty_jackknife));
                 s += &format!(
-                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma: the larger of Gauss-Newton and a batch-means sandwich for coloured residuals; model error is not included)\n"
+                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma; statistical {st:.2e}, fold jackknife {})\n",
+                    if jk.is_finite() { format!("{jk:.2e}") } else { "n/a".into() }
                 );
             }
             if let Some((h, ps)) = &e.other_hold {

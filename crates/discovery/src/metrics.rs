@@ -37,6 +37,13 @@ pub struct Fit {
     /// Outputs (0-based) whose measured segment is (nearly) constant: fit % undefined, judge
     /// by the RMSE.
     pub constant_outputs: Vec<usize>,
+    /// Fit % of the tracking error `e = w_ref - y` per output, when the model names each
+    /// output's reference input (`[signals] reference = "w1"`; empty otherwise): the share of
+    /// the loop's own error the model predicts. Its RMSE is the output's (`e - e_hat = y_hat -
+    /// y`); its fit % does not saturate as the output's does in a tight loop. See
+    /// [`tracking_fit`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tracking_fit_percent: Vec<Option<f64>>,
 }
 
 fn mean_std(a: &[f64]) -> (f64, f64) {
@@ -93,6 +100,38 @@ pub fn column(flat: &[f64], p: usize, i: usize, k0: usize, k1: usize) -> Vec<f64
     (k0..k1).map(|k| flat[k * p + i]).collect()
 }
 
+/// Fit % of the tracking error on `[k0, k1)`: for output `i` with reference input
+/// `reference[i]`, `e = w_ref - y` against `e_hat = w_ref - yhat` ([`fit_percent`], the scale
+/// deciding "constant" taken over the whole record). `y`, `yhat` flat with `p` columns, `w`
+/// flat with `m` columns; empty when `reference` is.
+pub fn tracking_fit(
+    y: &[f64],
+    yhat: &[f64],
+    w: &[f64],
+    (p, m): (usize, usize),
+    reference: &[usize],
+    k0: usize,
+    k1: usize,
+) -> Vec<Option<f64>> {
+    let n = y.len() / p.max(1);
+    reference
+        .iter()
+        .enumerate()
+        .take(p)
+        .map(|(i, &j)| {
+            if j >= m || w.len() < n * m {
+                return None;
+            }
+            let err = |out: &[f64], k: usize| w[k * m + j] - out[k * p + i];
+            let whole: Vec<f64> = (0..n).map(|k| err(y, k)).collect();
+            let (_, scale) = mean_std(&whole);
+            let a: Vec<f64> = (k0..k1).map(|k| err(y, k)).collect();
+            let b: Vec<f64> = (k0..k1).map(|k| err(yhat, k)).collect();
+            fit_percent(&a, &b, scale)
+        })
+        .collect()
+}
+
 /// Fit of `yhat` against `y` (both flat, `p` outputs) on `[k0, k1)`; the scales that decide
 /// whether a segment is constant are taken over the whole of `y`.
 pub fn fit(y: &[f64], yhat: &[f64], p: usize, k0: usize, k1: usize, dt: f64) -> Fit {
@@ -102,6 +141,7 @@ pub fn fit(y: &[f64], yhat: &[f64], p: usize, k0: usize, k1: usize, dt: f64) -> 
         velocity_fit_percent: vec![],
         velocity_rmse: vec![],
         constant_outputs: vec![],
+        tracking_fit_percent: vec![],
     };
     let n = y.len() / p.max(1);
     for i in 0..p {
@@ -153,6 +193,31 @@ pub fn fmt_quantity(v: f64, unit: &str) -> String {
     }
 }
 
+/// Scale of a figure axis whose data reach `max_abs` in `unit`: `(divisor, axis unit)`, the
+/// data to be divided by `divisor`. The usual units (and their `/s` rates) take an SI prefix
+/// (`2e-5 rad` -> `(1e-6, "urad")`, ticks `-20 .. 20`; the data lie in 0.1 .. 100 of the
+/// axis unit); other units and unitless data small or large get a power of 1000 written into
+/// the label (`(1e-6, "1e-6 deg")`, `(1e-6,
+/// "x 1e-6")`); else `(1, unit)`.
+pub fn axis_scale(max_abs: f64, unit: &str) -> (f64, String) {
+    // the data in 0.1 .. 100 of the chosen unit
+    let pow = if max_abs.is_finite() && max_abs > 0.0 { ((max_abs.log10() + 1.0) / 3.0).floor() as i32 } else { 0 };
+    let base = unit.strip_suffix("/s").unwrap_or(unit);
+    if SI_UNITS.contains(&base) && (-3..=2).contains(&pow) {
+        let pre = ["n", "u", "m", "", "k", "M"][(pow + 3) as usize];
+        return (10f64.powi(3 * pow), format!("{pre}{unit}"));
+    }
+    if pow == 0 {
+        return (1.0, unit.to_string());
+    }
+    let f = 10f64.powi(3 * pow);
+    if unit.is_empty() {
+        (f, format!("x 1e{}", 3 * pow))
+    } else {
+        (f, format!("1e{} {unit}", 3 * pow))
+    }
+}
+
 /// Unit of the derivative of a signal in `unit` (`m` -> `m/s`; none -> `1/s`).
 pub fn per_second(unit: &str) -> String {
     if unit.is_empty() {
@@ -182,8 +247,12 @@ pub fn headline_rmse(before: &Fit, after: &Fit, units: &[String]) -> String {
         .map(|i| {
             let u = units.get(i).map_or("", |s| s.as_str());
             let vu = per_second(u);
+            let tracking = match (before.tracking_fit_percent.get(i), after.tracking_fit_percent.get(i)) {
+                (Some(b), Some(a)) => format!("; tracking-error fit {} -> {} %", pct(*b), pct(*a)),
+                _ => String::new(),
+            };
             format!(
-                "{}validation RMSE {} -> {} (fit {} -> {} %); velocity RMSE {} -> {} (velocity fit {} -> {} %)",
+                "{}validation RMSE {} -> {} (fit {} -> {} %); velocity RMSE {} -> {} (velocity fit {} -> {} %){tracking}",
                 if p > 1 { format!("y{}: ", i + 1) } else { String::new() },
                 fmt_quantity(before.rmse[i], u),
                 fmt_quantity(after.rmse[i], u),
@@ -231,12 +300,21 @@ mod tests {
         assert_eq!(fmt_quantity(1.5e-5, ""), "1.5000e-5");
         assert_eq!(fmt_quantity(1.5e-5, "deg"), "1.5000e-5 deg");
         assert_eq!(per_second("m"), "m/s");
+        // figure axes: +-2e-5 rad in urad (no "0.0 / -0.0 / 0.0" ticks), rates too
+        assert_eq!(axis_scale(2e-5, "rad"), (1e-6, "urad".to_string()));
+        assert_eq!(axis_scale(0.05, "rad"), (1e-3, "mrad".to_string()));
+        assert_eq!(axis_scale(0.4, "rad"), (1.0, "rad".to_string()));
+        assert_eq!(axis_scale(3.0, "rad/s"), (1.0, "rad/s".to_string()));
+        assert_eq!(axis_scale(2e-5, ""), (1e-6, "x 1e-6".to_string()));
+        assert_eq!(axis_scale(2e-5, "deg"), (1e-6, "1e-6 deg".to_string()));
+        assert_eq!(axis_scale(0.4, ""), (1.0, String::new()));
         let f = |r: f64, fp: f64| Fit {
             fit_percent: vec![Some(fp)],
             rmse: vec![r],
             velocity_fit_percent: vec![Some(80.0)],
             velocity_rmse: vec![r * 10.0],
             constant_outputs: vec![],
+            tracking_fit_percent: vec![],
         };
         let (b, a) = (f(1.6e-5, 99.91), f(3.1e-6, 99.98));
         assert!(saturated(&b, &a, 99.0));
@@ -271,5 +349,25 @@ mod tests {
         assert!(fit_percent(&small, &small, 0.7).is_some());
         // A record constant throughout: undefined for any scale.
         assert!(fit_percent(&[2.0; 50], &[2.1; 50], 0.0).is_none());
+    }
+
+    #[test]
+    fn tracking_error_fit_does_not_saturate_in_a_tight_loop() {
+        // y tracks w within a small error e; a model that predicts e well and one that claims
+        // perfect tracking both fit y above 99 %, only the tracking-error fit tells them apart
+        let n = 400;
+        let w: Vec<f64> = (0..n).map(|k| (k as f64 * 0.05).sin()).collect();
+        let e: Vec<f64> = (0..n).map(|k| 0.005 * (k as f64 * 0.05).cos()).collect();
+        let y: Vec<f64> = w.iter().zip(&e).map(|(a, b)| a - b).collect();
+        let good: Vec<f64> = w.iter().zip(&e).map(|(a, b)| a - 0.9 * b).collect();
+        let perfect = w.clone();
+        let (fg, fp) = (fit(&y, &good, 1, 0, n, 0.05), fit(&y, &perfect, 1, 0, n, 0.05));
+        assert!(fg.fit_percent[0].unwrap() > 99.0 && fp.fit_percent[0].unwrap() > 99.0);
+        let tg = tracking_fit(&y, &good, &w, (1, 1), &[0], 0, n);
+        let tp = tracking_fit(&y, &perfect, &w, (1, 1), &[0], 0, n);
+        assert!((tg[0].unwrap() - 90.0).abs() < 0.1, "{tg:?}");
+        assert!(tp[0].unwrap().abs() < 5.0, "a model claiming perfect tracking predicts none of the error: {tp:?}");
+        // no reference named: nothing computed
+        assert!(tracking_fit(&y, &good, &w, (1, 1), &[], 0, n).is_empty());
     }
 }

@@ -44,6 +44,7 @@
 //! y = "m"
 //! w = ["m", "V"]
 //! t = "s"                     # unit of time (figures' time axes)
+//! reference = "w1"            # output i tracks this input (servo loops): tracking-error metrics
 //! ```
 use crate::toml_access::*;
 use crate::{Effects, Input, ModelError, SimDefaults, System};
@@ -564,6 +565,10 @@ pub struct Signals {
     pub w: Vec<String>,
     /// Unit of time (`""` when not stated).
     pub t: String,
+    /// For each output, the input (0-based) that is its reference in a tracking loop (`w1` in
+    /// the file is `0`); empty when not stated. `diagnose` then also reports the fit of the
+    /// tracking error `w_ref - y`.
+    pub reference: Vec<usize>,
 }
 
 impl Signals {
@@ -576,7 +581,7 @@ impl Signals {
         self.w.get(j).map_or("", |s| s.as_str())
     }
     pub fn is_empty(&self) -> bool {
-        self.y.is_empty() && self.w.is_empty() && self.t.is_empty()
+        self.y.is_empty() && self.w.is_empty() && self.t.is_empty() && self.reference.is_empty()
     }
 
     /// The common unit of all outputs (`""` when not stated or when they differ).
@@ -733,7 +738,7 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
 
 fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, ModelError> {
     let Some(t) = t else { return Ok(Signals::default()) };
-    check_keys(t, "signals", "y, w, t")?;
+    check_keys(t, "signals", "y, w, t, reference")?;
     let units = |k: &str, n: usize, what: &str| -> Result<Vec<String>, ModelError> {
         let key = format!("signals.{k}");
         match t.get(k) {
@@ -779,7 +784,27 @@ fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, Model
             })
         }
     };
-    Ok(Signals { y: units("y", p, "output")?, w: units("w", m, "input")?, t: time })
+    // reference: "w" / "wJ" (1-based, as the recording's columns), one for all outputs or one per output
+    let reference = match units("reference", p, "output")? {
+        names if names.is_empty() => vec![],
+        names => names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let j = match name.trim().strip_prefix('w') {
+                    Some("") if m == 1 => Some(0),
+                    Some(d) => d.parse::<usize>().ok().filter(|&j| (1..=m).contains(&j)).map(|j| j - 1),
+                    None => None,
+                };
+                j.ok_or_else(|| ModelError::WrongType {
+                    key: if p > 1 { format!("signals.reference[{i}]") } else { "signals.reference".into() },
+                    expected: "an input of the model named as the recording's column (`w` or `wJ`, J = 1..m)",
+                    found: format!("\"{name}\" (the model has {m} input{})", if m == 1 { "" } else { "s" }),
+                })
+            })
+            .collect::<Result<Vec<usize>, _>>()?,
+    };
+    Ok(Signals { y: units("y", p, "output")?, w: units("w", m, "input")?, t: time, reference })
 }
 
 fn fit_table(f: &FitSpec) -> Option<Table> {
@@ -827,6 +852,12 @@ fn signals_table(s: &Signals) -> Option<Table> {
     }
     if !s.t.is_empty() {
         t.insert("t".into(), Value::String(s.t.clone()));
+    }
+    if !s.reference.is_empty() {
+        t.insert(
+            "reference".into(),
+            Value::Array(s.reference.iter().map(|j| Value::String(format!("w{}", j + 1))).collect()),
+        );
     }
     Some(t)
 }

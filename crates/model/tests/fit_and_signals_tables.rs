@@ -12,7 +12,7 @@ fn parse(extra: &str) -> Result<model::System, String> {
 #[test]
 fn free_parameters_bounds_and_units_are_read_and_written_back() {
     let sys = parse(
-        "[fit]\nfree = [\"plant.A[1][1]\", \"plant.B[1][0]\"]\n[fit.bounds]\n\"plant.A[1][1]\" = [-10, 0]\n[signals]\ny = \"m\"\nw = [\"V\"]\nt = \"s\"\n",
+        "[fit]\nfree = [\"plant.A[1][1]\", \"plant.B[1][0]\"]\n[fit.bounds]\n\"plant.A[1][1]\" = [-10, 0]\n[signals]\ny = \"m\"\nw = [\"V\"]\nt = \"s\"\nreference = \"w1\"\n",
     )
     .unwrap();
     assert_eq!(sys.fit.free.len(), 2);
@@ -25,6 +25,7 @@ fn free_parameters_bounds_and_units_are_read_and_written_back() {
     assert_eq!(sys.signals.y_unit(0), "m");
     assert_eq!(sys.signals.w_unit(0), "V");
     assert_eq!((sys.signals.t.as_str(), sys.signals.y_common_unit()), ("s", "m"));
+    assert_eq!(sys.signals.reference, vec![0]);
     // Round trip, with a recorded result.
     let mut s2 = sys.clone();
     s2.fit.result.push(model::model_file::FitRecord {
@@ -78,6 +79,8 @@ fn bad_fit_tables_name_key_and_value() {
         ("[signals]\ny = 3\n", &["signals.y", "integer 3"]),
         ("[signals]\nz = \"m\"\n", &["signals.z", "unknown key"]),
         ("[signals]\nt = 1\n", &["signals.t", "integer 1"]),
+        ("[signals]\nreference = \"w2\"\n", &["signals.reference", "w2", "1 input"]),
+        ("[signals]\nreference = \"y1\"\n", &["signals.reference", "y1"]),
     ];
     for (extra, needles) in cases {
         let e = parse(extra).expect_err(extra);

@@ -251,3 +251,74 @@ fn play_width_bad_input_is_a_one_line_error() {
         assert!(!json.exists(), "a JSON file was written for a rejected input");
     }
 }
+
+/// Texts of an SVG (`<text>` contents, trimmed).
+fn svg_texts(path: &Path) -> Vec<String> {
+    let s = std::fs::read_to_string(path).unwrap();
+    s.split("<text")
+        .skip(1)
+        .filter_map(|t| t.split_once('>').and_then(|(_, r)| r.split_once("</text>")))
+        .map(|(a, _)| a.trim().to_string())
+        .collect()
+}
+
+#[test]
+fn bam_report_localises_against_a_null_and_zooms_on_the_windows_with_units() {
+    // The BAM servo log (units `[signals] y = "rad"` in the model file).
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    let o = diagnose(
+        &root("data/bam-servo/xl330-kp100-sin_time_square.csv"),
+        &root("examples/real/bam-xl330-kp100.toml"),
+        &out,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let loc = &j["localisation"];
+    assert_eq!(loc["null"]["level"], serde_json::json!(0.05), "{loc}");
+    let dt = j["dt"].as_f64().unwrap();
+    // the windows' width is the residual's correlation length, not a tenth of tau_slow
+    let corr = loc["scales"]["correlation_length_s"].as_f64().unwrap();
+    assert!(corr > 3.0 * dt && corr < 2.0, "{loc}");
+    assert!(loc["scales"]["low_speed_band"][0].as_f64().unwrap() > 0.0, "{loc}");
+    for key in ["regimes", "velocity_regimes"] {
+        let rs = j[key].as_array().unwrap();
+        assert!(rs.iter().any(|r| r["regime"] == "reversal"), "{key}");
+        for r in rs {
+            let (p, q, e) = (
+                r["p_value"].as_f64().unwrap(),
+                r["null_q95_enrichment"].as_f64().unwrap(),
+                r["enrichment"].as_f64().unwrap(),
+            );
+            assert!((0.0..=1.0).contains(&p) && q > 0.0, "{r}");
+            // enriched only when the observed enrichment is above the null's bulk
+            if r["enriched"].as_bool().unwrap() {
+                assert!(e > 1.0 && p <= 0.05, "{r}");
+            }
+        }
+    }
+    let windows = j["windows"].as_array().unwrap().len() + j["velocity_windows"].as_array().unwrap().len();
+    assert!(windows > 0);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("null 95 %") && md.contains("velocity residual") && md.contains("zoom-1.svg"), "{md}");
+    // figures: zoomed panels on the top windows, units on the axes, Okabe-Ito colours, no
+    // "-0.0" ticks
+    for f in ["fit", "residual", "zoom-1"] {
+        assert!(out.join(format!("{f}.png")).is_file(), "{f}.png");
+        let texts = svg_texts(&out.join(format!("{f}.svg")));
+        assert!(texts.iter().any(|t| t == "residual y - yhat (rad)"), "{f}: {texts:?}");
+        assert!(
+            !texts
+                .iter()
+                .any(|t| t.trim_start_matches('-').trim_matches(|c| c == '0' || c == '.').is_empty()
+                    && t.starts_with('-')),
+            "{f}: {texts:?}"
+        );
+        let svg = std::fs::read_to_string(out.join(format!("{f}.svg"))).unwrap();
+        assert!(svg.contains("#0072B2") && svg.contains("#E69F00"), "{f}: Okabe-Ito blue and orange");
+    }
+    let zoom = svg_texts(&out.join("zoom-1.svg"));
+    assert!(zoom.iter().any(|t| t.starts_with("Window 1: t = ")), "{zoom:?}");
+    assert!(zoom.iter().any(|t| t == "velocity residual (rad/s)"), "{zoom:?}");
+}

@@ -92,7 +92,7 @@ pub fn loop_model(name: &str, m: f64, c: f64, kp: f64, kd: f64) -> System {
         FreeParam { name: FREE[1].into(), matrix: PlantMatrix::A, row: 1, col: 1, bounds: None },
         FreeParam { name: FREE[2].into(), matrix: PlantMatrix::B, row: 1, col: 0, bounds: None },
     ];
-    sys.signals = Signals { y: vec!["m".into()], w: vec!["m".into()], t: "s".into() };
+    sys.signals = Signals { y: vec!["m".into()], w: vec!["m".into()], t: "s".into(), reference: vec![0] };
     sys
 }
 
