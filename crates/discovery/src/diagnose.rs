@@ -614,12 +614,26 @@ fn evidence_of(r: &Ranked) -> String {
 /// Fits every hypothesis, selects by BIC (margin `margin`) and blocked cross-validation,
 /// greedy forward.
 /// Fits every single hypothesis on the estimation segment (sorted by BIC).
-fn fit_singles(ctx: &Ctx, s: &DiagnoseSettings, sys: &System, nom: &FitResult) -> Vec<Ranked> {
+///
+/// `prev`: the singles of an earlier pass of the same diagnosis (after a change of input hold or
+/// of sub-steps, which moves each optimum a little): a hypothesis whose earlier fit converged
+/// (or ran out of iterations) starts from that estimate alone instead of all its starts; a stuck
+/// or failed earlier fit gets all its starts again.
+fn fit_singles(ctx: &Ctx, s: &DiagnoseSettings, sys: &System, nom: &FitResult, prev: Option<&[Ranked]>) -> Vec<Ranked> {
     let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
     let mut cands = hypothesis::candidates(sys, &ctx.scales);
     // Several inputs: play, saturation and delay on each input alone, too.
     cands.extend(crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w));
-    let one = |h: &Hypothesis| run_one(ctx, s, vec![h.clone()], None, None, &nom.x0, bic_nom, val_sse_nom);
+    let warm = |h: &Hypothesis| -> Option<Vec<f64>> {
+        let label = h.kind.label();
+        prev?
+            .iter()
+            .find(|r| !r.refit && r.parts.len() == 1 && r.label == label)
+            .filter(|r| matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations))
+            .filter(|r| r.params.len() == h.k() && r.params.iter().all(|v| v.is_finite()))
+            .map(|r| r.params.clone())
+    };
+    let one = |h: &Hypothesis| run_one(ctx, s, vec![h.clone()], None, warm(h), &nom.x0, bic_nom, val_sse_nom);
     let mut singles: Vec<Ranked> =
         if s.parallel { cands.par_iter().map(one).collect() } else { cands.iter().map(one).collect() };
     // Grey-box refit: the freed nominal parameters alone, ranked with the effects ("the
@@ -975,6 +989,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     let mut disc_final: Option<SubstepCheck> = None;
     let mut notes = Vec::new();
     let mut pass = 0;
+    let mut prev_singles: Option<Vec<Ranked>> = None;
     let (sel, e_nom, residual_nominal, nominal_adequate, nom_sim, loc, delta_bic_disc) = 'hold: loop {
         let nom_sim =
             ctx.problem(vec![], vec![]).simulate(&[], &nom.x0, None).ok_or(DiscoveryError::Unstable { mu })?;
@@ -991,7 +1006,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         let margin = s.select.margin_bic + delta_bic_disc;
         // State scales and the nominal run for data-derived bounds and starts (hypothesis.rs).
         ctx.scales = ctx.scales.clone().with_nominal(&nom_sim.x, &nom_sim.y, &ctx.y, k_est);
-        let singles = fit_singles(&ctx, s, sys, &nom);
+        let singles = fit_singles(&ctx, s, sys, &nom, prev_singles.as_deref());
         // Auto hold: do the best effects confirm the nominal's choice? The nominal's
         // preference can be an artefact of the missing effect. The best few singles are
         // asked (a flexible wrong effect, e.g. a cogging force, can rank first under the
@@ -1037,6 +1052,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                     ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
                     nom = fit_nominal(&ctx);
                     disc_final = None;
+                    prev_singles = Some(singles);
                     continue 'hold;
                 }
             }
@@ -1073,6 +1089,7 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
                 disc = discretisation::converge(|k| sim_nominal(hold, k), k, max_sub, &weights, tol);
                 ctx = mk_ctx(hold, disc.substeps, x_scale.clone());
                 nom = fit_nominal(&ctx);
+                prev_singles = Some(sel.ranking.clone());
                 continue;
             }
         }

@@ -79,6 +79,7 @@ pub struct FitResult {
     pub evaluations: usize,
 }
 
+#[derive(Clone)]
 struct Vars<'p, 'a> {
     pb: &'p Problem<'a>,
     /// Scales of the free initial state (empty: the initial state is fixed at `x0_fixed`).
@@ -90,6 +91,9 @@ struct Vars<'p, 'a> {
     ns: Vec<f64>,
     nlo: Vec<f64>,
     nhi: Vec<f64>,
+    /// Residuals on samples `[0, k_end)` of the estimation segment (`k_end = k_est` but in
+    /// the start phase of a long record).
+    k_end: usize,
 }
 
 impl Vars<'_, '_> {
@@ -107,7 +111,7 @@ impl Vars<'_, '_> {
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
         *evals += 1;
         let (t, n, x) = self.split(v);
-        self.pb.residual_with(&t, &n, &x)
+        self.pb.residual_to(&t, &n, &x, self.k_end)
     }
     fn clamp(&self, v: &mut [f64]) {
         for x in v.iter_mut().take(self.k) {
@@ -298,7 +302,8 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     };
     // Start of the freed nominal parameters (scaled, inside their bounds).
     let nomv: Vec<f64> = (0..kn).map(|i| (nom0[i] / ns[i]).clamp(nlo[i], nhi[i])).collect();
-    let vars = Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k, kn, ns: ns.clone(), nlo, nhi };
+    let vars =
+        Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k, kn, ns: ns.clone(), nlo, nhi, k_end: pb.k_est };
     let mut evals = 0;
     if k == 0 && kn == 0 && xs.is_empty() {
         // Nothing to fit: the nominal model from a known initial state.
@@ -350,15 +355,26 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
             starts.push(v);
         }
     }
+    // Long records: screening and the start iterations see a leading part of the estimation
+    // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
+    // see all of it, from the best start. Several starts only: a single (warm) start goes
+    // straight to the whole segment.
+    let start_vars = if starts.len() > 1 && pb.k_est >= LONG_RECORD {
+        Vars { k_end: (LONG_RECORD / 2).max(pb.k_est / 3), ..vars.clone() }
+    } else {
+        vars.clone()
+    };
     if starts.len() > SCREENED_STARTS {
-        let mut scored: Vec<(f64, Vec<f64>)> =
-            starts.into_iter().map(|v| (vars.res(&v, &mut evals).map_or(f64::INFINITY, |r| sse(&r)), v)).collect();
+        let mut scored: Vec<(f64, Vec<f64>)> = starts
+            .into_iter()
+            .map(|v| (start_vars.res(&v, &mut evals).map_or(f64::INFINITY, |r| sse(&r)), v))
+            .collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
         starts = scored.into_iter().take(SCREENED_STARTS).map(|(_, v)| v).collect();
     }
     let mut best: Option<(Vec<f64>, Vec<f64>, f64, bool)> = None;
     for v in starts {
-        if let Some(res) = lm(&vars, v, s.max_iter_start, s, &mut evals) {
+        if let Some(res) = lm(&start_vars, v, s.max_iter_start, s, &mut evals) {
             if best.as_ref().is_none_or(|b| res.2 < b.2) {
                 best = Some(res);
             }
@@ -377,7 +393,29 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
             evaluations: evals,
         };
     };
-    let (v, r, cost, conv) = lm(&vars, b.0.clone(), s.max_iter, s, &mut evals).unwrap_or(b);
+    // (after a short start phase the fallback is re-evaluated on the whole segment)
+    let b_v = b.0.clone();
+    let fallback = if start_vars.k_end < vars.k_end {
+        vars.res(&b.0, &mut evals).map(|r| {
+            let c = sse(&r);
+            (b.0.clone(), r, c, false)
+        })
+    } else {
+        Some(b)
+    };
+    let Some((v, r, cost, conv)) = lm(&vars, b_v, s.max_iter, s, &mut evals).or(fallback) else {
+        return FitResult {
+            theta: lo,
+            std: vec![f64::NAN; k],
+            nominal: nom0,
+            nominal_std: vec![f64::NAN; kn],
+            x0: x0_init.to_vec(),
+            sse: f64::INFINITY,
+            n_res: 0,
+            status: FitStatus::Failed,
+            evaluations: evals,
+        };
+    };
     // Gauss-Newton covariance of the effect parameters.
     let J = jacobian(&vars, &v, &r, s.tol_fd, &mut evals);
     let nres = r.len();
@@ -417,6 +455,11 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
 
 /// Starts iterated after screening (see [`fit`]).
 pub const SCREENED_STARTS: usize = 3;
+
+/// Estimation segments of at least this many samples run the start phase of [`fit`] on a
+/// leading part (at least half of this and a third of the segment), the final iterations on the
+/// whole: the cost of the multi-start phase stops growing with the record.
+pub const LONG_RECORD: usize = 24_000;
 
 #[cfg(test)]
 mod tests {

@@ -181,11 +181,18 @@ impl<'a> Problem<'a> {
     }
     /// As [`Problem::residual`] with freed nominal parameters at `nom`.
     pub fn residual_with(&self, theta: &[f64], nom: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
-        let out = self.simulate_with(theta, nom, x0, Some(self.k_est))?;
+        self.residual_to(theta, nom, x0, self.k_est)
+    }
+
+    /// The residual on the first `k_end <= k_est` samples only (the solver's start phase on
+    /// long records, see [`crate::fit::levenberg_marquardt`]).
+    pub fn residual_to(&self, theta: &[f64], nom: &[f64], x0: &[f64], k_end: usize) -> Option<Vec<f64>> {
+        let k_end = k_end.min(self.k_est);
+        let out = self.simulate_with(theta, nom, x0, Some(k_end))?;
         let p = self.p;
         let (b0, b1) = self.exclude.unwrap_or((0, 0));
         Some(
-            (0..self.k_est * p)
+            (0..k_end * p)
                 .filter(|idx| !(b0 * p..b1 * p).contains(idx))
                 .map(|idx| (out.y[idx] - self.y[idx]) * self.weights[idx % p])
                 .collect(),
