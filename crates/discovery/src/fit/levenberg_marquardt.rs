@@ -27,11 +27,14 @@ pub struct FitSettings {
     pub tol_fd: f64,
     /// Relative cost decrease below which iteration stops. Default 1e-7.
     pub tol_cost: f64,
+    /// Estimation segments of at least this many samples run the multi-start phase on a
+    /// leading part (see [`LONG_RECORD`]); `usize::MAX` never. Default [`LONG_RECORD`].
+    pub long_record: usize,
 }
 
 impl Default for FitSettings {
     fn default() -> Self {
-        Self { max_iter_start: 6, max_iter: 40, tol_fd: 1e-3, tol_cost: 1e-7 }
+        Self { max_iter_start: 6, max_iter: 40, tol_fd: 1e-3, tol_cost: 1e-7, long_record: LONG_RECORD }
     }
 }
 
@@ -359,8 +362,8 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
     // see all of it, from the best start. Several starts only: a single (warm) start goes
     // straight to the whole segment.
-    let start_vars = if starts.len() > 1 && pb.k_est >= LONG_RECORD {
-        Vars { k_end: (LONG_RECORD / 2).max(pb.k_est / 3), ..vars.clone() }
+    let start_vars = if starts.len() > 1 && pb.k_est >= s.long_record {
+        Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() }
     } else {
         vars.clone()
     };

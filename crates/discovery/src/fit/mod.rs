@@ -12,6 +12,6 @@ pub mod missing_input;
 pub mod nominal;
 pub mod problem;
 
-pub use levenberg_marquardt::{fit, FitResult, FitSettings, FitStatus};
+pub use levenberg_marquardt::{fit, FitResult, FitSettings, FitStatus, LONG_RECORD};
 pub use nominal::{FreeNominal, Refit};
 pub use problem::Problem;
