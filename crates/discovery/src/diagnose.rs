@@ -553,7 +553,12 @@ fn cv_sse(
         let (theta, nom, x0f) = if pb.k() == 0 && pb.k_nominal() == 0 && ctx.x_scale.is_empty() {
             (vec![], vec![], x0.to_vec())
         } else {
-            let r = fit::fit(&pb, x0, &ctx.x_scale, Some(params), &fs);
+            // With the first fold held out, a free initial state is left to folds that start
+            // after the loop has forgotten it: the refit could move it anywhere and the held-out
+            // error would measure that, not the effect. It stays at the estimation fit's value
+            // there (the same for every hypothesis, the nominal included).
+            let x_scale: &[f64] = if b0 == 0 { &[] } else { &ctx.x_scale };
+            let r = fit::fit(&pb, x0, x_scale, Some(params), &fs);
             (r.theta, r.nominal, r.x0)
         };
         let sim = pb.simulate_with(&theta, &nom, &x0f, None)?;

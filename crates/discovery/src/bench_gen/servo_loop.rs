@@ -49,6 +49,8 @@ pub const VEL_NOISE: f64 = 1e-4;
 pub struct ServoTruth {
     pub mass: f64,
     pub viscous: f64,
+    /// Coulomb friction force (N; 0 in the grey-box cases).
+    pub coulomb: f64,
     pub kp: f64,
     pub kd: f64,
     pub omega_n: f64,
@@ -104,6 +106,17 @@ pub fn mass_and_viscous(sys: &System, kp: f64, kd: f64) -> (f64, f64) {
 
 /// Case `index` of `seed`; `correct_nominal`: the nominal model is the truth.
 pub fn generate(seed: u64, index: usize, correct_nominal: bool) -> ServoCase {
+    generate_with_friction(seed, index, correct_nominal, 0.0)
+}
+
+/// As [`generate`], the carriage also under Coulomb friction of `friction` times the largest
+/// control force of the frictionless run's reference swing (`Fc = friction * Kp * max |r|`):
+/// stuck while the drive force stays within `Fc`, sliding against `Fc` otherwise. Integrated
+/// by 50 exact sub-steps per sample (constant force between velocity reversals; a sub-step
+/// that would reverse the velocity stops at rest), nothing shared with the diagnoser. The
+/// nominal model leaves the friction out: a friction-dominated sampled position loop
+/// (issue 14's acceptance case).
+pub fn generate_with_friction(seed: u64, index: usize, correct_nominal: bool, friction: f64) -> ServoCase {
     let mix = seed ^ 0x5E7B_0000_0000_0000 ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1);
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
     let mass = (rng.random_range(0.5f64.ln()..5.0f64.ln())).exp();
@@ -132,6 +145,8 @@ pub fn generate(seed: u64, index: usize, correct_nominal: bool) -> ServoCase {
         fade * comps.iter().map(|(a, w, p)| a * ((w * t + p).sin() - p.sin())).sum::<f64>()
     };
     let ns = (DURATION / H).round() as usize + 1;
+    let rmax = (0..ns).map(|kk| reference(kk as f64 * H).abs()).fold(0.0, f64::max);
+    let fc = friction.max(0.0) * kp * rmax;
     let a = viscous / mass;
     let (mut x, mut v) = (0.0f64, 0.0f64);
     let (mut t, mut w, mut y) = (Vec::with_capacity(ns), Vec::with_capacity(ns), Vec::with_capacity(ns));
@@ -144,12 +159,36 @@ pub fn generate(seed: u64, index: usize, correct_nominal: bool) -> ServoCase {
         w.push(vec![rk]);
         y.push(vec![yk]);
         let u = kp * (rk - yk) - kd * vk;
-        // Exact step of m v' = u - c v, x' = v over H with u constant.
-        let e = (-a * H).exp();
-        let vinf = u / viscous;
-        let xn = x + vinf * H + (v - vinf) * (1.0 - e) / a;
-        v = vinf + (v - vinf) * e;
-        x = xn;
+        if fc == 0.0 {
+            // Exact step of m v' = u - c v, x' = v over H with u constant.
+            let e = (-a * H).exp();
+            let vinf = u / viscous;
+            let xn = x + vinf * H + (v - vinf) * (1.0 - e) / a;
+            v = vinf + (v - vinf) * e;
+            x = xn;
+        } else {
+            let hs = H / 50.0;
+            for _ in 0..50 {
+                if v == 0.0 && u.abs() <= fc {
+                    continue; // stuck: static friction balances the drive
+                }
+                // sliding direction: of the velocity, or of the drive when starting from rest
+                let dir = if v != 0.0 { v.signum() } else { u.signum() };
+                let f = u - fc * dir;
+                let vinf = f / viscous;
+                let e = (-a * hs).exp();
+                let vn = vinf + (v - vinf) * e;
+                if vn * dir < 0.0 {
+                    // the velocity reaches 0 within the sub-step: stop there (at rest)
+                    let tau = ((v - vinf) / (0.0 - vinf)).ln() / a;
+                    x += vinf * tau + (v - vinf) * (1.0 - (-a * tau).exp()) / a;
+                    v = 0.0;
+                } else {
+                    x += vinf * hs + (v - vinf) * (1.0 - e) / a;
+                    v = vn;
+                }
+            }
+        }
     }
     let recording = Recording::from_samples(&format!("servo-loop-{seed}-{index}"), &t, w, y, None);
     let nominal = loop_model(
@@ -160,11 +199,11 @@ pub fn generate(seed: u64, index: usize, correct_nominal: bool) -> ServoCase {
         kd,
     );
     let description = format!(
-        "m = {mass:.3} kg (nominal {nominal_mass:.3}), c = {viscous:.3} N s/m (nominal {nominal_viscous:.3}), omega_n = {:.2} Hz, zeta = {zeta:.2}, Kp = {kp:.1} N/m, Kd = {kd:.2} N s/m, {ns} samples at 1 kHz",
+        "m = {mass:.3} kg (nominal {nominal_mass:.3}), c = {viscous:.3} N s/m (nominal {nominal_viscous:.3}), omega_n = {:.2} Hz, zeta = {zeta:.2}, Kp = {kp:.1} N/m, Kd = {kd:.2} N s/m, Coulomb friction {fc:.3} N (not in the nominal), {ns} samples at 1 kHz",
         omega_n / TAU
     );
     ServoCase {
-        truth: ServoTruth { mass, viscous, kp, kd, omega_n, zeta },
+        truth: ServoTruth { mass, viscous, coulomb: fc, kp, kd, omega_n, zeta },
         nominal_mass,
         nominal_viscous,
         nominal,
