@@ -166,7 +166,7 @@ impl EtaOrbit {
     /// samples of `eta_T` at the cell boundaries. `None` if `cells` does not divide it.
     pub fn eta_dot_cells(&self, cells: usize) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
         let K = self.t.len() - 1;
-        if cells == 0 || K % cells != 0 {
+        if cells == 0 || !K.is_multiple_of(cells) {
             return None;
         }
         let per = K / cells;
@@ -188,7 +188,7 @@ impl EtaOrbit {
     /// unless the output is scalar and `cells` divides the number of sample intervals.
     pub fn deta_cells_scalar(&self, cells: usize) -> Option<(Vec<f64>, Vec<f64>)> {
         let K = self.t.len() - 1;
-        if cells == 0 || K % cells != 0 || self.deta.first().map(Vec::len) != Some(1) {
+        if cells == 0 || !K.is_multiple_of(cells) || self.deta.first().map(Vec::len) != Some(1) {
             return None;
         }
         let per = K / cells;

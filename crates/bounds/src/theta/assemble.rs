@@ -714,7 +714,7 @@ impl ThetaReport {
 
 /// The largest divisor of `k` that is at most `at_most` (at least 1).
 fn largest_divisor_at_most(k: usize, at_most: usize) -> usize {
-    (1..=at_most.min(k).max(1)).rev().find(|d| k % d == 0).unwrap_or(1)
+    (1..=at_most.min(k).max(1)).rev().find(|&d| k.is_multiple_of(d)).unwrap_or(1)
 }
 
 /// The largest float below `x` (for values that must be rounded down; `x` finite).

@@ -320,9 +320,9 @@ mod tests {
         let psi = Psi { alpha: 0.0, lambda: 0.3, beta: 0.024 };
         let (prof, speed) = play_case(0.2);
         assert!(prof.engaged_cells() > prof.cells() / 2, "{} engaged", prof.engaged_cells());
-        for c in 0..prof.cells() {
+        for (c, (floor, sp)) in prof.floor.iter().zip(&speed).enumerate() {
             // one sample step of slack for the discrete derivative near the catching point
-            assert!(prof.floor[c] <= speed[c] + 0.05, "cell {c}: floor {} above speed {}", prof.floor[c], speed[c]);
+            assert!(*floor <= sp + 0.05, "cell {c}: floor {floor} above speed {sp}");
         }
         let nodes = prof.best_partition(&psi, 4);
         let mut none = prof.clone();
