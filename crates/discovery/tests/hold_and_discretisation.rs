@@ -1,11 +1,12 @@
 //! Issue 13: input hold (exact ZOH / FOH discretisation, `auto` from the data), sub-steps by
 //! convergence, stuck fits, starts over decades, blocked cross-validation. Every check has a
 //! negative control.
+mod common;
 use discovery::bench_gen::{self, Profile};
 use discovery::diagnose::HoldChoice;
-use discovery::fit::{self, FitSettings, FitStatus, Problem};
+use discovery::fit::{self, FitSettings, FitStatus};
 use discovery::hypothesis::{self, Kind, Scales};
-use discovery::simulate::{ExtendedModel, InputHold, StepMaps};
+use discovery::simulate::{ExtendedModel, InputHold};
 use discovery::{diagnose, DiagnoseSettings, InitialState, Recording};
 use model::effects::Effect;
 
@@ -180,31 +181,12 @@ fn small_friction_problem() -> (model::System, Vec<f64>, Vec<f64>, f64, Scales) 
 #[test]
 fn starts_over_decades_find_a_small_friction_and_stuck_fits_are_flagged() {
     let (sys, w, y, level, scales) = small_friction_problem();
-    let dt = scales.dt;
     let h = hypothesis::candidates(&sys, &scales)
         .into_iter()
         .find(|h| h.kind == Kind::CoulombFriction { state: 1 })
         .unwrap();
     assert!((h.upper[0] / level - 500.0).abs() < 1.0, "truth at 0.2 % of the bound");
-    let pb = |h: &hypothesis::Hypothesis| Problem {
-        sys: &sys,
-        fixed: vec![],
-        parts: vec![h.clone()],
-        scales: &scales,
-        w: &w,
-        y: &y,
-        m: 1,
-        p: 1,
-        dt,
-        k_est: w.len(),
-        weights: vec![1.0],
-        maps: StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / 4.0),
-        substeps: 4,
-        hold: InputHold::Foh,
-        z0: None,
-        exclude: None,
-        refit: None,
-    };
+    let pb = |h: &hypothesis::Hypothesis| common::scalar_problem(&sys, h, &scales, &w, &y, w.len(), 1.0, 4);
     // Known initial state (empty x scale).
     let r = fit::fit(&pb(&h), &[0.0, 0.0], &[], None, &FitSettings::default());
     assert!((r.theta[0] / level - 1.0).abs() < 0.05, "decade starts: level {} vs {level}", r.theta[0]);

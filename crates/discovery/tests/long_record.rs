@@ -1,9 +1,10 @@
 //! Long records (estimation segment >= `fit::LONG_RECORD` samples): the multi-start phase runs
 //! on a leading third, the final iterations on the whole segment. The estimate must be the one
 //! the whole-segment start phase finds (control: `long_record = usize::MAX`), and the truth.
-use discovery::fit::{self, FitSettings, Problem, LONG_RECORD};
+mod common;
+use discovery::fit::{self, FitSettings, LONG_RECORD};
 use discovery::hypothesis::{self, Kind, Scales};
-use discovery::simulate::{ExtendedModel, InputHold, StepMaps};
+use discovery::simulate::ExtendedModel;
 use model::effects::Effect;
 
 fn mass() -> model::System {
@@ -43,25 +44,7 @@ fn long_record_start_phase_finds_the_whole_segment_estimate() {
         .find(|h| h.kind == Kind::CoulombFriction { state: 1 })
         .expect("Coulomb friction on the velocity state is a candidate");
     assert!(h.starts.len() > 1, "several starts: the start phase is used");
-    let pb = Problem {
-        sys: &sys,
-        fixed: vec![],
-        parts: vec![h.clone()],
-        scales: &scales,
-        w: &w,
-        y: &y,
-        m: 1,
-        p: 1,
-        dt,
-        k_est,
-        weights: vec![1.0 / yr],
-        maps: StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / 2.0),
-        substeps: 2,
-        hold: InputHold::Foh,
-        z0: None,
-        exclude: None,
-        refit: None,
-    };
+    let pb = common::scalar_problem(&sys, &h, &scales, &w, &y, k_est, 1.0 / yr, 2);
     let short = fit::fit(&pb, &[0.0, 0.0], &[], None, &FitSettings::default());
     let whole = fit::fit(&pb, &[0.0, 0.0], &[], None, &FitSettings { long_record: usize::MAX, ..Default::default() });
     let (a, b) = (short.theta[0], whole.theta[0]);

@@ -1,9 +1,10 @@
 //! Issue 13 item 7: the reported sigma includes the model-error spread of a delete-a-group
 //! jackknife over contiguous folds of the estimation segment. Each check has a negative control.
+mod common;
 use discovery::fit::jackknife::{self, Estimate};
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::{self, Kind, Scales};
-use discovery::simulate::{ExtendedModel, InputHold, StepMaps};
+use discovery::simulate::ExtendedModel;
 use model::effects::Effect;
 
 fn mass(k: f64) -> model::System {
@@ -53,23 +54,8 @@ fn fit_and_jackknife(k: f64, iters: usize) -> (f64, f64, jackknife::Jackknife) {
         .find(|h| h.kind == Kind::ConstantForce { state: 1 })
         .expect("constant force on the velocity state is a candidate");
     let pb = |exclude: Option<(usize, usize)>| Problem {
-        sys: &sys,
-        fixed: vec![],
-        parts: vec![h.clone()],
-        scales: &scales,
-        w: &w,
-        y: &y,
-        m: 1,
-        p: 1,
-        dt,
-        k_est,
-        weights: vec![1.0 / yr],
-        maps: StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / 4.0),
-        substeps: 4,
-        hold: InputHold::Foh,
-        z0: None,
         exclude,
-        refit: None,
+        ..common::scalar_problem(&sys, &h, &scales, &w, &y, k_est, 1.0 / yr, 4)
     };
     let s = FitSettings::default();
     let full = fit::fit(&pb(None), &[0.0, 0.0], &[], None, &s);

@@ -368,17 +368,15 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         (true, Some((edot, nodes))) => Some(SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R)),
         _ => None,
     };
-    let (theta_profile, lambda_profile, profile_intervals) = match &profile {
+    // (theta_profile, its certified (lambda, b_hat), partition size)
+    let (theta_profile, (lambda_profile, beta_profile), profile_intervals) = match &profile {
         Some(prof) => {
             let nodes = prof
                 .best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
-            let (v, l) = star_points
-                .iter()
-                .map(|&(l, b)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
-                .fold((f64::INFINITY, f64::NAN), |a, c| if c.0 < a.0 { c } else { a });
-            (v.min(theta_star), if v <= theta_star { l } else { lambda_star }, nodes.len() - 1)
+            let (v, at) = best_certified_point(prof, &nodes, a_low, &star_points);
+            (v.min(theta_star), if v <= theta_star { at } else { (lambda_star, beta_star) }, nodes.len() - 1)
         }
-        None => (theta_star, lambda_star, 0),
+        None => (theta_star, (lambda_star, beta_star), 0),
     };
     let theta_profile_verified = theta_verified && profile.is_some();
 
@@ -397,7 +395,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let (theta_engaged, lambda_engaged, engaged_cells) = match &engaged {
         Some(prof) => {
             let nodes = prof.best_partition(
-                &Psi { alpha: a_low, lambda: lambda_profile, beta: beta_at(&star_points, lambda_profile, beta_star) },
+                &Psi { alpha: a_low, lambda: lambda_profile, beta: beta_profile },
                 settings.profile_stride,
             );
             // the floors weigh psi at high speeds more than the chords do: a lambda search of
@@ -415,10 +413,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
                 }
                 Err(e) => notes.push(format!("third lambda search (for theta_engaged) failed: {e}")),
             }
-            let (v, l) = points
-                .iter()
-                .map(|&(l, b)| (prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes), l))
-                .fold((f64::INFINITY, f64::NAN), |a, c| if c.0 < a.0 { c } else { a });
+            let (v, (l, _)) = best_certified_point(prof, &nodes, a_low, &points);
             (v.min(theta_profile), if v <= theta_profile { l } else { lambda_profile }, prof.engaged_cells())
         }
         None => (theta_profile, lambda_profile, 0),
@@ -731,7 +726,11 @@ pub fn linearised_matrix(sys: &System) -> DMatrix<f64> {
     sys.F()
 }
 
-/// `b_hat` of the certified point with this `lambda` (`default` when none matches).
-fn beta_at(points: &[(f64, f64)], lambda: f64, default: f64) -> f64 {
-    points.iter().find(|p| p.0 == lambda).map_or(default, |p| p.1)
+/// The smallest bound of `prof` with partition `nodes` over the certified `(lambda, b_hat)`
+/// points, and the point attaining it (`(inf, (NaN, NaN))` without points).
+fn best_certified_point(prof: &SpeedProfile, nodes: &[usize], alpha: f64, points: &[(f64, f64)]) -> (f64, (f64, f64)) {
+    points
+        .iter()
+        .map(|&(l, b)| (prof.bound(&Psi { alpha, lambda: l, beta: b }, nodes), (l, b)))
+        .fold((f64::INFINITY, (f64::NAN, f64::NAN)), |a, c| if c.0 < a.0 { c } else { a })
 }

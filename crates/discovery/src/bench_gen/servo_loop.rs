@@ -160,12 +160,7 @@ pub fn generate_with_friction(seed: u64, index: usize, correct_nominal: bool, fr
         y.push(vec![yk]);
         let u = kp * (rk - yk) - kd * vk;
         if fc == 0.0 {
-            // Exact step of m v' = u - c v, x' = v over H with u constant.
-            let e = (-a * H).exp();
-            let vinf = u / viscous;
-            let xn = x + vinf * H + (v - vinf) * (1.0 - e) / a;
-            v = vinf + (v - vinf) * e;
-            x = xn;
+            (x, v) = slide(x, v, u / viscous, a, H);
         } else {
             let hs = H / 50.0;
             for _ in 0..50 {
@@ -174,18 +169,15 @@ pub fn generate_with_friction(seed: u64, index: usize, correct_nominal: bool, fr
                 }
                 // sliding direction: of the velocity, or of the drive when starting from rest
                 let dir = if v != 0.0 { v.signum() } else { u.signum() };
-                let f = u - fc * dir;
-                let vinf = f / viscous;
-                let e = (-a * hs).exp();
-                let vn = vinf + (v - vinf) * e;
+                let vinf = (u - fc * dir) / viscous;
+                let (xn, vn) = slide(x, v, vinf, a, hs);
                 if vn * dir < 0.0 {
                     // the velocity reaches 0 within the sub-step: stop there (at rest)
                     let tau = ((v - vinf) / (0.0 - vinf)).ln() / a;
-                    x += vinf * tau + (v - vinf) * (1.0 - (-a * tau).exp()) / a;
+                    x = slide(x, v, vinf, a, tau).0;
                     v = 0.0;
                 } else {
-                    x += vinf * hs + (v - vinf) * (1.0 - e) / a;
-                    v = vn;
+                    (x, v) = (xn, vn);
                 }
             }
         }
@@ -210,6 +202,13 @@ pub fn generate_with_friction(seed: u64, index: usize, correct_nominal: bool, fr
         recording,
         description,
     }
+}
+
+/// Exact step of `x' = v`, `v' = a (vinf - v)` (the mass with viscous friction under a constant
+/// force, `vinf` = force / viscous term) over `h`: the new `(x, v)`.
+fn slide(x: f64, v: f64, vinf: f64, a: f64, h: f64) -> (f64, f64) {
+    let e = (-a * h).exp();
+    (x + vinf * h + (v - vinf) * (1.0 - e) / a, vinf + (v - vinf) * e)
 }
 
 #[cfg(test)]

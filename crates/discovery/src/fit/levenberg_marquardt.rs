@@ -362,10 +362,12 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
     // see all of it, from the best start. Several starts only: a single (warm) start goes
     // straight to the whole segment.
+    let short;
     let start_vars = if starts.len() > 1 && pb.k_est >= s.long_record {
-        Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() }
+        short = Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() };
+        &short
     } else {
-        vars.clone()
+        &vars
     };
     if starts.len() > SCREENED_STARTS {
         let mut scored: Vec<(f64, Vec<f64>)> = starts
@@ -377,48 +379,35 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
     }
     let mut best: Option<(Vec<f64>, Vec<f64>, f64, bool)> = None;
     for v in starts {
-        if let Some(res) = lm(&start_vars, v, s.max_iter_start, s, &mut evals) {
+        if let Some(res) = lm(start_vars, v, s.max_iter_start, s, &mut evals) {
             if best.as_ref().is_none_or(|b| res.2 < b.2) {
                 best = Some(res);
             }
         }
     }
-    let Some(b) = best else {
-        return FitResult {
-            theta: lo,
-            std: vec![f64::NAN; k],
-            nominal: nom0,
-            nominal_std: vec![f64::NAN; kn],
-            x0: x0_init.to_vec(),
-            sse: f64::INFINITY,
-            n_res: 0,
-            status: FitStatus::Failed,
-            evaluations: evals,
-        };
+    let failed = |evals: usize| FitResult {
+        theta: lo.clone(),
+        std: vec![f64::NAN; k],
+        nominal: nom0.clone(),
+        nominal_std: vec![f64::NAN; kn],
+        x0: x0_init.to_vec(),
+        sse: f64::INFINITY,
+        n_res: 0,
+        status: FitStatus::Failed,
+        evaluations: evals,
     };
-    // (after a short start phase the fallback is re-evaluated on the whole segment)
-    let b_v = b.0.clone();
-    let fallback = if start_vars.k_end < vars.k_end {
-        vars.res(&b.0, &mut evals).map(|r| {
+    let Some(b) = best else { return failed(evals) };
+    let refined = match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
+        Some(done) => Some(done),
+        // the best start's residual is of the leading part after a short start phase: the
+        // fallback is evaluated on the whole segment
+        None if start_vars.k_end < vars.k_end => vars.res(&b.0, &mut evals).map(|r| {
             let c = sse(&r);
-            (b.0.clone(), r, c, false)
-        })
-    } else {
-        Some(b)
+            (b.0, r, c, false)
+        }),
+        None => Some(b),
     };
-    let Some((v, r, cost, conv)) = lm(&vars, b_v, s.max_iter, s, &mut evals).or(fallback) else {
-        return FitResult {
-            theta: lo,
-            std: vec![f64::NAN; k],
-            nominal: nom0,
-            nominal_std: vec![f64::NAN; kn],
-            x0: x0_init.to_vec(),
-            sse: f64::INFINITY,
-            n_res: 0,
-            status: FitStatus::Failed,
-            evaluations: evals,
-        };
-    };
+    let Some((v, r, cost, conv)) = refined else { return failed(evals) };
     // Gauss-Newton covariance of the effect parameters.
     let J = jacobian(&vars, &v, &r, s.tol_fd, &mut evals);
     let nres = r.len();

@@ -162,17 +162,51 @@ fn rich_runs(text: &str) -> Vec<(String, bool)> {
     runs
 }
 
+/// Width in pixels of the plain string `s` at font size `sz`.
+fn text_width<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, s: &str, sz: u32) -> i32 {
+    area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font())).map(|(w, _)| w as i32).unwrap_or(0)
+}
+
+/// Font size of a run of [`rich_runs`] and its offset across the line (subscripts smaller,
+/// set off by 45 % of `size`).
+fn run_metrics(size: u32, sub: bool) -> (u32, i32) {
+    if sub {
+        (size * 7 / 10, (size * 45 / 100) as i32)
+    } else {
+        (size, 0)
+    }
+}
+
 /// Width in pixels of `text` drawn by [`draw_rich`] at `size`.
 fn rich_width<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, text: &str, size: u32) -> i32 {
-    rich_runs(text)
-        .iter()
-        .map(|(s, sub)| {
-            let sz = if *sub { size * 7 / 10 } else { size };
-            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
-                .map(|(w, _)| w as i32)
-                .unwrap_or(0)
-        })
-        .sum()
+    rich_runs(text).iter().map(|(s, sub)| text_width(area, s, run_metrics(size, *sub).0)).sum()
+}
+
+/// Draws `text` with its top-left at `at` (`vertical`: rotated a quarter turn counter-clockwise,
+/// reading upwards as a y-axis label, `at` the bottom-left of the line), subscripts (see
+/// [`rich_runs`]) smaller and set off to the reader's "below". Leading blanks of a run are
+/// dropped by the backends: their width is skipped instead.
+fn draw_rich_runs<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    text: &str,
+    at: (i32, i32),
+    size: u32,
+    vertical: bool,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut along = 0;
+    for (s, sub) in rich_runs(text) {
+        let (sz, off) = run_metrics(size, sub);
+        let (w, lead) = (text_width(area, &s, sz), text_width(area, &s, sz) - text_width(area, s.trim_start(), sz));
+        let (font, pos) = if vertical {
+            let font = ("sans-serif", sz).into_font().transform(FontTransform::Rotate270).color(&BLACK);
+            (font, (at.0 + off, at.1 - along - lead))
+        } else {
+            (("sans-serif", sz).into_font().color(&BLACK), (at.0 + along + lead, at.1 + off))
+        };
+        area.draw(&Text::new(s.trim_start().to_string(), pos, font))?;
+        along += w;
+    }
+    Ok(())
 }
 
 /// Draws `text` with its top-left at `at`, subscripts (see [`rich_runs`]) smaller and lower.
@@ -182,47 +216,18 @@ fn draw_rich<DB: DrawingBackend>(
     at: (i32, i32),
     size: u32,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let mut x = at.0;
-    for (s, sub) in rich_runs(text) {
-        let (sz, dy) = if sub { (size * 7 / 10, (size * 45 / 100) as i32) } else { (size, 0) };
-        let font = ("sans-serif", sz).into_font().color(&BLACK);
-        let width = |s: &str| {
-            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
-                .map(|(w, _)| w as i32)
-                .unwrap_or(0)
-        };
-        // leading blanks are dropped by the backends: skip their width instead
-        let lead = width(&s) - width(s.trim_start());
-        area.draw(&Text::new(s.trim_start().to_string(), (x + lead, at.1 + dy), font.clone()))?;
-        x += width(&s);
-    }
-    Ok(())
+    draw_rich_runs(area, text, at, size, false)
 }
 
-/// Draws `text` rotated a quarter turn counter-clockwise (reading upwards, as a y-axis label),
-/// centred on `centre`, subscripts (see [`rich_runs`]) smaller and set off to the reader's
-/// "below", i.e. towards the axis.
+/// Draws `text` rotated a quarter turn counter-clockwise (a y-axis label), centred on `centre`.
 fn draw_rich_vertical<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     text: &str,
     centre: (i32, i32),
     size: u32,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let total = rich_width(area, text, size);
-    let mut y = centre.1 + total / 2;
-    for (s, sub) in rich_runs(text) {
-        let (sz, dx) = if sub { (size * 7 / 10, (size * 45 / 100) as i32) } else { (size, 0) };
-        let font = ("sans-serif", sz).into_font().transform(FontTransform::Rotate270).color(&BLACK);
-        let width = |s: &str| {
-            area.estimate_text_size(s, &TextStyle::from(("sans-serif", sz).into_font()))
-                .map(|(w, _)| w as i32)
-                .unwrap_or(0)
-        };
-        let lead = width(&s) - width(s.trim_start());
-        area.draw(&Text::new(s.trim_start().to_string(), (centre.0 - size as i32 / 2 + dx, y - lead), font))?;
-        y -= width(&s);
-    }
-    Ok(())
+    let half = rich_width(area, text, size) / 2;
+    draw_rich_runs(area, text, (centre.0 - size as i32 / 2, centre.1 + half), size, true)
 }
 
 /// Whether `text` has a subscript that is not a digit (those have no Unicode subscript glyph
@@ -425,41 +430,61 @@ pub fn to_svg(f: &Figure) -> Result<String, FigureError> {
     Ok(crate::plot::embed_font(buf))
 }
 
-/// The figure's SVG parsed for rasterising or PDF conversion, with the embedded DejaVu Sans as
-/// its only font (the same glyphs as the PNG and the SVG).
-fn usvg_tree(f: &Figure) -> Result<svg2pdf::usvg::Tree, FigureError> {
-    let svg = to_svg(f)?;
-    let mut opt = svg2pdf::usvg::Options::default();
-    opt.fontdb_mut().load_font_data(dejavu::sans::regular().to_vec());
-    opt.font_family = "DejaVu Sans".into();
-    svg2pdf::usvg::Tree::from_str(&svg, &opt)
+/// `svg` (the figure's, from [`to_svg`]) parsed for rasterising or PDF conversion, with the
+/// embedded DejaVu Sans as its only font (the same glyphs as the PNG and the SVG; the font
+/// database is built once per process).
+fn usvg_tree(f: &Figure, svg: &str) -> Result<svg2pdf::usvg::Tree, FigureError> {
+    use std::sync::{Arc, OnceLock};
+    static FONTS: OnceLock<Arc<svg2pdf::usvg::fontdb::Database>> = OnceLock::new();
+    let fonts = FONTS.get_or_init(|| {
+        let mut db = svg2pdf::usvg::fontdb::Database::new();
+        db.load_font_data(dejavu::sans::regular().to_vec());
+        Arc::new(db)
+    });
+    let opt = svg2pdf::usvg::Options { fontdb: fonts.clone(), font_family: "DejaVu Sans".into(), ..Default::default() };
+    svg2pdf::usvg::Tree::from_str(svg, &opt)
         .map_err(|e| FigureError::Draw { figure: f.title.clone(), reason: format!("SVG not readable: {e}") })
 }
 
 /// The figure as a one-page vector PDF (text as text in the embedded, subset DejaVu Sans), from
 /// its SVG by `svg2pdf`.
 pub fn to_pdf(f: &Figure) -> Result<Vec<u8>, FigureError> {
-    let tree = usvg_tree(f)?;
-    svg2pdf::to_pdf(&tree, svg2pdf::ConversionOptions::default(), svg2pdf::PageOptions::default())
+    pdf_of(f, &usvg_tree(f, &to_svg(f)?)?)
+}
+
+fn pdf_of(f: &Figure, tree: &svg2pdf::usvg::Tree) -> Result<Vec<u8>, FigureError> {
+    svg2pdf::to_pdf(tree, svg2pdf::ConversionOptions::default(), svg2pdf::PageOptions::default())
         .map_err(|e| FigureError::Draw { figure: f.title.clone(), reason: format!("PDF conversion: {e}") })
 }
 
 /// The figure as PNG bytes at `dpi` dots per inch: its SVG rasterised by `resvg` at scale
 /// `dpi / 96` (CSS pixels are 1/96 inch), so every size (text, lines, margins) scales together.
 pub fn to_png_at_dpi(f: &Figure, dpi: f64) -> Result<Vec<u8>, FigureError> {
-    use svg2pdf::usvg::tiny_skia_path::Transform;
-    let bad = |reason: String| FigureError::Draw { figure: f.title.clone(), reason };
+    check_dpi(f, dpi)?;
+    png_of(f, &usvg_tree(f, &to_svg(f)?)?, dpi)
+}
+
+/// The pixel size of `f` at `dpi`, or the error naming the value.
+fn check_dpi(f: &Figure, dpi: f64) -> Result<(u32, u32), FigureError> {
     let scale = dpi / 96.0;
     let (w, h) = ((f.size.0 as f64 * scale).round(), (f.size.1 as f64 * scale).round());
     if !(scale.is_finite() && scale > 0.0 && w >= 1.0 && h >= 1.0 && w * h <= 1e8) {
-        return Err(bad(format!(
-            "--dpi {dpi} gives a {w} x {h} pixel image (at most 1e8 pixels; dpi must be positive)"
-        )));
+        return Err(FigureError::Draw {
+            figure: f.title.clone(),
+            reason: format!("--dpi {dpi} gives a {w} x {h} pixel image (at most 1e8 pixels; dpi must be positive)"),
+        });
     }
-    let tree = usvg_tree(f)?;
-    let mut pixmap = resvg::tiny_skia::Pixmap::new(w as u32, h as u32).ok_or_else(|| bad("empty image".into()))?;
+    Ok((w as u32, h as u32))
+}
+
+fn png_of(f: &Figure, tree: &svg2pdf::usvg::Tree, dpi: f64) -> Result<Vec<u8>, FigureError> {
+    use svg2pdf::usvg::tiny_skia_path::Transform;
+    let bad = |reason: String| FigureError::Draw { figure: f.title.clone(), reason };
+    let (w, h) = check_dpi(f, dpi)?;
+    let scale = (dpi / 96.0) as f32;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(w, h).ok_or_else(|| bad("empty image".into()))?;
     pixmap.fill(resvg::tiny_skia::Color::WHITE);
-    resvg::render(&tree, Transform::from_scale(scale as f32, scale as f32), &mut pixmap.as_mut());
+    resvg::render(tree, Transform::from_scale(scale, scale), &mut pixmap.as_mut());
     pixmap.encode_png().map_err(|e| bad(format!("PNG encoding: {e}")))
 }
 
@@ -506,24 +531,35 @@ pub fn write_figure_with(
         |p: &Path, e: &dyn std::fmt::Display| FigureError::Write { path: p.to_path_buf(), reason: e.to_string() };
     let staged = crate::output::StagedDir::new(out).map_err(|e| werr(out, &e))?;
     let mut files = vec![];
+    let png_dpi = png_dpi.filter(|_| formats.contains(&Format::Png));
     for (stem, f) in figs {
-        if formats.contains(&Format::Svg) {
-            let svg = to_svg(f)?;
+        if let Some(dpi) = png_dpi {
+            check_dpi(f, dpi)?; // before any drawing: a bad value costs nothing
+        }
+        // the SVG is drawn once and parsed once for every format made from it
+        let svg = (formats.contains(&Format::Svg) || formats.contains(&Format::Pdf) || png_dpi.is_some())
+            .then(|| to_svg(f))
+            .transpose()?;
+        let tree = match &svg {
+            Some(svg) if formats.contains(&Format::Pdf) || png_dpi.is_some() => Some(usvg_tree(f, svg)?),
+            _ => None,
+        };
+        if let (true, Some(svg)) = (formats.contains(&Format::Svg), &svg) {
             let p = staged.path(&format!("{stem}.svg"));
             std::fs::write(&p, svg).map_err(|e| werr(&p, &e))?;
             files.push(out.join(format!("{stem}.svg")));
         }
         if formats.contains(&Format::Png) {
             let p = staged.path(&format!("{stem}.png"));
-            match png_dpi {
-                Some(dpi) => std::fs::write(&p, to_png_at_dpi(f, dpi)?).map_err(|e| werr(&p, &e))?,
-                None => write_png(f, &p)?,
+            match (png_dpi, &tree) {
+                (Some(dpi), Some(tree)) => std::fs::write(&p, png_of(f, tree, dpi)?).map_err(|e| werr(&p, &e))?,
+                _ => write_png(f, &p)?,
             }
             files.push(out.join(format!("{stem}.png")));
         }
-        if formats.contains(&Format::Pdf) {
+        if let (true, Some(tree)) = (formats.contains(&Format::Pdf), &tree) {
             let p = staged.path(&format!("{stem}.pdf"));
-            std::fs::write(&p, to_pdf(f)?).map_err(|e| werr(&p, &e))?;
+            std::fs::write(&p, pdf_of(f, tree)?).map_err(|e| werr(&p, &e))?;
             files.push(out.join(format!("{stem}.pdf")));
         }
         if formats.contains(&Format::Pgf) {
