@@ -67,6 +67,7 @@ pub fn tube_diameters_with(
     sphere: &SphereMaxSettings,
 ) -> Result<TubeDiameters, BoundsError> {
     let p = C.nrows();
+    let sphere = &sphere.scaled_for_dimension(p);
     let tube_C = TubeKernel::with_shared(C, F, E, theta, d_theta, sg, Horizon::Infinite, tube)?;
     let CF = C * F;
     let tube_CF = TubeKernel::with_shared(&CF, F, E, theta, d_theta, sg, Horizon::Infinite, tube)?;
