@@ -727,7 +727,7 @@ fn select_all(
                 let sse_s = cv_sse(ctx, s, &sb.parts, sb.refit.then_some(&sb.nominal[..]), &sb.params, &sb.x0)
                     .unwrap_or_else(|| vec![f64::INFINITY; s.cv_folds]);
                 let cv = cross_validate(ctx, s, &singles[bi], sb, &sse_s);
-                if cv.status != "not_testable" && cv.ratio > hypothesis::NESTED_MAX_CV_RATIO {
+                if cv.status != "not_testable" && !hypothesis::nested_supported(&cv.sse, &sse_s) {
                     let cv0 = cross_validate(ctx, s, &singles[si], &nominal_ranked, &base_sse);
                     if cv0.status != "failed" {
                         let label = format!("{} (against {})", singles[bi].label, singles[si].label);
@@ -1180,8 +1180,13 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         ));
     }
     for (l, r, req) in &cv_rejected {
+        let nested = if l.contains(" (against ") {
+            format!(", or at most {:.2} with every fold lower", hypothesis::NESTED_CONSISTENT_MAX_CV_RATIO)
+        } else {
+            String::new()
+        };
         notes.push(format!(
-            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {req:.2} required): rejected."
+            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {req:.2} required{nested}): rejected."
         ));
     }
 
