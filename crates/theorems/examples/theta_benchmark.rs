@@ -145,6 +145,43 @@ fn main() {
     println!();
     summary(&format!("A. All {} convergent systems:", table_a.len()), &table_a);
     summary(&format!("B. The {} convergent systems certified by the paper's theta:", table_b.len()), &table_b);
+    // Ceiling of eq. (theta) itself (NOT a bound): the chord with the measured path length per
+    // period and the measured limsup |z'| in place of their certified bounds, at the best
+    // lambda of the certified (lambda, beta) curve. Any theta built on eq. (theta) with
+    // tighter path or speed bounds stays above it, so its median ratio caps theta_star's.
+    let ceiling = |r: &Row| -> Option<f64> {
+        let m = r.rep.measured.as_ref()?;
+        let (g1, ginf) = (m.path_length_per_period / (r.rep.period * r.rep.R), m.limsup_zdot / r.rep.R);
+        r.rep
+            .curve
+            .iter()
+            .map(|&(lambda, beta, _)| bounds::theta::Psi { alpha: r.rep.alpha.lower, lambda, beta }.theta(g1, ginf))
+            .filter(|t| t.is_finite())
+            .min_by(f64::total_cmp)
+    };
+    for (title, set) in [("A", &table_a), ("B", &table_b)] {
+        let c: Vec<(f64, f64)> = set.iter().filter_map(|r| ceiling(r).map(|t| (t, r.rate))).collect();
+        let neg: Vec<f64> = c.iter().filter(|(t, _)| *t < 0.0).map(|(t, m)| t / m).collect();
+        println!(
+            "Table {title}: ceiling of eq. (theta) with the measured path and limsup |z'| (not a bound): < 0 on {} of {}, median ceiling / measured {:.3}.",
+            neg.len(),
+            set.len(),
+            median(neg.clone())
+        );
+    }
+    // where theta_star loses against the ceiling: certified path / measured path (<= 1) and
+    // certified limsup |z'| / measured (>= 1), medians over table B
+    let path_ratio: Vec<f64> = table_b
+        .iter()
+        .filter_map(|r| r.rep.measured.as_ref().map(|m| r.rep.gamma_1_star * r.rep.period * r.rep.R / m.path_length_per_period))
+        .collect();
+    let speed_ratio: Vec<f64> =
+        table_b.iter().filter_map(|r| r.rep.measured.as_ref().map(|m| r.rep.zdot_bound / m.limsup_zdot)).collect();
+    println!(
+        "Table B: certified path / measured path median {:.3}; certified limsup |z'| / measured median {:.3}.",
+        median(path_ratio),
+        median(speed_ratio)
+    );
     let all_viol = rows
         .iter()
         .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
