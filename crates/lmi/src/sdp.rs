@@ -62,14 +62,19 @@ impl SdpSettings {
         Ok(())
     }
 
-    fn to_clarabel(&self) -> DefaultSettings<f64> {
+    /// Clarabel's settings. `fast` is the variant for a first attempt that may fail without
+    /// harm (`beta_sdp`'s solve without the compactness bound): iterative refinement of the
+    /// KKT solves off (about a fifth of the time of a small SDP).
+    fn to_clarabel(&self, fast: bool) -> DefaultSettings<f64> {
+        let d = DefaultSettings::<f64>::default();
         DefaultSettings {
             tol_gap_abs: self.tol_gap_abs,
             tol_gap_rel: self.tol_gap_rel,
             tol_feas: self.tol_feas,
             max_iter: self.max_iter,
             verbose: self.verbose,
-            ..DefaultSettings::default()
+            iterative_refinement_enable: !fast && d.iterative_refinement_enable,
+            ..d
         }
     }
 }
@@ -212,6 +217,12 @@ impl ConicProgram {
     /// `min q^T x` subject to the accumulated constraints. `Err` only when Clarabel rejects
     /// the data; every termination status is returned in the outcome.
     pub fn solve(&self, q: &[f64], settings: &SdpSettings) -> Result<ConicOutcome> {
+        self.solve_with(q, settings, false)
+    }
+
+    /// [`ConicProgram::solve`], with Clarabel's settings for a first attempt when `fast`
+    /// (`SdpSettings::to_clarabel`).
+    pub(crate) fn solve_with(&self, q: &[f64], settings: &SdpSettings, fast: bool) -> Result<ConicOutcome> {
         let m = self.b.len();
         let n = self.nvar;
         let mut colptr = Vec::with_capacity(n + 1);
@@ -228,7 +239,7 @@ impl ConicProgram {
         }
         let A = CscMatrix::new(m, n, colptr, rowval, nzval);
         let P = CscMatrix::zeros((n, n));
-        let mut solver = DefaultSolver::new(&P, q, &A, &self.b, &self.cones, settings.to_clarabel())
+        let mut solver = DefaultSolver::new(&P, q, &A, &self.b, &self.cones, settings.to_clarabel(fast))
             .map_err(|_| LmiError::SetupRejected { rows: m, cols: n })?;
         solver.solve();
         let sol = &solver.solution;
@@ -248,6 +259,13 @@ impl LmiBuilder {
     /// Add `M0 + sum_k x_k Mk[k] >= 0`; `Mk[k] = None` means variable `k` does not enter.
     pub fn add_psd(&mut self, M0: &DMatrix<f64>, Mk: &[Option<DMatrix<f64>>]) {
         self.0.add_psd(M0, Mk)
+    }
+
+    /// The raw outcome of `min q^T x` (no error mapping) with the `fast` settings of
+    /// `SdpSettings::to_clarabel`: for a first attempt whose failure is not an error
+    /// (`beta_sdp`'s solve without the compactness bound).
+    pub fn solve_fast(&self, q: &[f64], settings: &SdpSettings) -> Result<ConicOutcome> {
+        self.0.solve_with(q, settings, true)
     }
 
     /// `min q^T x` subject to the accumulated constraints.
