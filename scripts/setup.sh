@@ -4,10 +4,7 @@
 set -euo pipefail
 
 need_pkgs=()
-# libopenblas0-serial: the single-threaded OpenBLAS that the binaries prefer at run time
-# (.cargo/config.toml, RUNPATH); the pthread build is 1.2-1.5x slower on Clarabel's tiny
-# LAPACK calls.
-for pkg in libopenblas-dev libopenblas0-serial libgfortran-12-dev pkg-config; do
+for pkg in libopenblas-dev libgfortran-12-dev pkg-config; do
     dpkg -s "$pkg" >/dev/null 2>&1 || need_pkgs+=("$pkg")
 done
 if [ "${#need_pkgs[@]}" -gt 0 ]; then
