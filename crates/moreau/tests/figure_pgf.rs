@@ -75,3 +75,33 @@ fn psi_figure_as_pgfplots_is_ascii_balanced_and_compiles_when_latex_is_present()
         .unwrap();
     assert!(!run("doc.tex").status.success(), "a broken pgf file compiled: the check cannot fail");
 }
+
+#[test]
+fn psi_figure_of_a_report_draws_the_sharper_certified_bounds_as_levels() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml");
+    let sys = model::load(std::path::Path::new(path)).unwrap();
+    let rep = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
+    let f = psi::from_report(&rep);
+    let level = |prefix: &str| {
+        f.elements.iter().find_map(|e| match e {
+            moreau::figures::Element::Line { label, pts, .. } if label.starts_with(prefix) => Some(pts.clone()),
+            _ => None,
+        })
+    };
+    // theta_star and the best bound beyond the paper, verified and below the paper's theta
+    assert!(rep.theta_star_verified && rep.theta_star < rep.theta);
+    let star = level("θ* =").expect("theta_star level");
+    assert!(star.iter().all(|p| p.1 == rep.theta_star) && star[0].0 == 0.0 && star[1].0 > rep.gamma_inf);
+    let best = level(match rep.theta_best_method {
+        "theta_engaged" => "θ_eng =",
+        _ => "θ_prof =",
+    })
+    .expect("best-bound level");
+    assert!(best.iter().all(|p| p.1 == rep.theta_best) && rep.theta_best < rep.theta_star);
+    // negative control: without the verified flags no level is drawn
+    let mut unverified = rep.clone();
+    unverified.theta_star_verified = false;
+    unverified.theta_best_verified = false;
+    let g = psi::from_report(&unverified);
+    assert!(g.elements.len() + 2 == f.elements.len(), "{} vs {}", g.elements.len(), f.elements.len());
+}

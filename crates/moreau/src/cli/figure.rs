@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Kind {
-    /// Fig. psi1: psi(gamma) with psi(0), psi(gamma_inf), the limit -lambda and the chord (theta). INPUT: model file.
+    /// Fig. psi1: psi(gamma) with psi(0), psi(gamma_inf), the limit -lambda and the chord (theta), and the sharper certified bounds (theta_star, the best beyond the paper) as levels. INPUT: model file.
     Psi,
     /// Fig. loop: the orbit eta_T, the tube eta_T + C Xi_inf + Theta, the simulated periodic z. INPUT: model file.
     Tube,

@@ -1,7 +1,8 @@
 //! Fig. psi1: `psi(gamma)` of eq. (phipsi), its value `psi(0)` (eq. (psilim)), the limit
 //! `-lambda`, the value `psi(gamma_inf)` and the chord over `[0, gamma_inf]` whose value at
-//! `gamma_1` is `theta` (eq. (theta)).
-use super::canvas::{Element, Figure, BLUE, GREY, ORANGE, RED};
+//! `gamma_1` is `theta` (eq. (theta)); from a report, also the sharper certified bounds as
+//! levels ([`from_report`]).
+use super::canvas::{Element, Figure, BLUE, GREEN, GREY, ORANGE, PURPLE, RED};
 use crate::sweep::table::sig;
 use bounds::theta::{Psi, ThetaReport};
 
@@ -62,7 +63,35 @@ pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
     f
 }
 
-/// Fig. psi1 of a theta report.
+/// Fig. psi1 of a theta report, with the sharper certified bounds drawn as levels: `theta_star`
+/// (eq. (theta) with the strongest path bound, at its own `lambda`) and the best bound beyond
+/// the paper (`theta_best` when it comes from `theta_profile` or `theta_engaged`), each only
+/// when verified and below the paper's `theta`. They are not read off this `psi` (each has its
+/// own `lambda` and `beta`); the levels show how far below the chord they certify.
 pub fn from_report(r: &ThetaReport) -> Figure {
-    psi_figure(&r.psi(), r.gamma_1, r.gamma_inf)
+    let mut f = psi_figure(&r.psi(), r.gamma_1, r.gamma_inf);
+    // the right end of the psi curve (the first element)
+    let x_max = match f.elements.first() {
+        Some(Element::Line { pts, .. }) => pts.last().map_or(1.0, |p| p.0),
+        _ => 1.0,
+    };
+    let v = |x: f64| sig(x, 4, false);
+    let mut levels = vec![];
+    if r.theta_star_verified && r.theta_star < r.theta {
+        levels.push((format!("θ* = {} with {}", v(r.theta_star), r.path_best_method), r.theta_star, GREEN));
+    }
+    if r.theta_best_verified && r.theta_best < r.theta.min(r.theta_star) {
+        let name = match r.theta_best_method {
+            "theta_profile" => Some("θ_prof"),
+            "theta_engaged" => Some("θ_eng"),
+            _ => None,
+        };
+        if let Some(name) = name {
+            levels.push((format!("{name} = {} (beyond the paper)", v(r.theta_best)), r.theta_best, PURPLE));
+        }
+    }
+    for (label, y, color) in levels {
+        f.elements.push(Element::Line { label, pts: vec![(0.0, y), (x_max, y)], color, dashed: true });
+    }
+    f
 }
