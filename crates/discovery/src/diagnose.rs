@@ -471,7 +471,7 @@ struct Selection {
     ties: Vec<String>,
     /// Candidates that passed the BIC margin but failed cross-validation (label, CV ratio,
     /// the ratio required).
-    cv_rejected: Vec<(String, f64, f64)>,
+    cv_rejected: Vec<(String, f64, String)>,
 }
 
 fn failed_fit(p: usize) -> Fit {
@@ -709,7 +709,7 @@ fn select_all(
             let cv = cross_validate(ctx, s, r, &nominal_ranked, &base_sse);
             r.beats_nominal = cv.status != "failed";
             if !r.beats_nominal {
-                cv_rejected.push((r.label.clone(), cv.ratio, 1.0 - s.select.min_val_gain));
+                cv_rejected.push((r.label.clone(), cv.ratio, format!("at most {:.2}", 1.0 - s.select.min_val_gain)));
             }
             r.cv = Some(cv);
             if r.beats_nominal {
@@ -731,7 +731,12 @@ fn select_all(
                     let cv0 = cross_validate(ctx, s, &singles[si], &nominal_ranked, &base_sse);
                     if cv0.status != "failed" {
                         let label = format!("{} (against {})", singles[bi].label, singles[si].label);
-                        cv_rejected.push((label, cv.ratio, hypothesis::NESTED_MAX_CV_RATIO));
+                        let req = format!(
+                            "at most {:.2}, or at most {:.2} with every fold lower",
+                            hypothesis::NESTED_MAX_CV_RATIO,
+                            hypothesis::NESTED_CONSISTENT_MAX_CV_RATIO
+                        );
+                        cv_rejected.push((label, cv.ratio, req));
                         singles[bi].beats_nominal = false;
                         singles[bi].cv = Some(cv);
                         singles[si].beats_nominal = true;
@@ -1180,13 +1185,8 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         ));
     }
     for (l, r, req) in &cv_rejected {
-        let nested = if l.contains(" (against ") {
-            format!(", or at most {:.2} with every fold lower", hypothesis::NESTED_CONSISTENT_MAX_CV_RATIO)
-        } else {
-            String::new()
-        };
         notes.push(format!(
-            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, at most {req:.2} required{nested}): rejected."
+            "{l} improves the estimation fit beyond the BIC margin but not the held-out folds (CV SSE ratio {r:.3}, {req} required): rejected."
         ));
     }
 

@@ -3,7 +3,7 @@
 //! the whole-segment start phase finds (control: `long_record = usize::MAX`), and the truth.
 mod common;
 use discovery::fit::{self, FitSettings, LONG_RECORD};
-use discovery::hypothesis::{self, Kind, Scales};
+use discovery::hypothesis::{self, Kind};
 use discovery::simulate::ExtendedModel;
 use model::effects::Effect;
 
@@ -30,15 +30,7 @@ fn long_record_start_phase_finds_the_whole_segment_estimate() {
         y0.iter().enumerate().map(|(k, v)| v + 0.01 * yr * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)).collect();
     let k_est = 7 * n / 10;
     assert!(k_est >= LONG_RECORD, "the case must take the long-record path");
-    let scales = Scales {
-        y_range: vec![yr],
-        w_range: vec![3.6],
-        w_absmax: 1.8,
-        tau_slow: 1.7,
-        dt,
-        duration: n as f64 * dt,
-        ..Default::default()
-    };
+    let scales = common::test_scales(yr, n, dt);
     let h = hypothesis::candidates(&sys, &scales)
         .into_iter()
         .find(|h| h.kind == Kind::CoulombFriction { state: 1 })

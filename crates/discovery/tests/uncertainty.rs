@@ -3,7 +3,7 @@
 mod common;
 use discovery::fit::jackknife::{self, Estimate};
 use discovery::fit::{self, FitSettings, Problem};
-use discovery::hypothesis::{self, Kind, Scales};
+use discovery::hypothesis::{self, Kind};
 use discovery::simulate::ExtendedModel;
 use model::effects::Effect;
 
@@ -40,15 +40,7 @@ fn fit_and_jackknife(k: f64, iters: usize) -> (f64, f64, jackknife::Jackknife) {
     let n = w.len();
     let k_est = 7 * n / 10;
     let yr = y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min);
-    let scales = Scales {
-        y_range: vec![yr],
-        w_range: vec![3.6],
-        w_absmax: 1.8,
-        tau_slow: 1.7,
-        dt,
-        duration: n as f64 * dt,
-        ..Default::default()
-    };
+    let scales = common::test_scales(yr, n, dt);
     let h = hypothesis::candidates(&sys, &scales)
         .into_iter()
         .find(|h| h.kind == Kind::ConstantForce { state: 1 })

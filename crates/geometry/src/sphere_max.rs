@@ -11,6 +11,30 @@
 //! the best value found and the largest upper bound is below the tolerance. For `p = 1` the
 //! sphere is `{-1, 1}` and the maximum is exact.
 use crate::Bounds;
+
+/// Orders the items of a branch-and-bound max-heap by their upper bound `ub` (total order on
+/// `f64`, so a NaN bound sorts first and is seen at once).
+macro_rules! ordered_by_ub {
+    ($($t:ty),+) => {$(
+        impl PartialEq for $t {
+            fn eq(&self, o: &Self) -> bool {
+                self.ub == o.ub
+            }
+        }
+        impl Eq for $t {}
+        impl PartialOrd for $t {
+            fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+                Some(self.cmp(o))
+            }
+        }
+        impl Ord for $t {
+            fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+                self.ub.total_cmp(&o.ub)
+            }
+        }
+    )+};
+}
+pub(crate) use ordered_by_ub;
 use std::collections::BinaryHeap;
 
 /// Settings of [`sphere_max`].
@@ -51,22 +75,7 @@ struct Cell {
     centre: Vec<f64>,
     half: f64,
 }
-impl PartialEq for Cell {
-    fn eq(&self, o: &Self) -> bool {
-        self.ub == o.ub
-    }
-}
-impl Eq for Cell {}
-impl PartialOrd for Cell {
-    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Cell {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.ub.total_cmp(&o.ub)
-    }
-}
+ordered_by_ub!(Cell);
 
 /// Encloses `max_{|u|=1} f(u)` for an `L`-Lipschitz `f` (with respect to the Euclidean
 /// distance on the sphere). Returns `Bounds { lower, upper }` where `lower` is attained at a

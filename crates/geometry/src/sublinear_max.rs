@@ -72,6 +72,7 @@
 //!
 //! The method needs sublinearity: for a function that is not convex on the cones (a narrow
 //! bump) the "upper bound" can lie below a sampled value (see the negative-control tests).
+use crate::sphere_max::ordered_by_ub;
 use crate::{sphere_max, Bounds, SphereMaxSettings};
 use std::collections::BinaryHeap;
 
@@ -92,22 +93,7 @@ struct Arc {
     g0: f64,
     g1: f64,
 }
-impl PartialEq for Arc {
-    fn eq(&self, o: &Self) -> bool {
-        self.ub == o.ub
-    }
-}
-impl Eq for Arc {}
-impl PartialOrd for Arc {
-    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Arc {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.ub.total_cmp(&o.ub)
-    }
-}
+ordered_by_ub!(Arc);
 
 /// `max_{|v| = 1} g(v)` for sublinear `g`; `lipschitz` is used only for `p > MAX_CONE_DIM`
 /// (the Lipschitz fallback).
@@ -182,22 +168,7 @@ struct Tri {
     v: [[f64; 3]; 3],
     g: [f64; 3],
 }
-impl PartialEq for Tri {
-    fn eq(&self, o: &Self) -> bool {
-        self.ub == o.ub
-    }
-}
-impl Eq for Tri {}
-impl PartialOrd for Tri {
-    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Tri {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.ub.total_cmp(&o.ub)
-    }
-}
+ordered_by_ub!(Tri);
 
 fn angle(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let c: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
@@ -576,22 +547,7 @@ struct Entry {
     ub: f64,
     slot: u32,
 }
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.ub == o.ub
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.ub.total_cmp(&o.ub)
-    }
-}
+ordered_by_ub!(Entry);
 
 /// [`cones_max`] for a dimension known at compile time.
 fn cones_max_p<const P: usize>(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bounds {

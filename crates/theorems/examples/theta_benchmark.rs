@@ -173,7 +173,9 @@ fn main() {
     // certified limsup |z'| / measured (>= 1), medians over table B
     let path_ratio: Vec<f64> = table_b
         .iter()
-        .filter_map(|r| r.rep.measured.as_ref().map(|m| r.rep.gamma_1_star * r.rep.period * r.rep.R / m.path_length_per_period))
+        .filter_map(|r| {
+            r.rep.measured.as_ref().map(|m| r.rep.gamma_1_star * r.rep.period * r.rep.R / m.path_length_per_period)
+        })
         .collect();
     let speed_ratio: Vec<f64> =
         table_b.iter().filter_map(|r| r.rep.measured.as_ref().map(|m| r.rep.zdot_bound / m.limsup_zdot)).collect();

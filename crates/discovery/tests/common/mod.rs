@@ -38,3 +38,18 @@ pub fn scalar_problem<'a>(
         refit: None,
     }
 }
+
+/// Scales of the one-input test records (input range 3.6 about 0, slowest time constant 1.7 s):
+/// output range `y_range`, `n` samples of `dt`.
+#[allow(dead_code)] // not every test binary that includes `common` uses it
+pub fn test_scales(y_range: f64, n: usize, dt: f64) -> Scales {
+    Scales {
+        y_range: vec![y_range],
+        w_range: vec![3.6],
+        w_absmax: 1.8,
+        tau_slow: 1.7,
+        dt,
+        duration: n as f64 * dt,
+        ..Default::default()
+    }
+}
