@@ -136,8 +136,18 @@ pub mod defs {
         "$\\gamma_1^*$",
         "(g1),(path1)",
         Lower,
-        "max((path), (path1), (path2)) / (T R), R upper",
+        "max((path), (path1), (path1-local), (path2)) / (T R), R upper",
     );
+    pub const ZDOT_STAR: QuantityDef = q(
+        "zdot_star_bound",
+        "||eta_T'|| + max(ceil+-)",
+        "$\\dot z^*_{\\max}$",
+        "(zinf)",
+        Upper,
+        "limsup |z'| with the backlash side pinned (p = 1; beyond the paper, proofs-notes/theta-star.md)",
+    );
+    pub const GAMMA_INF_STAR: QuantityDef =
+        q("gamma_inf_star", "gamma_inf*", "$\\gamma_\\infty^*$", "(ginf)", Upper, "min(zdot bounds) / R, R upper");
     pub const THETA_STAR: QuantityDef = q(
         "theta_star",
         "theta*",
@@ -166,6 +176,14 @@ pub mod defs {
         q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");
     pub const PATH1_BOUND: QuantityDef =
         q("path1_bound", "sup_partitions", "(path1)", "(path1)", Lower, "dynamic programming over a grid");
+    pub const PATH1_LOCAL_BOUND: QuantityDef = q(
+        "path1_local_bound",
+        "sup_partitions, local loss",
+        "(path1-local)",
+        "(path1),(zinf)",
+        Lower,
+        "(path1) with the loss min(d, diam Theta + dt D) per step (beyond the paper)",
+    );
     pub const PATH2_BOUND: QuantityDef =
         q("path2_bound", "sup_eps (2eps-d)N_eps", "(path2)", "(path2)", Lower, "greedy packing");
     pub const PHI_FIRST_SINGULAR: QuantityDef = q(
@@ -198,7 +216,7 @@ pub mod defs {
     );
 
     /// All of them, in report order.
-    pub const ALL: [&QuantityDef; 30] = [
+    pub const ALL: [&QuantityDef; 33] = [
         &PERIOD,
         &MU,
         &R,
@@ -218,11 +236,14 @@ pub mod defs {
         &PSI_LIMIT,
         &THETA,
         &GAMMA_1_STAR,
+        &ZDOT_STAR,
+        &GAMMA_INF_STAR,
         &THETA_STAR,
         &THETA_PROFILE,
         &THETA_ENGAGED,
         &PATH_BOUND,
         &PATH1_BOUND,
+        &PATH1_LOCAL_BOUND,
         &PATH2_BOUND,
         &PHI_FIRST_SINGULAR,
         &STATIONARY_SLACK,
@@ -336,11 +357,14 @@ pub fn glossary(key: &str) -> Option<&'static str> {
         "psi_limit" => "-lambda, the limit of psi at infinite speed: no bound of this kind goes below it.",
         "theta" => "theta, the paper's bound of the exponential rate at which any two trajectories approach each other. theta < 0 and verified: a unique periodic regime attracts every trajectory at least at this rate. theta >= 0: a valid bound, no convergence guaranteed.",
         "gamma_1_star" => "gamma_1*, gamma_1 from the strongest proven path bound per period ((path1) or (path2) instead of (path)).",
-        "theta_star" => "theta*, eq. (theta) with gamma_1* and the best certified (lambda, beta): a proven bound beyond the paper (proofs-notes/theta-star.md).",
+        "zdot_star_bound" => "An upper bound of the backlash speed |z'| after transients that uses which side of Theta the backlash is pushed from (p = 1: z' > 0 only with z = y + min Theta); never above (zinf), lower when C E > 0. Equal to (zinf) for p >= 2.",
+        "gamma_inf_star" => "gamma_inf*, the smaller speed bound divided by R: the chord of theta* ends there.",
+        "theta_star" => "theta*, eq. (theta) with gamma_1*, gamma_inf* and the best certified (lambda, beta): a proven bound beyond the paper (proofs-notes/theta-star.md).",
         "theta_profile" => "theta_profile, the chord of theta applied cell by cell of the speed bound |eta_T'(t)| + D, with path bounds per interval: a proven bound beyond the paper, never above theta* (proofs-notes/theta-profile.md).",
         "theta_engaged" => "theta_engaged, theta_profile with a floor on the backlash speed where the output has provably moved monotonically by Theta's width, so the backlash is engaged and moves with it (p = 1): a proven bound beyond the paper, never above theta_profile (proofs-notes/theta-engaged.md).",
         "path_bound" => "(path), the paper's lower bound of the backlash path per period: (osc - d)_+.",
         "path1_bound" => "(path1), the path bound over a partition of the period (sum of (|eta_T jumps| - d)_+), computed on a grid: at least (path).",
+        "path1_local_bound" => "(path1) where a short step loses only diam(Theta) + (step length) D instead of d (the tube moves at most at speed D): at least (path1).",
         "path2_bound" => "(path2), the path bound from a packing of the orbit by balls of radius eps > d/2.",
         "phi_first_singular" => "The first time in [0, T] at which Theorem 1's matrix Phi(t) = I - t C Psi(tA) E is singular (none: Theorem 1's representation holds on the whole period).",
         "stationary_slack" => "Theorem 1: slack of the SDP deciding whether some initial state stays at rest for a whole period (the stationary set R(T)); > 0 means R(T) is empty.",

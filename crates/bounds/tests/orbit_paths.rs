@@ -53,3 +53,33 @@ fn path_bounds_on_a_circle() {
     // Negative control: a "packing" bound computed with too small a d exceeds the true one.
     assert!(packing_bound(&refs[..K], 0.0, 2.0, 64).value > pk.value);
 }
+
+#[test]
+fn local_partition_bound_on_a_circle() {
+    // Unit circle traversed once in T = 2 pi (speed 1). The loss min(d, w + dt D): with D = inf
+    // it is (path1) with d; with a small D short steps lose about w, so the bound rises towards
+    // the perimeter minus what the steps lose; never above the perimeter.
+    let K = 720;
+    let t: Vec<f64> = (0..=K).map(|k| std::f64::consts::TAU * k as f64 / K as f64).collect();
+    let pts: Vec<Vec<f64>> = t.iter().map(|a| vec![a.cos(), a.sin()]).collect();
+    let refs: Vec<&[f64]> = pts.iter().map(|p| p.as_slice()).collect();
+    let (d, w) = (0.5, 0.1);
+    let p1 = partition_bound(&refs, d);
+    assert_eq!(bounds::orbit::partition_bound_local(&refs, &t, d, w, f64::INFINITY), p1);
+    let local = bounds::orbit::partition_bound_local(&refs, &t, d, w, 0.05);
+    assert!(local > p1 && local < std::f64::consts::TAU, "{local} vs (path1) {p1}");
+    // each of N steps loses at least w: the bound is at most the perimeter minus w per step,
+    // and at least it for the best N (here the chord sum of N equal steps minus N (w + D T/N))
+    let best_equal = (1..=60)
+        .map(|n| {
+            let step = std::f64::consts::TAU / n as f64;
+            n as f64 * (2.0 * (step / 2.0).sin() - (w + step * 0.05).min(d)).max(0.0)
+        })
+        .fold(0.0f64, f64::max);
+    assert!(local >= best_equal * (1.0 - 1e-3), "{local} < {best_equal}");
+    // negative control: the loss w alone (the tube frozen over a step) claims more than the
+    // bound with the tube's motion, so the motion term is not inert
+    assert!(bounds::orbit::partition_bound_local(&refs, &t, d, w, 0.0) > local);
+    // mismatched times: no bound claimed
+    assert_eq!(bounds::orbit::partition_bound_local(&refs, &t[..10], d, w, 0.05), 0.0);
+}

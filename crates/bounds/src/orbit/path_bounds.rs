@@ -38,6 +38,35 @@ pub fn partition_bound(eta: &[&[f64]], d: f64) -> f64 {
     best[K - 1]
 }
 
+/// (path1) with a loss that depends on the length of each step (beyond the paper,
+/// proofs-notes/theta-star.md): over a step of length `dt = t_j - t_i`,
+/// `z - eta_T = C dev + v` with `v = z - y` in `Theta` and `dev = x - xi_T` moving at speed
+/// `|C dev'| <= D(C(F Xi_inf + E Theta),{0}) = speed` (zinf), so
+/// `|z(t_j) - z(t_i)| >= |eta_j - eta_i| - min(d, diam(Theta) + dt speed)`.
+/// Short steps lose about `diam(Theta)` instead of `d`, so finer partitions pay.
+/// `t[k]` are the sample times of `eta[k]`; `d`, `diam_theta` and `speed` upper bounds.
+pub fn partition_bound_local(eta: &[&[f64]], t: &[f64], d: f64, diam_theta: f64, speed: f64) -> f64 {
+    let K = eta.len();
+    if K < 2 || t.len() != K {
+        return 0.0;
+    }
+    // The loss is rounded up: a relative 1e-12 covers the two roundings of `diam + dt speed`
+    // and the rounding of `dt` (times on a grid of at most a few thousand points).
+    let loss = |dt: f64| d.min((diam_theta + dt.abs() * speed) * (1.0 + 1e-12));
+    let mut best = vec![0.0f64; K];
+    for j in 1..K {
+        let mut b = 0.0f64;
+        for i in 0..j {
+            let v = best[i] + (dist(eta[j], eta[i]) - loss(t[j] - t[i])).max(0.0);
+            if v > b {
+                b = v;
+            }
+        }
+        best[j] = b;
+    }
+    best[K - 1]
+}
+
 /// Result of the (path2) search.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[non_exhaustive]

@@ -12,12 +12,15 @@
 //! then not itself an upper bound of the true `gamma_inf`, but `theta` is one of the true `theta`.
 //! `theta` is verified only if every part is.
 use crate::error::BoundsError;
-use crate::orbit::{packing_bound, partition_bound, path_bound, EtaOrbit, OrbitSettings, PackingBound};
+use crate::orbit::{
+    packing_bound, partition_bound, partition_bound_local, path_bound, EtaOrbit, OrbitSettings, PackingBound,
+};
 use crate::report::{BoundKind, Quantity};
 use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
 use crate::theta::speed_profile::SpeedProfile;
+use crate::tube::EngagedSpeed;
 use crate::tube::{tube_diameters, TubeSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
 use geometry::{ConvexSet, SphereMaxSettings};
@@ -156,7 +159,12 @@ pub struct ThetaReport {
     pub convergence_guaranteed: bool,
     /// `gamma_1* = max((path), (path1), (path2)) / (T R)` (from below; `>= gamma_1`).
     pub gamma_1_star: f64,
-    /// `gamma_1* / gamma_inf`.
+    /// Upper bound of `limsup |z'|` with the backlash side pinned (p = 1,
+    /// [`crate::tube::EngagedSpeed`]); `zdot_bound` otherwise. Never above `zdot_bound`.
+    pub zdot_star_bound: f64,
+    /// `gamma_inf* = zdot_star_bound / R` (from above; `<= gamma_inf`).
+    pub gamma_inf_star: f64,
+    /// `gamma_1* / gamma_inf*`.
     pub kappa_star: f64,
     /// `theta*`: eq. (theta) with `gamma_1*` (beyond the paper; proofs-notes/theta-star.md),
     /// minimised over the certified `(lambda, b_hat)` of the lambda search.
@@ -194,6 +202,8 @@ pub struct ThetaReport {
     pub theta_best_verified: bool,
     pub path_bound: f64,
     pub path1_bound: f64,
+    /// (path1) with the step-length-dependent loss `min(d, diam Theta + dt D)` (beyond the paper).
+    pub path1_local_bound: f64,
     /// Number of grid points of the (path1) dynamic programme.
     pub path1_grid: usize,
     pub path2: PackingBound,
@@ -245,6 +255,13 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let (d, d_lower) = (diam.d.upper, diam.d.lower);
     let (d_ftheta, d_ftheta_lower) = (diam.d_ftheta.upper, diam.d_ftheta.lower);
     let d_ok = diam.verified;
+    // (zinf) with the backlash side pinned (p = 1; beyond the paper, tube::engaged_speed).
+    let engaged_speed = if p == 1 {
+        let (lo, hi) = (-theta_set.support(&[-1.0]), theta_set.support(&[1.0]));
+        EngagedSpeed::new(&diam.tube_CF, C, E, lo, hi)
+    } else {
+        None
+    };
     let tube_C = diam.tube_C;
 
     // Orbit eta_T.
@@ -253,6 +270,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let osc_sampled = orbit.osc_sampled();
     let eta_dot_inf = orbit.eta_dot_inf;
     let zdot_bound = eta_dot_inf + d_ftheta;
+    let zdot_star = engaged_speed.map_or(zdot_bound, |es| es.zdot_bound(eta_dot_inf).min(zdot_bound));
 
     // gamma_1, gamma_inf, eqs. (g1), (ginf), at the upper bound of R.
     let strongly_convex = R.is_finite() && R > 0.0;
@@ -318,8 +336,18 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let sub: Vec<&[f64]> = idx.iter().map(|&i| orbit.eta[i].as_slice()).collect();
     let all: Vec<&[f64]> = orbit.eta.iter().map(|e| e.as_slice()).collect();
     let path_b = path_bound(osc, d);
-    let path1 = partition_bound(&sub, d).max(path_b.min(0.0));
-    let path2 = packing_bound(&all[..all.len() - 1], d, osc, settings.packing_eps);
+    // The closed-form samples lie within rel_margin * rho of the orbit (rho = osc / (2 (1 - margin))
+    // <= osc): each distance between two samples is within 2 rel_margin osc of the true one, so
+    // the partition sums use a loss d + 2 rel_margin osc (0 for exact or grid samples).
+    let d_path = d + 2.0 * orbit.rel_margin * osc * (1.0 + 1e-12);
+    let path1 = partition_bound(&sub, d_path).max(path_b.min(0.0));
+    let path2 = packing_bound(&all[..all.len() - 1], d_path, osc, settings.packing_eps);
+    // (path1) with the loss min(d, diam(Theta) + dt D(C(F Xi_inf + E Theta),{0})) per step of
+    // length dt (proofs-notes/theta-star.md): the same partitions, a smaller loss on short steps.
+    let sub_t: Vec<f64> = idx.iter().map(|&i| orbit.t[i]).collect();
+    let diam_theta = theta_set.diameter().upper;
+    let diam_path = diam_theta + 2.0 * orbit.rel_margin * osc * (1.0 + 1e-12);
+    let path_local = partition_bound_local(&sub, &sub_t, d_path, diam_path, d_ftheta).max(path1);
 
     // theta* (beyond eq. (g1)): the chord argument of eq. (theta) with gamma_1 from the
     // strongest proven path bound. Over a window of k periods the path of z is at least
@@ -327,24 +355,27 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // so the long-run mean of |z'|/R is at least S / (T R): the same chord (psiup) then gives
     // theta* (proofs-notes/theta-star.md). Each (lambda, b_hat) of the certified curve gives a
     // valid theta*; the best is kept.
-    let (path_best, path_best_method) = [(path_b, "(path)"), (path1, "(path1)"), (path2.value, "(path2)")]
-        .into_iter()
-        .fold((0.0f64, "(path)"), |a, b| if b.0 > a.0 { b } else { a });
+    let (path_best, path_best_method) =
+        [(path_b, "(path)"), (path1, "(path1)"), (path2.value, "(path2)"), (path_local, "(path1-local)")]
+            .into_iter()
+            .fold((0.0f64, "(path)"), |a, b| if b.0 > a.0 { b } else { a });
     // Rounding of the sums of distances (at most 2000 terms, each within a few ulps): a relative
     // margin far above it.
     let path_safe = path_best * (1.0 - 1e-10);
     let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
-    let kappa_star = if gamma_inf > 0.0 { down(gamma_1_star / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
+    let gamma_inf_star =
+        if strongly_convex { (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf) } else { 0.0 };
+    let kappa_star = if gamma_inf_star > 0.0 { down(gamma_1_star / gamma_inf_star).clamp(0.0, 1.0) } else { 0.0 };
     // Certified (lambda, b_hat) points for theta*: the paper's curve, plus a second lambda search
     // with theta* as its objective when gamma_1* > gamma_1 (theta*'s best lambda differs from
     // theta's); every point is a verified certificate, so the minimum over all is a bound.
     let mut star_points: Vec<(f64, f64)> = curve.iter().map(|&(l, b, _)| (l, b)).collect();
-    if strongly_convex && gamma_1_star > gamma_1 {
+    if strongly_convex && (gamma_1_star > gamma_1 || gamma_inf_star < gamma_inf) {
         match optimise_lambda(
             &F,
             E,
             C,
-            |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf),
+            |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf_star),
             &settings.lambda,
         ) {
             Ok(s2) => {
@@ -355,7 +386,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     }
     let (theta_star, lambda_star, beta_star) = star_points
         .iter()
-        .map(|&(l, b)| (Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf), l, b))
+        .map(|&(l, b)| (Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf_star), l, b))
         .fold((theta, opt.value.lambda, opt.value.beta), |a, c| if c.0 < a.0 { c } else { a });
     // The same proof obligations as theta (the path bounds use the same d and orbit samples).
     let theta_star_verified = theta_verified;
@@ -365,7 +396,14 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // certified (lambda, b_hat) of the curve for that partition.
     let cells = largest_divisor_at_most(orbit.t.len() - 1, settings.profile_cells.max(1));
     let profile = match (strongly_convex, orbit.eta_dot_cells(cells)) {
-        (true, Some((edot, nodes))) => Some(SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R)),
+        (true, Some((edot, nodes))) => {
+            let prof = SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R);
+            // p = 1: the signed speed bounds (tube::engaged_speed) lower the cells' ceilings
+            match (&engaged_speed, orbit.deta_cells_scalar(cells)) {
+                (Some(es), Some((low, high))) => Some(prof.with_signed_speed(&low, &high, es)),
+                _ => Some(prof),
+            }
+        }
         _ => None,
     };
     // (theta_profile, its certified (lambda, b_hat), partition size)
@@ -517,6 +555,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         d_ftheta,
         d_ftheta_lower,
         zdot_bound,
+        zdot_star_bound: zdot_star,
+        gamma_inf_star,
         gamma_1,
         gamma_inf,
         kappa,
@@ -547,6 +587,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         engaged_cells,
         path_bound: path_b,
         path1_bound: path1,
+        path1_local_bound: path_local,
         path1_grid: sub.len(),
         path2,
         curve,
@@ -595,9 +636,15 @@ impl ThetaReport {
             GAMMA_1_STAR
                 .with(self.gamma_1_star, orb && r_ok && self.d_verified)
                 .note(format!("{} / (T R), R upper", self.path_best_method)),
+            ZDOT_STAR.with(self.zdot_star_bound, orb && self.d_verified).note(if self.p == 1 {
+                "||eta_T'||_inf + max(ceil_up, ceil_down): backlash side pinned (p = 1)".to_string()
+            } else {
+                "= (zinf) (the side is pinned only for p = 1)".to_string()
+            }),
+            GAMMA_INF_STAR.with(self.gamma_inf_star, orb && r_ok && self.d_verified),
             THETA_STAR
                 .with(self.theta_star, self.theta_star_verified)
-                .note(format!("eq. (theta) with gamma_1*, at lambda = {:.6}", self.lambda_star)),
+                .note(format!("eq. (theta) with gamma_1*, gamma_inf*, at lambda = {:.6}", self.lambda_star)),
             THETA_PROFILE.with(self.theta_profile, self.theta_profile_verified).note(format!(
                 "time-resolved chord: {} cells, {} intervals, lambda = {:.6}",
                 self.profile_cells, self.profile_intervals, self.lambda_profile
@@ -616,6 +663,9 @@ impl ThetaReport {
             PATH1_BOUND
                 .with(self.path1_bound, orb && self.d_verified)
                 .note(format!("dynamic programming over a {}-point grid", self.path1_grid)),
+            PATH1_LOCAL_BOUND
+                .with(self.path1_local_bound, orb && self.d_verified)
+                .note(format!("loss min(d, diam Theta + dt D) per step, {}-point grid", self.path1_grid)),
             PATH2_BOUND
                 .with(self.path2.value, orb && self.d_verified)
                 .note(format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count)),

@@ -31,6 +31,7 @@
 //! chord of `psi` over `[l_c, g_c]` instead of `[0, g_c]`, and the path bound of an interval only
 //! has to be met by the speed above the floors. With every `l_c = 0` the bound is `theta_profile`.
 use crate::theta::psi::Psi;
+use crate::tube::EngagedSpeed;
 use geometry::linalg::dist;
 
 /// Time-resolved data of one period: cell speed bounds and the orbit at the cell boundaries.
@@ -49,6 +50,9 @@ pub struct SpeedProfile {
     /// `l_c`: a lower bound of `u` on cell `c` (asymptotically); all `0` unless set by
     /// [`SpeedProfile::with_floors`].
     pub floor: Vec<f64>,
+    /// `(floor_up, floor_down)` of [`EngagedSpeed`] once set by [`SpeedProfile::with_signed_speed`]:
+    /// the floors of engaged cells then use the pinned backlash side instead of `D`.
+    pub engaged_offsets: Option<(f64, f64)>,
 }
 
 impl SpeedProfile {
@@ -60,7 +64,22 @@ impl SpeedProfile {
         let cells = eta_dot_cell.len();
         assert_eq!(eta.len(), cells + 1, "one more boundary than cells");
         let g = eta_dot_cell.iter().map(|e| up((e + d_ftheta) / R)).collect();
-        Self { h: T / cells as f64, g, eta, d, R, floor: vec![0.0; cells] }
+        Self { h: T / cells as f64, g, eta, d, R, floor: vec![0.0; cells], engaged_offsets: None }
+    }
+
+    /// The profile with the signed speed bounds of [`EngagedSpeed`] (p = 1; proofs-notes/theta-star.md):
+    /// on cell `c`, `z' <= max eta_T' + ceil_up` where `z' > 0` and `-z' <= -min eta_T' + ceil_down`
+    /// where `z' < 0`, so `g_c` drops to `max(high_c + ceil_up, -low_c + ceil_down, 0) / R` where
+    /// that is lower (`deta_low[c]`, `deta_high[c]` enclose `eta_T'` on the cell). Later floors
+    /// use the engaged offsets.
+    pub fn with_signed_speed(mut self, deta_low: &[f64], deta_high: &[f64], es: &EngagedSpeed) -> Self {
+        assert!(deta_low.len() == self.cells() && deta_high.len() == self.cells(), "one enclosure per cell");
+        for c in 0..self.cells() {
+            let top = (deta_high[c] + es.ceil_up).max(-deta_low[c] + es.ceil_down).max(0.0);
+            self.g[c] = self.g[c].min(up(up(top) / self.R));
+        }
+        self.engaged_offsets = Some((es.floor_up, es.floor_down));
+        self
     }
 
     /// The profile with the speed floors of engaged cells (p = 1; module docs): `deta_low[c]`
@@ -82,6 +101,18 @@ impl SpeedProfile {
                     v - 4.0 * f64::EPSILON * (m.abs() + d_ftheta.abs())
                 })
                 .collect();
+            // speed of the engaged backlash: with the pinned side (EngagedSpeed) where known,
+            // never below the rate of y itself (z' = y' there)
+            let offset = self.engaged_offsets.map(|(up, down)| if sigma > 0.0 { up } else { down });
+            let engaged_rate: Vec<f64> = (0..K)
+                .map(|c| match offset {
+                    Some(o) => {
+                        let m = if sigma > 0.0 { deta_low[c] } else { -deta_high[c] };
+                        rate[c].max(m - o - 4.0 * f64::EPSILON * (m.abs() + o.abs()))
+                    }
+                    None => rate[c],
+                })
+                .collect();
             // Start each run after a cell with no guaranteed motion; with none the speed bound
             // never leaves the band of D around 0 from one side, impossible for a periodic orbit
             // unless rate is positive everywhere, which would make the run a full cycle: skip.
@@ -94,7 +125,7 @@ impl SpeedProfile {
                     continue;
                 }
                 if moved > width {
-                    floor[c] = floor[c].max(rate[c] / self.R * (1.0 - 1e-12));
+                    floor[c] = floor[c].max(engaged_rate[c] / self.R * (1.0 - 1e-12));
                 }
                 moved += rate[c] * self.h * (1.0 - 1e-12);
             }

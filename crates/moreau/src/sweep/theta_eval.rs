@@ -110,7 +110,7 @@ pub const DERIVED: [(&str, &str); 8] = [
 ];
 
 /// Path-length columns (report quantities, then the measured path and the ratio).
-pub const PATH_COLUMNS: [&str; 3] = ["path_bound", "path1_bound", "path2_bound"];
+pub const PATH_COLUMNS: [&str; 4] = ["path_bound", "path1_bound", "path1_local_bound", "path2_bound"];
 
 fn def(key: &str) -> &'static bounds::report::QuantityDef {
     bounds::report::defs::by_key(key).expect("sweep columns name declared quantities")
@@ -166,7 +166,7 @@ impl Evaluator for ThetaEvaluator {
             Some(m) if certified => num(r.theta_best / m.rate),
             _ => Cell::Empty,
         };
-        let best_path = r.path_bound.max(r.path1_bound).max(r.path2.value);
+        let best_path = r.path_bound.max(r.path1_bound).max(r.path1_local_bound).max(r.path2.value);
         let path_ratio = match &r.measured {
             Some(m) if m.path_length_per_period > 0.0 => num(best_path / m.path_length_per_period),
             Some(_) => num(f64::NAN),
