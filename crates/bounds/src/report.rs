@@ -140,11 +140,11 @@ pub mod defs {
     );
     pub const ZDOT_STAR: QuantityDef = q(
         "zdot_star_bound",
-        "||eta_T'|| + max(ceil+-)",
+        "limsup |z'| <= (p = 1)",
         "$\\dot z^*_{\\max}$",
         "(zinf)",
         Upper,
-        "limsup |z'| with the backlash side pinned (p = 1; beyond the paper, proofs-notes/theta-star.md)",
+        "limsup |z'| with the backlash side pinned and its engaged history (p = 1; beyond the paper, proofs-notes/theta-star.md)",
     );
     pub const GAMMA_INF_STAR: QuantityDef =
         q("gamma_inf_star", "gamma_inf*", "$\\gamma_\\infty^*$", "(ginf)", Upper, "min(zdot bounds) / R, R upper");
@@ -357,7 +357,7 @@ pub fn glossary(key: &str) -> Option<&'static str> {
         "psi_limit" => "-lambda, the limit of psi at infinite speed: no bound of this kind goes below it.",
         "theta" => "theta, the paper's bound of the exponential rate at which any two trajectories approach each other. theta < 0 and verified: a unique periodic regime attracts every trajectory at least at this rate. theta >= 0: a valid bound, no convergence guaranteed.",
         "gamma_1_star" => "gamma_1*, gamma_1 from the strongest proven path bound per period ((path1) or (path2) instead of (path)).",
-        "zdot_star_bound" => "An upper bound of the backlash speed |z'| after transients that uses which side of Theta the backlash is pushed from (p = 1: z' > 0 only with z = y + min Theta); never above (zinf), lower when C E > 0. Equal to (zinf) for p >= 2.",
+        "zdot_star_bound" => "An upper bound of the backlash speed |z'| after transients that uses which side of Theta the backlash is pushed from (p = 1: z' > 0 only with z = y + min Theta) and, where the backlash is provably engaged, for how long; never above (zinf). Equal to (zinf) for p >= 2.",
         "gamma_inf_star" => "gamma_inf*, the smaller speed bound divided by R: the chord of theta* ends there.",
         "theta_star" => "theta*, eq. (theta) with gamma_1*, gamma_inf* and the best certified (lambda, beta): a proven bound beyond the paper (proofs-notes/theta-star.md).",
         "theta_profile" => "theta_profile, the chord of theta applied cell by cell of the speed bound |eta_T'(t)| + D, with path bounds per interval: a proven bound beyond the paper, never above theta* (proofs-notes/theta-profile.md).",

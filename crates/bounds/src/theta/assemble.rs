@@ -20,8 +20,8 @@ use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
 use crate::theta::speed_profile::SpeedProfile;
-use crate::tube::EngagedSpeed;
 use crate::tube::{tube_diameters, TubeSettings};
+use crate::tube::{EngagedHistory, EngagedSpeed};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
 use geometry::{ConvexSet, SphereMaxSettings};
 use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
@@ -44,6 +44,10 @@ pub struct ThetaSettings {
     pub orbit: OrbitSettings,
     /// Grid points of the (path1) dynamic programme (`O(K^2)`). Default `600`.
     pub path1_points: usize,
+    /// p = 1: steps of the engaged-history table over half a period
+    /// ([`crate::tube::EngagedHistory`]; two finite-horizon kernels each). `0` disables it.
+    /// Default `16`.
+    pub engaged_history_steps: usize,
     /// Number of `eps` values of the (path2) packing search. Default `64`.
     pub packing_eps: usize,
     /// Cells of the time-resolved speed profile of `theta_profile` (must divide
@@ -67,6 +71,7 @@ impl Default for ThetaSettings {
             lambda: LambdaSearchSettings::default(),
             orbit: OrbitSettings::default(),
             path1_points: 600,
+            engaged_history_steps: 16,
             packing_eps: 64,
             profile_cells: 400,
             profile_stride: 4,
@@ -349,6 +354,64 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let diam_path = diam_theta + 2.0 * orbit.rel_margin * osc * (1.0 + 1e-12);
     let path_local = partition_bound_local(&sub, &sub_t, d_path, diam_path, d_ftheta).max(path1);
 
+    // Speed profile per cell (theta_profile, theta_engaged), built before theta* because its
+    // largest ceiling also bounds limsup |z'|.
+    let cells = largest_divisor_at_most(orbit.t.len() - 1, settings.profile_cells.max(1));
+    let profile = match (strongly_convex, orbit.eta_dot_cells(cells)) {
+        (true, Some((edot, nodes))) => {
+            let prof = SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R);
+            // p = 1: the signed speed bounds (tube::engaged_speed) lower the cells' ceilings
+            match (&engaged_speed, orbit.deta_cells_scalar(cells)) {
+                (Some(es), Some((low, high))) => Some(prof.with_signed_speed(&low, &high, es)),
+                _ => Some(prof),
+            }
+        }
+        _ => None,
+    };
+    // p = 1: the backlash's engaged history (tube::EngagedHistory), tabulated on
+    // tau = j T / (2 history_steps), j <= history_steps (half a period).
+    let history = match (&profile, settings.engaged_history_steps) {
+        (Some(_), steps) if p == 1 && steps > 0 => {
+            let sg = crate::tube::SemigroupData::new(&F);
+            let dtau = T / (2.0 * steps as f64);
+            match EngagedHistory::new(&diam.tube_CF, C, &F, E, &theta_set, &sg, &tube, dtau, steps) {
+                Ok(h) => h,
+                Err(e) => {
+                    notes.push(format!("engaged history not computed: {e}"));
+                    None
+                }
+            }
+        }
+        _ => None,
+    };
+    // theta_engaged (beyond the paper, p = 1): the profile with speed floors where the backlash
+    // is provably engaged (the output has moved monotonically by Theta's width), partition by
+    // dynamic programming again (the floors change which intervals matter), then the best
+    // certified (lambda, b_hat) of the curve (proofs-notes/theta-engaged.md).
+    let engaged = match (&profile, orbit.deta_cells_scalar(cells)) {
+        (Some(prof), Some((low, high))) if p == 1 => {
+            let width = (theta_set.support(&[1.0]) + theta_set.support(&[-1.0])) * (1.0 + 1e-12);
+            let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
+            // the engaged history narrows the band of z' - eta_T' on engaged cells
+            // (tube::EngagedHistory; proofs-notes/theta-engaged.md)
+            let prof = match &history {
+                Some(h) => prof.with_history(&low, &high, h, -theta_set.support(&[-1.0]), theta_set.support(&[1.0])),
+                None => prof,
+            };
+            (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
+        }
+        _ => None,
+    };
+    // theta_profile uses the engaged profile's ceilings (valid at every time of their cells)
+    // without its floors.
+    let profile = match &engaged {
+        Some(e) => {
+            let mut prof = e.clone();
+            prof.floor.iter_mut().for_each(|f| *f = 0.0);
+            Some(prof)
+        }
+        None => profile,
+    };
     // theta* (beyond eq. (g1)): the chord argument of eq. (theta) with gamma_1 from the
     // strongest proven path bound. Over a window of k periods the path of z is at least
     // k S - (one wrap-around term), S any cyclic partition sum (path1) or packing sum (path2),
@@ -363,8 +426,17 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // margin far above it.
     let path_safe = path_best * (1.0 - 1e-10);
     let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
-    let gamma_inf_star =
-        if strongly_convex { (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf) } else { 0.0 };
+    // gamma_inf*: the pinned speed bound, or the profile's largest cell ceiling if lower
+    let zdot_star = match &profile {
+        Some(prof) if strongly_convex => zdot_star.min((prof.max_speed() * R * (1.0 + 4.0 * f64::EPSILON)).next_up()),
+        _ => zdot_star,
+    };
+    let gamma_inf_star = if strongly_convex {
+        let from_profile = profile.as_ref().map_or(f64::INFINITY, |p| p.max_speed());
+        (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf).min(from_profile)
+    } else {
+        0.0
+    };
     let kappa_star = if gamma_inf_star > 0.0 { down(gamma_1_star / gamma_inf_star).clamp(0.0, 1.0) } else { 0.0 };
     // Certified (lambda, b_hat) points for theta*: the paper's curve, plus a second lambda search
     // with theta* as its objective when gamma_1* > gamma_1 (theta*'s best lambda differs from
@@ -391,21 +463,6 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // The same proof obligations as theta (the path bounds use the same d and orbit samples).
     let theta_star_verified = theta_verified;
 
-    // theta_profile (beyond the paper): pointwise speed bounds per cell and path bounds per
-    // interval of a partition chosen by dynamic programming at (lambda*, b_hat*), then the best
-    // certified (lambda, b_hat) of the curve for that partition.
-    let cells = largest_divisor_at_most(orbit.t.len() - 1, settings.profile_cells.max(1));
-    let profile = match (strongly_convex, orbit.eta_dot_cells(cells)) {
-        (true, Some((edot, nodes))) => {
-            let prof = SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R);
-            // p = 1: the signed speed bounds (tube::engaged_speed) lower the cells' ceilings
-            match (&engaged_speed, orbit.deta_cells_scalar(cells)) {
-                (Some(es), Some((low, high))) => Some(prof.with_signed_speed(&low, &high, es)),
-                _ => Some(prof),
-            }
-        }
-        _ => None,
-    };
     // (theta_profile, its certified (lambda, b_hat), partition size)
     let (theta_profile, (lambda_profile, beta_profile), profile_intervals) = match &profile {
         Some(prof) => {
@@ -418,18 +475,6 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     };
     let theta_profile_verified = theta_verified && profile.is_some();
 
-    // theta_engaged (beyond the paper, p = 1): the profile with speed floors where the backlash
-    // is provably engaged (the output has moved monotonically by Theta's width), partition by
-    // dynamic programming again (the floors change which intervals matter), then the best
-    // certified (lambda, b_hat) of the curve (proofs-notes/theta-engaged.md).
-    let engaged = match (&profile, orbit.deta_cells_scalar(cells)) {
-        (Some(prof), Some((low, high))) if p == 1 => {
-            let width = (theta_set.support(&[1.0]) + theta_set.support(&[-1.0])) * (1.0 + 1e-12);
-            let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
-            (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
-        }
-        _ => None,
-    };
     let (theta_engaged, lambda_engaged, engaged_cells) = match &engaged {
         Some(prof) => {
             let nodes = prof.best_partition(
@@ -637,7 +682,7 @@ impl ThetaReport {
                 .with(self.gamma_1_star, orb && r_ok && self.d_verified)
                 .note(format!("{} / (T R), R upper", self.path_best_method)),
             ZDOT_STAR.with(self.zdot_star_bound, orb && self.d_verified).note(if self.p == 1 {
-                "||eta_T'||_inf + max(ceil_up, ceil_down): backlash side pinned (p = 1)".to_string()
+                "backlash side pinned; largest cell ceiling with the engaged history".to_string()
             } else {
                 "= (zinf) (the side is pinned only for p = 1)".to_string()
             }),

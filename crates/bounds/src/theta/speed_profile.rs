@@ -31,7 +31,7 @@
 //! chord of `psi` over `[l_c, g_c]` instead of `[0, g_c]`, and the path bound of an interval only
 //! has to be met by the speed above the floors. With every `l_c = 0` the bound is `theta_profile`.
 use crate::theta::psi::Psi;
-use crate::tube::EngagedSpeed;
+use crate::tube::{EngagedHistory, EngagedSpeed};
 use geometry::linalg::dist;
 
 /// Time-resolved data of one period: cell speed bounds and the orbit at the cell boundaries.
@@ -53,6 +53,10 @@ pub struct SpeedProfile {
     /// `(floor_up, floor_down)` of [`EngagedSpeed`] once set by [`SpeedProfile::with_signed_speed`]:
     /// the floors of engaged cells then use the pinned backlash side instead of `D`.
     pub engaged_offsets: Option<(f64, f64)>,
+    /// For each cell with a floor: the sign `sigma` of the motion and the number of cells of the
+    /// same run that were engaged before it (the backlash is engaged for at least that many
+    /// cell lengths at the start of the cell). Set by [`SpeedProfile::with_floors`].
+    pub engaged_age: Vec<Option<(f64, usize)>>,
 }
 
 impl SpeedProfile {
@@ -64,7 +68,16 @@ impl SpeedProfile {
         let cells = eta_dot_cell.len();
         assert_eq!(eta.len(), cells + 1, "one more boundary than cells");
         let g = eta_dot_cell.iter().map(|e| up((e + d_ftheta) / R)).collect();
-        Self { h: T / cells as f64, g, eta, d, R, floor: vec![0.0; cells], engaged_offsets: None }
+        Self {
+            h: T / cells as f64,
+            g,
+            eta,
+            d,
+            R,
+            floor: vec![0.0; cells],
+            engaged_offsets: None,
+            engaged_age: vec![None; cells],
+        }
     }
 
     /// The profile with the signed speed bounds of [`EngagedSpeed`] (p = 1; proofs-notes/theta-star.md):
@@ -92,6 +105,7 @@ impl SpeedProfile {
         let K = self.cells();
         assert!(deta_low.len() == K && deta_high.len() == K, "one enclosure per cell");
         let mut floor = vec![0.0f64; K];
+        let mut age: Vec<Option<(f64, usize)>> = vec![None; K];
         for sigma in [1.0f64, -1.0] {
             // guaranteed rate of sigma y on each cell (rounded down), positive or not
             let rate: Vec<f64> = (0..K)
@@ -118,14 +132,18 @@ impl SpeedProfile {
             // unless rate is positive everywhere, which would make the run a full cycle: skip.
             let Some(start) = (0..K).find(|&c| rate[c] <= 0.0) else { continue };
             let mut moved = 0.0f64;
+            let mut engaged_before = 0usize;
             for k in 1..=K {
                 let c = (start + k) % K;
                 if rate[c] <= 0.0 {
                     moved = 0.0;
+                    engaged_before = 0;
                     continue;
                 }
                 if moved > width {
                     floor[c] = floor[c].max(engaged_rate[c] / self.R * (1.0 - 1e-12));
+                    age[c] = Some((sigma, engaged_before));
+                    engaged_before += 1;
                 }
                 moved += rate[c] * self.h * (1.0 - 1e-12);
             }
@@ -135,7 +153,43 @@ impl SpeedProfile {
             *f = f.min(*g);
         }
         self.floor = floor;
+        self.engaged_age = age;
         self
+    }
+
+    /// The engaged cells' bounds from the backlash's engaged history ([`EngagedHistory`], p = 1;
+    /// proofs-notes/theta-engaged.md, "Engaged history"): on a cell engaged (sign `sigma`) for at
+    /// least `age h`, `z' - eta_T'` lies in `hist.band(age h, w)` with `w = lo` (rising) or `hi`
+    /// (falling), so `sigma z'` lies in `[m_lo + a, m_hi + b]` mirrored for `sigma = -1`. Raises
+    /// floors and lowers ceilings where that is sharper; the floors stay below the ceilings.
+    /// Call after [`SpeedProfile::with_floors`].
+    pub fn with_history(
+        mut self,
+        deta_low: &[f64],
+        deta_high: &[f64],
+        hist: &EngagedHistory,
+        lo: f64,
+        hi: f64,
+    ) -> Self {
+        let K = self.cells();
+        assert!(deta_low.len() == K && deta_high.len() == K, "one enclosure per cell");
+        for c in 0..K {
+            let Some((sigma, age)) = self.engaged_age[c] else { continue };
+            let tau = age as f64 * self.h * (1.0 - 1e-12);
+            let (a, b) = hist.band(tau, if sigma > 0.0 { lo } else { hi });
+            // z' in [deta_low + a, deta_high + b]; |z'| = sigma z' (> 0 on an engaged cell)
+            let (zl, zh) = (deta_low[c] + a, deta_high[c] + b);
+            let (sl, sh) = if sigma > 0.0 { (zl, zh) } else { (-zh, -zl) };
+            let (sl, sh) = (sl - 4.0 * f64::EPSILON * sl.abs(), sh + 4.0 * f64::EPSILON * sh.abs());
+            self.g[c] = self.g[c].min(up(sh.max(0.0) / self.R));
+            self.floor[c] = self.floor[c].max(sl / self.R * (1.0 - 1e-12)).min(self.g[c]);
+        }
+        self
+    }
+
+    /// `max_c g_c`: an upper bound of `limsup |z'| / R` (every time lies in some cell).
+    pub fn max_speed(&self) -> f64 {
+        self.g.iter().copied().fold(0.0, f64::max)
     }
 
     /// Number of cells with a positive floor.

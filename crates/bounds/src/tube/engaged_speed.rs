@@ -16,7 +16,11 @@
 //! with `s(+-1) = sigma_{C F Xi_inf}(+-1)`. The ceilings are never above `D` (which takes the worst
 //! `v` in `Theta` for either sign); they are lower by `CE (hi - lo)` when `CE > 0`. The floors
 //! hold only while the backlash is engaged (`theta_engaged` decides where).
-use crate::tube::TubeKernel;
+use crate::error::BoundsError;
+use crate::tube::{Horizon, SemigroupData, TubeKernel, TubeSettings};
+use dynamics::linear::expm::frobenius_up;
+use geometry::{ConvexSet, Shape};
+use nalgebra::DMatrix;
 
 /// Offsets of the signed speed of `z` for `p = 1` (module docs), each an upper bound.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,6 +72,129 @@ impl EngagedSpeed {
     }
 }
 
+/// Upper bound of `||C F_exact - fl(C F)||_F` for the computed `F` with `||F_exact - F||_2 <=
+/// f_radius` (the product's rounding `gamma_n ||C|| ||F||` and `||C|| f_radius`).
+pub fn cf_error(C: &DMatrix<f64>, F: &DMatrix<f64>, f_radius: f64) -> f64 {
+    let n = F.nrows() as f64;
+    let g = n * f64::EPSILON / (1.0 - n * f64::EPSILON);
+    up(frobenius_up(C) * (f_radius + g * frobenius_up(F)) * (1.0 + 1e-10))
+}
+
+/// The engaged history of the backlash for `p = 1` (beyond the paper; proofs-notes/theta-engaged.md,
+/// "Engaged history"). With `k(u) = C F e^{uF} E` and `dev(t) = int_0^inf e^{uF} E v(t - u) du`
+/// (asymptotically), if the backlash has been engaged from one side for the last `tau`
+/// (`v = w`, `w = lo` when rising, `hi` when falling), then
+///
+/// ```text
+/// z' - eta_T' = C F dev + C E w = w (CE + I(tau)) + int_tau^inf k(u) v(t - u) du,
+/// I(tau) = int_0^tau k,   int_tau^inf k v in [-S_-(tau), S_+(tau)],
+/// S_+-(tau) = int_tau^inf sigma_Theta(+-k) = sigma_{C F Xi_inf}(+-1) - int_0^tau sigma_Theta(+-k)
+/// ```
+///
+/// so the band of `z' - eta_T'` narrows from the width of `C F Xi_inf` at `tau = 0` to 0 as the
+/// history lengthens. Tabulated at `tau_j = j dtau`; the integrals over `[0, tau_j]` come from
+/// finite-horizon [`TubeKernel`]s (lower values: proven here because `sigma_Theta` of an
+/// interval, or of the point `{1}` for `I`, is one multiplication, within the kernel's
+/// allowance), those over `[0, inf)` from the caller's `sigma_{C F Xi_inf}` kernel (upper
+/// values), each widened by the effect of `||C F_exact - fl(C F)||` ([`cf_error`]).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct EngagedHistory {
+    /// Grid step of `tau`.
+    pub dtau: f64,
+    /// Enclosure of `CE + I(tau_j)` (`= C e^{tau_j F} E`).
+    pub known_lo: Vec<f64>,
+    pub known_hi: Vec<f64>,
+    /// Upper bounds of `S_+(tau_j)` and `S_-(tau_j)`.
+    pub tail_up: Vec<f64>,
+    pub tail_down: Vec<f64>,
+}
+
+impl EngagedHistory {
+    /// Tabulates `tau_j = j dtau`, `j = 0..=steps`. `tube_CF` is the kernel of
+    /// `sigma_{C F Xi_inf}` built with `tube` (whose `f_radius` covers `F`), `sg` the semigroup
+    /// data of `F`, `theta` an interval containing 0. `None` when `p != 1`, `theta` is not an
+    /// interval or a bound is not finite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        tube_CF: &TubeKernel,
+        C: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        sg: &SemigroupData,
+        tube: &TubeSettings,
+        dtau: f64,
+        steps: usize,
+    ) -> Result<Option<Self>, BoundsError> {
+        let Shape::Interval(iv) = theta else { return Ok(None) };
+        if C.nrows() != 1 || E.ncols() != 1 || !(iv.lo <= 0.0 && 0.0 <= iv.hi) || !(dtau > 0.0 && dtau.is_finite()) {
+            return Ok(None);
+        }
+        let Some(exp_norm) = sg.exp_norm() else { return Ok(None) };
+        let n = C.ncols();
+        // CE with its rounding error
+        let ce = (0..n).map(|i| C[(0, i)] * E[(i, 0)]).sum::<f64>();
+        let ce_err = 2.0 * (n as f64 + 1.0) * f64::EPSILON * (0..n).map(|i| (C[(0, i)] * E[(i, 0)]).abs()).sum::<f64>();
+        // the kernels use L = fl(C F): its error times int ||e^{s F_exact}|| ||E|| (times
+        // D(Theta, {0}) for the support integrals, 1 for I)
+        let eps = tube.f_radius;
+        let i_inf = exp_norm.integral;
+        let i_exact = if eps * i_inf < 0.5 { i_inf + eps * i_inf * i_inf / (1.0 - eps * i_inf) } else { f64::INFINITY };
+        let l_err = cf_error(C, F, eps) * frobenius_up(E) * i_exact;
+        let d_theta = theta.deviation_from_origin().upper;
+        let CF = C * F;
+        let unit = Shape::Interval(geometry::Interval { lo: 1.0, hi: 1.0 });
+        let (s_up, s_down) = (tube_CF.support_upper(&[1.0]), tube_CF.support_upper(&[-1.0]));
+        let mut out = Self {
+            dtau,
+            known_lo: vec![down(ce - ce_err)],
+            known_hi: vec![up(ce + ce_err)],
+            tail_up: vec![up(s_up + d_theta * l_err)],
+            tail_down: vec![up(s_down + d_theta * l_err)],
+        };
+        for j in 1..=steps {
+            let tau = j as f64 * dtau;
+            let h = Horizon::Finite(tau);
+            let kt = TubeKernel::with_shared(&CF, F, E, theta, d_theta, sg, h, tube)?;
+            let ki = TubeKernel::with_shared(&CF, F, E, &unit, 1.0, sg, h, tube)?;
+            let (a_up, a_down) = (kt.support_bounds(&[1.0]).lower, kt.support_bounds(&[-1.0]).lower);
+            let int = ki.support_bounds(&[1.0]);
+            out.tail_up.push(up(s_up - a_up + 2.0 * d_theta * l_err).max(0.0));
+            out.tail_down.push(up(s_down - a_down + 2.0 * d_theta * l_err).max(0.0));
+            out.known_lo.push(down(ce - ce_err + int.lower - l_err));
+            out.known_hi.push(up(ce + ce_err + int.upper + l_err));
+        }
+        let finite = [&out.known_lo, &out.known_hi, &out.tail_up, &out.tail_down]
+            .iter()
+            .all(|v| v.iter().all(|x| x.is_finite()));
+        Ok(finite.then_some(out))
+    }
+
+    /// Enclosure `[a, b]` of `z' - eta_T'` at a time when the backlash has been engaged from the
+    /// side `w` (`lo` while rising, `hi` while falling) for at least `tau` (module docs).
+    pub fn band(&self, tau: f64, w: f64) -> (f64, f64) {
+        let last = self.tail_up.len() - 1;
+        // the largest tau_j <= tau (a shorter history is still a valid one)
+        let j = ((tau / self.dtau) * (1.0 - 1e-9)).floor().clamp(0.0, last as f64) as usize;
+        let (k_lo, k_hi) = if w >= 0.0 {
+            (w * self.known_lo[j], w * self.known_hi[j])
+        } else {
+            (w * self.known_hi[j], w * self.known_lo[j])
+        };
+        (down(k_lo - self.tail_down[j]), up(k_hi + self.tail_up[j]))
+    }
+}
+
+/// Rounds down by a relative `4u` and an absolute `MIN_POSITIVE`.
+fn down(x: f64) -> f64 {
+    if x.is_finite() {
+        x - 4.0 * f64::EPSILON * x.abs() - f64::MIN_POSITIVE
+    } else {
+        x
+    }
+}
+
 /// Rounds up by a relative `4u` and an absolute `MIN_POSITIVE` (one sum of a few terms).
 fn up(x: f64) -> f64 {
     if x.is_finite() {
@@ -80,7 +207,7 @@ fn up(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tube::{Horizon, TubeSettings};
+    use crate::tube::{Horizon, SemigroupData, TubeSettings};
     use geometry::{ConvexSet, Interval, Shape};
     use nalgebra::DMatrix;
 
@@ -114,6 +241,84 @@ mod tests {
             // negative control: the floors are not ceilings (floor_up allows z' below eta' - s(-1))
             assert!(s.floor_up >= sd - ce * (-0.1) - 1e-12);
         }
+    }
+
+    /// The band of `z' - eta_T'` after an engaged history of length `tau`, against direct
+    /// quadrature of `C F dev + C E lo` for random histories `v(t - u)` in Theta that equal `lo`
+    /// on `u < tau`: every value inside; the band narrows with tau. Negative control: the band
+    /// without its tail terms (history older than tau ignored) misses some history.
+    #[test]
+    fn history_band_contains_random_histories() {
+        let F = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.6]);
+        let C = DMatrix::from_row_slice(1, 2, &[1.0, 0.3]);
+        let E = DMatrix::from_row_slice(2, 1, &[0.2, 1.0]);
+        let (lo, hi) = (-0.1, 0.2);
+        let theta = Shape::Interval(Interval::new(lo, hi).unwrap());
+        let st = TubeSettings::default();
+        let k = kernel(&C, &F, &E, &theta);
+        let sg = SemigroupData::new(&F);
+        let hist = EngagedHistory::new(&k, &C, &F, &E, &theta, &sg, &st, 0.5, 8).unwrap().unwrap();
+        // tails shrink with the history's length
+        for j in 1..hist.tail_up.len() {
+            assert!(hist.tail_up[j] + hist.tail_down[j] <= hist.tail_up[j - 1] + hist.tail_down[j - 1] + 1e-9);
+        }
+        // direct quadrature of int_0^U k(u) v(u) du + CE lo, k(u) = C F e^{uF} E (U = 60, |e^{60F}| ~ 1e-8)
+        let du = 1e-3;
+        let steps = 60_000usize;
+        let step = (F.clone() * du).exp();
+        let CF = &C * &F;
+        let mut P = DMatrix::<f64>::identity(2, 2);
+        let mut kv = Vec::with_capacity(steps);
+        for _ in 0..steps {
+            kv.push((&CF * &P * &E)[(0, 0)]);
+            P = &P * &step;
+        }
+        let ce = (&C * &E)[(0, 0)];
+        let mut rng = 12345u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut missed_without_tail = 0;
+        for &tau in &[0.0, 1.0, 2.0, 3.7] {
+            let (a, b) = hist.band(tau, lo);
+            let j = ((tau / hist.dtau) * (1.0 - 1e-9)).floor() as usize;
+            let (ka, kb) = (lo * hist.known_hi[j.min(8)], lo * hist.known_lo[j.min(8)]);
+            for trial in 0..200 {
+                // v = lo on [0, tau); before: blocks of random length at random levels or at the ends
+                let mut v = vec![lo; steps];
+                let mut u = (tau / du).ceil() as usize;
+                while u < steps {
+                    let len = 1 + (next() * 3000.0) as usize;
+                    let level = match trial % 3 {
+                        0 => lo + (hi - lo) * next(),
+                        _ => {
+                            if next() < 0.5 {
+                                lo
+                            } else {
+                                hi
+                            }
+                        }
+                    };
+                    for x in v.iter_mut().skip(u).take(len) {
+                        *x = level;
+                    }
+                    u += len;
+                }
+                let val: f64 = kv.iter().zip(&v).map(|(k, v)| k * v).sum::<f64>() * du + ce * lo;
+                assert!(val >= a - 1e-3 && val <= b + 1e-3, "tau {tau}: {val} outside [{a}, {b}]");
+                if val < ka - 1e-3 || val > kb + 1e-3 {
+                    missed_without_tail += 1;
+                }
+            }
+        }
+        assert!(missed_without_tail > 0, "negative control: the band without tails was never violated");
+        // tau = 0 is the pinned bound of EngagedSpeed (same terms)
+        let es = EngagedSpeed::new(&k, &C, &E, lo, hi).unwrap();
+        let (a0, b0) = hist.band(0.0, lo);
+        assert!((b0 - es.ceil_up).abs() < 1e-9 && (a0 + es.floor_up).abs() < 1e-9, "{a0} {b0} {es:?}");
     }
 
     #[test]

@@ -10,6 +10,6 @@ pub mod localisation;
 pub mod xi_support;
 
 pub use diameters::{tube_diameters, tube_diameters_with, OutputTube, TubeDiameters};
-pub use engaged_speed::EngagedSpeed;
+pub use engaged_speed::{EngagedHistory, EngagedSpeed};
 pub use geometry::sublinear_sphere_max;
 pub use xi_support::{dxx_bound, exp_norm_integral, Horizon, SemigroupData, TubeKernel, TubeSettings};

@@ -445,6 +445,14 @@ pub struct SemigroupData {
     steps: std::sync::Mutex<Vec<(u64, DMatrix<f64>, f64)>>,
 }
 
+impl SemigroupData {
+    /// The proven semigroup bounds of `F` (`sup ||e^{sF}||`, `int_0^inf ||e^{sF}||`), when `F`
+    /// is Hurwitz and they were proven.
+    pub fn exp_norm(&self) -> Option<ExpNormBounds> {
+        self.bounds.as_ref().ok().cloned()
+    }
+}
+
 /// Most memoised steps per [`SemigroupData`].
 const STEP_MEMO: usize = 64;
 

@@ -104,7 +104,7 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
     s.push_str(&format!("\nVerdict: {verdict}\n"));
     if let Some(m) = &rep.measured {
         s.push_str(&format!(
-            "Reality: measured exponent {} (95% CI [{}, {}]); path length/period {} vs bounds (path) {}, (path1) {}, (path2) {}; limsup |z'| {} vs (zinf) {}.\n",
+            "Reality: measured exponent {} (95% CI [{}, {}]); path length/period {} vs bounds (path) {}, (path1) {}, (path2) {}; limsup |z'| {} vs (zinf) {}, pinned {}.\n",
             fmt_value(m.rate),
             fmt_value(m.ci_low),
             fmt_value(m.ci_high),
@@ -113,7 +113,8 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
             fmt_value(rep.path1_bound),
             fmt_value(rep.path2.value),
             fmt_value(m.limsup_zdot),
-            fmt_value(rep.zdot_bound)
+            fmt_value(rep.zdot_bound),
+            fmt_value(rep.zdot_star_bound)
         ));
     }
     for n in &rep.notes {
