@@ -263,7 +263,16 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // (zinf) with the backlash side pinned (p = 1; beyond the paper, tube::engaged_speed).
     let engaged_speed = if p == 1 {
         let (lo, hi) = (-theta_set.support(&[-1.0]), theta_set.support(&[1.0]));
-        EngagedSpeed::new(&diam.tube_CF, C, E, lo, hi)
+        let sg = crate::tube::SemigroupData::new(&F);
+        let l_err = crate::tube::engaged_speed::cf_support_error(
+            C,
+            &F,
+            E,
+            tube.f_radius,
+            &sg,
+            theta_set.deviation_from_origin().upper,
+        );
+        EngagedSpeed::new(&diam.tube_CF, C, E, lo, hi, l_err)
     } else {
         None
     };

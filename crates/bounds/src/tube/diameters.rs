@@ -96,6 +96,11 @@ pub fn tube_diameters_with(
         lip_f,
         sphere,
     );
+    // the kernel's L = fl(C F) against C F_exact (tube::engaged_speed::cf_support_error)
+    let df_b = geometry::Bounds {
+        lower: df_b.lower,
+        upper: df_b.upper + crate::tube::engaged_speed::cf_support_error(C, F, E, tube.f_radius, sg, d_theta),
+    };
     let df_lower = df_b.lower - tube_CF.remainder_bound() - tube_CF.tail_bound();
     // The upper values are proofs when every enclosure they were built from is finite and the
     // sampled maxima lie below them (a sampled value above the bound would expose a broken

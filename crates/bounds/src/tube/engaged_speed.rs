@@ -38,14 +38,9 @@ pub struct EngagedSpeed {
 
 impl EngagedSpeed {
     /// `tube_CF`: the kernel of `sigma_{C F Xi_inf}` (as for `D`), `C` (1 x n), `E` (n x 1) and
-    /// `Theta = [lo, hi]`. `None` unless `p = 1` and every value is finite.
-    pub fn new(
-        tube_CF: &TubeKernel,
-        C: &nalgebra::DMatrix<f64>,
-        E: &nalgebra::DMatrix<f64>,
-        lo: f64,
-        hi: f64,
-    ) -> Option<Self> {
+    /// `Theta = [lo, hi]`; `l_err`: [`cf_support_error`] for the kernel's `L = fl(C F)` (`0`
+    /// when `L` is exact). `None` unless `p = 1` and every value is finite.
+    pub fn new(tube_CF: &TubeKernel, C: &DMatrix<f64>, E: &DMatrix<f64>, lo: f64, hi: f64, l_err: f64) -> Option<Self> {
         if C.nrows() != 1 || E.ncols() != 1 || C.ncols() != E.nrows() || !(lo <= 0.0 && 0.0 <= hi) {
             return None;
         }
@@ -53,8 +48,8 @@ impl EngagedSpeed {
         // CE = sum C_i E_i with its rounding error (at most n u sum |C_i E_i| / (1 - n u)).
         let ce = (0..n).map(|i| C[(0, i)] * E[(i, 0)]).sum::<f64>();
         let ce_err = 2.0 * (n as f64 + 1.0) * f64::EPSILON * (0..n).map(|i| (C[(0, i)] * E[(i, 0)]).abs()).sum::<f64>();
-        let s_up = tube_CF.support_upper(&[1.0]);
-        let s_down = tube_CF.support_upper(&[-1.0]);
+        let s_up = tube_CF.support_upper(&[1.0]) + l_err;
+        let s_down = tube_CF.support_upper(&[-1.0]) + l_err;
         // a + ce m, rounded up: the product's own rounding and ce's error times |m|.
         let add = |a: f64, m: f64| up(a + ce * m + ce_err * m.abs() + 2.0 * f64::EPSILON * ((ce * m).abs() + a.abs()));
         let out = Self {
@@ -78,6 +73,24 @@ pub fn cf_error(C: &DMatrix<f64>, F: &DMatrix<f64>, f_radius: f64) -> f64 {
     let n = F.nrows() as f64;
     let g = n * f64::EPSILON / (1.0 - n * f64::EPSILON);
     up(frobenius_up(C) * (f_radius + g * frobenius_up(F)) * (1.0 + 1e-10))
+}
+
+/// Upper bound of the effect of `L = fl(C F)` (instead of `C F_exact`) on a support integral
+/// `int_0^inf sigma_Theta((L e^{sF_exact} E)^T v) ds`, `|v| = 1`: `D(Theta, {0}) ||dL|| ||E||
+/// int ||e^{s F_exact}||`, with `int ||e^{s F_exact}|| <= I + eps I^2 / (1 - eps I)` (`I` the
+/// proven integral for `F`, `eps = f_radius`). Infinite when `F` has no proven semigroup bound.
+pub fn cf_support_error(
+    C: &DMatrix<f64>,
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    f_radius: f64,
+    sg: &SemigroupData,
+    d_theta: f64,
+) -> f64 {
+    let Some(b) = sg.exp_norm() else { return f64::INFINITY };
+    let i = b.integral;
+    let i_exact = if f_radius * i < 0.5 { i + f_radius * i * i / (1.0 - f_radius * i) } else { f64::INFINITY };
+    up(d_theta * cf_error(C, F, f_radius) * frobenius_up(E) * i_exact * (1.0 + 1e-10))
 }
 
 /// The engaged history of the backlash for `p = 1` (beyond the paper; proofs-notes/theta-engaged.md,
@@ -131,17 +144,16 @@ impl EngagedHistory {
         if C.nrows() != 1 || E.ncols() != 1 || !(iv.lo <= 0.0 && 0.0 <= iv.hi) || !(dtau > 0.0 && dtau.is_finite()) {
             return Ok(None);
         }
-        let Some(exp_norm) = sg.exp_norm() else { return Ok(None) };
+        if sg.exp_norm().is_none() {
+            return Ok(None);
+        }
         let n = C.ncols();
         // CE with its rounding error
         let ce = (0..n).map(|i| C[(0, i)] * E[(i, 0)]).sum::<f64>();
         let ce_err = 2.0 * (n as f64 + 1.0) * f64::EPSILON * (0..n).map(|i| (C[(0, i)] * E[(i, 0)]).abs()).sum::<f64>();
         // the kernels use L = fl(C F): its error times int ||e^{s F_exact}|| ||E|| (times
         // D(Theta, {0}) for the support integrals, 1 for I)
-        let eps = tube.f_radius;
-        let i_inf = exp_norm.integral;
-        let i_exact = if eps * i_inf < 0.5 { i_inf + eps * i_inf * i_inf / (1.0 - eps * i_inf) } else { f64::INFINITY };
-        let l_err = cf_error(C, F, eps) * frobenius_up(E) * i_exact;
+        let l_err = cf_support_error(C, F, E, tube.f_radius, sg, 1.0);
         let d_theta = theta.deviation_from_origin().upper;
         let CF = C * F;
         let unit = Shape::Interval(geometry::Interval { lo: 1.0, hi: 1.0 });
@@ -227,7 +239,7 @@ mod tests {
             (DMatrix::from_row_slice(1, 2, &[1.0, -0.5]), DMatrix::from_row_slice(2, 1, &[0.0, 1.0]), -0.5),
         ] {
             let k = kernel(&C, &F, &E, &theta);
-            let s = EngagedSpeed::new(&k, &C, &E, -0.1, 0.2).unwrap();
+            let s = EngagedSpeed::new(&k, &C, &E, -0.1, 0.2, 0.0).unwrap();
             let (su, sd) = (k.support_upper(&[1.0]), k.support_upper(&[-1.0]));
             // D's two terms: s(u) + sigma_Theta(CE u)
             let d = (su + theta.support(&[ce])).max(sd + theta.support(&[-ce]));
@@ -316,7 +328,7 @@ mod tests {
         }
         assert!(missed_without_tail > 0, "negative control: the band without tails was never violated");
         // tau = 0 is the pinned bound of EngagedSpeed (same terms)
-        let es = EngagedSpeed::new(&k, &C, &E, lo, hi).unwrap();
+        let es = EngagedSpeed::new(&k, &C, &E, lo, hi, cf_support_error(&C, &F, &E, 0.0, &sg, 0.2)).unwrap();
         let (a0, b0) = hist.band(0.0, lo);
         assert!((b0 - es.ceil_up).abs() < 1e-9 && (a0 + es.floor_up).abs() < 1e-9, "{a0} {b0} {es:?}");
     }
@@ -330,8 +342,8 @@ mod tests {
         let C1 = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
         let E1 = DMatrix::from_row_slice(2, 1, &[1.0, 0.0]);
         let k = kernel(&C1, &F, &E1, &theta);
-        assert!(EngagedSpeed::new(&k, &C, &E, -0.1, 0.2).is_none());
-        assert!(EngagedSpeed::new(&k, &C1, &E1, 0.1, 0.2).is_none(), "0 not in Theta");
-        assert!(EngagedSpeed::new(&k, &C1, &E1, -0.1, 0.2).is_some());
+        assert!(EngagedSpeed::new(&k, &C, &E, -0.1, 0.2, 0.0).is_none());
+        assert!(EngagedSpeed::new(&k, &C1, &E1, 0.1, 0.2, 0.0).is_none(), "0 not in Theta");
+        assert!(EngagedSpeed::new(&k, &C1, &E1, -0.1, 0.2, 0.0).is_some());
     }
 }
