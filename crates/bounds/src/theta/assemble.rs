@@ -377,22 +377,6 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         }
         _ => None,
     };
-    // p = 1: the backlash's engaged history (tube::EngagedHistory), tabulated on
-    // tau = j T / (2 history_steps), j <= history_steps (half a period).
-    let history = match (&profile, settings.engaged_history_steps) {
-        (Some(_), steps) if p == 1 && steps > 0 => {
-            let sg = crate::tube::SemigroupData::new(&F);
-            let dtau = T / (2.0 * steps as f64);
-            match EngagedHistory::new(&diam.tube_CF, C, &F, E, &theta_set, &sg, &tube, dtau, steps) {
-                Ok(h) => h,
-                Err(e) => {
-                    notes.push(format!("engaged history not computed: {e}"));
-                    None
-                }
-            }
-        }
-        _ => None,
-    };
     // theta_engaged (beyond the paper, p = 1): the profile with speed floors where the backlash
     // is provably engaged (the output has moved monotonically by Theta's width), partition by
     // dynamic programming again (the floors change which intervals matter), then the best
@@ -402,7 +386,21 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             let width = (theta_set.support(&[1.0]) + theta_set.support(&[-1.0])) * (1.0 + 1e-12);
             let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
             // the engaged history narrows the band of z' - eta_T' on engaged cells
-            // (tube::EngagedHistory; proofs-notes/theta-engaged.md)
+            // (tube::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
+            // tau_j = j T / (2 history_steps) up to the longest engaged history of the profile
+            let oldest = prof.engaged_age.iter().flatten().map(|&(_, a)| a).max().unwrap_or(0) as f64 * prof.h;
+            let steps = settings.engaged_history_steps;
+            let dtau = T / (2.0 * steps.max(1) as f64);
+            let needed = ((oldest / dtau).floor() as usize).min(steps);
+            let history = if steps > 0 && needed > 0 {
+                let sg = crate::tube::SemigroupData::new(&F);
+                EngagedHistory::new(&diam.tube_CF, C, &F, E, &theta_set, &sg, &tube, dtau, needed).unwrap_or_else(|e| {
+                    notes.push(format!("engaged history not computed: {e}"));
+                    None
+                })
+            } else {
+                None
+            };
             let prof = match &history {
                 Some(h) => prof.with_history(&low, &high, h, -theta_set.support(&[-1.0]), theta_set.support(&[1.0])),
                 None => prof,
