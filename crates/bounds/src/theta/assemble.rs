@@ -20,8 +20,7 @@ use crate::stationary::{rest_set, RestSet, RestSetSettings};
 use crate::theta::alpha::{alpha, Alpha};
 use crate::theta::psi::Psi;
 use crate::theta::speed_profile::SpeedProfile;
-use crate::tube::{tube_diameters, TubeSettings};
-use crate::tube::{EngagedHistory, EngagedSpeed};
+use crate::tube::{tube_diameters_with, EngagedHistory, SemigroupData, TubeSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
 use geometry::{ConvexSet, SphereMaxSettings};
 use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
@@ -256,25 +255,22 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         f_radius: lmi::verify::f_enclosure_radius(&F, E, C).norm() * (1.0 + 1e-10),
         ..settings.tube
     };
-    let diam = tube_diameters(C, &F, E, &theta_set, &tube, &settings.sphere)?;
+    // One semigroup of F for every tube kernel of this report (the tube diameters and, for
+    // p = 1, the engaged history).
+    let sg = SemigroupData::new(&F);
+    let d_theta = theta_set.deviation_from_origin().upper;
+    let diam = tube_diameters_with(C, &F, E, &theta_set, d_theta, &sg, &tube, &settings.sphere)?;
     let (d, d_lower) = (diam.d.upper, diam.d.lower);
     let (d_ftheta, d_ftheta_lower) = (diam.d_ftheta.upper, diam.d_ftheta.lower);
     let d_ok = diam.verified;
-    // (zinf) with the backlash side pinned (p = 1; beyond the paper, tube::engaged_speed).
-    let engaged_speed = if p == 1 {
-        let (lo, hi) = (-theta_set.support(&[-1.0]), theta_set.support(&[1.0]));
-        let sg = crate::tube::SemigroupData::new(&F);
-        let l_err = crate::tube::engaged_speed::cf_support_error(
-            C,
-            &F,
-            E,
-            tube.f_radius,
-            &sg,
-            theta_set.deviation_from_origin().upper,
-        );
-        EngagedSpeed::new(&diam.tube_CF, C, E, lo, hi, l_err)
-    } else {
-        None
+    // p = 1: Theta = [lo, hi]; (zinf) with the backlash side pinned (beyond the paper,
+    // tube::engaged_speed): the engaged history's band at tau = 0.
+    let lo_hi = (p == 1).then(|| (-theta_set.support(&[-1.0]), theta_set.support(&[1.0])));
+    let engaged_speed = match lo_hi {
+        Some((lo, hi)) => {
+            EngagedHistory::new(&diam.tube_CF, C, &F, E, (lo, hi), &sg, &tube, 1.0, 0)?.map(|h| h.pinned(lo, hi))
+        }
+        None => None,
     };
     let tube_C = diam.tube_C;
 
@@ -381,9 +377,9 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // is provably engaged (the output has moved monotonically by Theta's width), partition by
     // dynamic programming again (the floors change which intervals matter), then the best
     // certified (lambda, b_hat) of the curve (proofs-notes/theta-engaged.md).
-    let engaged = match (&profile, orbit.deta_cells_scalar(cells)) {
-        (Some(prof), Some((low, high))) if p == 1 => {
-            let width = (theta_set.support(&[1.0]) + theta_set.support(&[-1.0])) * (1.0 + 1e-12);
+    let engaged = match (&profile, orbit.deta_cells_scalar(cells), lo_hi) {
+        (Some(prof), Some((low, high)), Some((lo, hi))) => {
+            let width = (hi - lo) * (1.0 + 1e-12);
             let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
             // the engaged history narrows the band of z' - eta_T' on engaged cells
             // (tube::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
@@ -392,9 +388,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             let steps = settings.engaged_history_steps;
             let dtau = T / (2.0 * steps.max(1) as f64);
             let needed = ((oldest / dtau).floor() as usize).min(steps);
-            let history = if steps > 0 && needed > 0 {
-                let sg = crate::tube::SemigroupData::new(&F);
-                EngagedHistory::new(&diam.tube_CF, C, &F, E, &theta_set, &sg, &tube, dtau, needed).unwrap_or_else(|e| {
+            let history = if needed > 0 && matches!(theta_set, geometry::Shape::Interval(_)) {
+                EngagedHistory::new(&diam.tube_CF, C, &F, E, (lo, hi), &sg, &tube, dtau, needed).unwrap_or_else(|e| {
                     notes.push(format!("engaged history not computed: {e}"));
                     None
                 })
@@ -402,7 +397,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
                 None
             };
             let prof = match &history {
-                Some(h) => prof.with_history(&low, &high, h, -theta_set.support(&[-1.0]), theta_set.support(&[1.0])),
+                Some(h) => prof.with_history(&low, &high, h, lo, hi),
                 None => prof,
             };
             (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
@@ -434,15 +429,12 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let path_safe = path_best * (1.0 - 1e-10);
     let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
     // gamma_inf*: the pinned speed bound, or the profile's largest cell ceiling if lower
-    let zdot_star = match &profile {
-        Some(prof) if strongly_convex => zdot_star.min((prof.max_speed() * R * (1.0 + 4.0 * f64::EPSILON)).next_up()),
-        _ => zdot_star,
-    };
-    let gamma_inf_star = if strongly_convex {
-        let from_profile = profile.as_ref().map_or(f64::INFINITY, |p| p.max_speed());
-        (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf).min(from_profile)
+    let max_cell_speed = profile.as_ref().map_or(f64::INFINITY, |p| p.max_speed());
+    let (zdot_star, gamma_inf_star) = if strongly_convex {
+        let zdot_star = zdot_star.min((max_cell_speed * R * (1.0 + 4.0 * f64::EPSILON)).next_up());
+        (zdot_star, (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf).min(max_cell_speed))
     } else {
-        0.0
+        (zdot_star, 0.0)
     };
     let kappa_star = if gamma_inf_star > 0.0 { down(gamma_1_star / gamma_inf_star).clamp(0.0, 1.0) } else { 0.0 };
     // Certified (lambda, b_hat) points for theta*: the paper's curve, plus a second lambda search

@@ -107,26 +107,17 @@ impl SpeedProfile {
         let mut floor = vec![0.0f64; K];
         let mut age: Vec<Option<(f64, usize)>> = vec![None; K];
         for sigma in [1.0f64, -1.0] {
-            // guaranteed rate of sigma y on each cell (rounded down), positive or not
-            let rate: Vec<f64> = (0..K)
-                .map(|c| {
-                    let m = if sigma > 0.0 { deta_low[c] } else { -deta_high[c] };
-                    let v = m - d_ftheta;
-                    v - 4.0 * f64::EPSILON * (m.abs() + d_ftheta.abs())
-                })
-                .collect();
-            // speed of the engaged backlash: with the pinned side (EngagedSpeed) where known,
-            // never below the rate of y itself (z' = y' there)
+            // m - o rounded down: the guaranteed rate of sigma y (o = D) or of the engaged
+            // backlash (o = its pinned offset, EngagedSpeed), m = min sigma eta_T' on the cell
+            let m: Vec<f64> = (0..K).map(|c| if sigma > 0.0 { deta_low[c] } else { -deta_high[c] }).collect();
+            let minus = |m: f64, o: f64| m - o - 4.0 * f64::EPSILON * (m.abs() + o.abs());
+            let rate: Vec<f64> = m.iter().map(|&m| minus(m, d_ftheta)).collect();
+            // z' = y' once engaged, so the engaged rate is never below the rate of y
             let offset = self.engaged_offsets.map(|(up, down)| if sigma > 0.0 { up } else { down });
-            let engaged_rate: Vec<f64> = (0..K)
-                .map(|c| match offset {
-                    Some(o) => {
-                        let m = if sigma > 0.0 { deta_low[c] } else { -deta_high[c] };
-                        rate[c].max(m - o - 4.0 * f64::EPSILON * (m.abs() + o.abs()))
-                    }
-                    None => rate[c],
-                })
-                .collect();
+            let engaged_rate: Vec<f64> = match offset {
+                Some(o) => m.iter().zip(&rate).map(|(&m, &r)| r.max(minus(m, o))).collect(),
+                None => rate.clone(),
+            };
             // Start each run after a cell with no guaranteed motion; with none the speed bound
             // never leaves the band of D around 0 from one side, impossible for a periodic orbit
             // unless rate is positive everywhere, which would make the run a full cycle: skip.

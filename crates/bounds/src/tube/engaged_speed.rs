@@ -22,7 +22,8 @@ use dynamics::linear::expm::frobenius_up;
 use geometry::{ConvexSet, Shape};
 use nalgebra::DMatrix;
 
-/// Offsets of the signed speed of `z` for `p = 1` (module docs), each an upper bound.
+/// Offsets of the signed speed of `z` for `p = 1` (module docs), each an upper bound: the band of
+/// [`EngagedHistory`] at `tau = 0` ([`EngagedHistory::pinned`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct EngagedSpeed {
@@ -37,30 +38,6 @@ pub struct EngagedSpeed {
 }
 
 impl EngagedSpeed {
-    /// `tube_CF`: the kernel of `sigma_{C F Xi_inf}` (as for `D`), `C` (1 x n), `E` (n x 1) and
-    /// `Theta = [lo, hi]`; `l_err`: [`cf_support_error`] for the kernel's `L = fl(C F)` (`0`
-    /// when `L` is exact). `None` unless `p = 1` and every value is finite.
-    pub fn new(tube_CF: &TubeKernel, C: &DMatrix<f64>, E: &DMatrix<f64>, lo: f64, hi: f64, l_err: f64) -> Option<Self> {
-        if C.nrows() != 1 || E.ncols() != 1 || C.ncols() != E.nrows() || !(lo <= 0.0 && 0.0 <= hi) {
-            return None;
-        }
-        let n = C.ncols();
-        // CE = sum C_i E_i with its rounding error (at most n u sum |C_i E_i| / (1 - n u)).
-        let ce = (0..n).map(|i| C[(0, i)] * E[(i, 0)]).sum::<f64>();
-        let ce_err = 2.0 * (n as f64 + 1.0) * f64::EPSILON * (0..n).map(|i| (C[(0, i)] * E[(i, 0)]).abs()).sum::<f64>();
-        let s_up = tube_CF.support_upper(&[1.0]) + l_err;
-        let s_down = tube_CF.support_upper(&[-1.0]) + l_err;
-        // a + ce m, rounded up: the product's own rounding and ce's error times |m|.
-        let add = |a: f64, m: f64| up(a + ce * m + ce_err * m.abs() + 2.0 * f64::EPSILON * ((ce * m).abs() + a.abs()));
-        let out = Self {
-            ceil_up: add(s_up, lo),
-            ceil_down: add(s_down, -hi),
-            floor_up: add(s_down, -lo),
-            floor_down: add(s_up, hi),
-        };
-        [out.ceil_up, out.ceil_down, out.floor_up, out.floor_down].iter().all(|x| x.is_finite()).then_some(out)
-    }
-
     /// `limsup |z'| <= ||eta_T'||_inf + max(ceil_up, ceil_down)` (at least `0`), from above.
     pub fn zdot_bound(&self, eta_dot_inf: f64) -> f64 {
         up((eta_dot_inf + self.ceil_up.max(self.ceil_down)).max(0.0))
@@ -124,36 +101,35 @@ pub struct EngagedHistory {
 }
 
 impl EngagedHistory {
-    /// Tabulates `tau_j = j dtau`, `j = 0..=steps`. `tube_CF` is the kernel of
-    /// `sigma_{C F Xi_inf}` built with `tube` (whose `f_radius` covers `F`), `sg` the semigroup
-    /// data of `F`, `theta` an interval containing 0. `None` when `p != 1`, `theta` is not an
-    /// interval or a bound is not finite.
+    /// Tabulates `tau_j = j dtau`, `j = 0..=steps` (`steps = 0`: the pinned band only, no
+    /// kernels). `tube_CF` is the kernel of `sigma_{C F Xi_inf}` built with `tube` (whose
+    /// `f_radius` covers `F`), `sg` the semigroup data of `F`, `Theta = [lo, hi]` (any set in R^1
+    /// is that interval) with `lo <= 0 <= hi`. `None` when `p != 1`, `0` is not in Theta or a
+    /// bound is not finite.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         tube_CF: &TubeKernel,
         C: &DMatrix<f64>,
         F: &DMatrix<f64>,
         E: &DMatrix<f64>,
-        theta: &Shape,
+        (lo, hi): (f64, f64),
         sg: &SemigroupData,
         tube: &TubeSettings,
         dtau: f64,
         steps: usize,
     ) -> Result<Option<Self>, BoundsError> {
-        let Shape::Interval(iv) = theta else { return Ok(None) };
-        if C.nrows() != 1 || E.ncols() != 1 || !(iv.lo <= 0.0 && 0.0 <= iv.hi) || !(dtau > 0.0 && dtau.is_finite()) {
-            return Ok(None);
-        }
-        if sg.exp_norm().is_none() {
+        let shape_ok = C.nrows() == 1 && E.ncols() == 1 && C.ncols() == E.nrows() && lo <= 0.0 && 0.0 <= hi;
+        if !shape_ok || (steps > 0 && !(dtau > 0.0 && dtau.is_finite())) || sg.exp_norm().is_none() {
             return Ok(None);
         }
         let n = C.ncols();
-        // CE with its rounding error
+        // CE = sum C_i E_i with its rounding error (at most n u sum |C_i E_i| / (1 - n u))
         let ce = (0..n).map(|i| C[(0, i)] * E[(i, 0)]).sum::<f64>();
         let ce_err = 2.0 * (n as f64 + 1.0) * f64::EPSILON * (0..n).map(|i| (C[(0, i)] * E[(i, 0)]).abs()).sum::<f64>();
         // the kernels use L = fl(C F): its error times int ||e^{s F_exact}|| ||E|| (times
         // D(Theta, {0}) for the support integrals, 1 for I)
         let l_err = cf_support_error(C, F, E, tube.f_radius, sg, 1.0);
+        let theta = Shape::Interval(geometry::Interval { lo, hi });
         let d_theta = theta.deviation_from_origin().upper;
         let CF = C * F;
         let unit = Shape::Interval(geometry::Interval { lo: 1.0, hi: 1.0 });
@@ -168,7 +144,7 @@ impl EngagedHistory {
         for j in 1..=steps {
             let tau = j as f64 * dtau;
             let h = Horizon::Finite(tau);
-            let kt = TubeKernel::with_shared(&CF, F, E, theta, d_theta, sg, h, tube)?;
+            let kt = TubeKernel::with_shared(&CF, F, E, &theta, d_theta, sg, h, tube)?;
             let ki = TubeKernel::with_shared(&CF, F, E, &unit, 1.0, sg, h, tube)?;
             let (a_up, a_down) = (kt.support_bounds(&[1.0]).lower, kt.support_bounds(&[-1.0]).lower);
             let int = ki.support_bounds(&[1.0]);
@@ -181,6 +157,14 @@ impl EngagedHistory {
             .iter()
             .all(|v| v.iter().all(|x| x.is_finite()));
         Ok(finite.then_some(out))
+    }
+
+    /// The pinned offsets: the band at `tau = 0` for either side (`z' > 0` only with `v = lo`,
+    /// `z' < 0` only with `v = hi`; module docs of this file).
+    pub fn pinned(&self, lo: f64, hi: f64) -> EngagedSpeed {
+        let (a_up, b_up) = self.band(0.0, lo);
+        let (a_down, b_down) = self.band(0.0, hi);
+        EngagedSpeed { ceil_up: b_up, floor_up: -a_up, ceil_down: -a_down, floor_down: b_down }
     }
 
     /// Enclosure `[a, b]` of `z' - eta_T'` at a time when the backlash has been engaged from the
@@ -227,6 +211,21 @@ mod tests {
         TubeKernel::new(&(C * F), F, E, theta, Horizon::Infinite, &TubeSettings::default()).unwrap()
     }
 
+    /// The pinned offsets (the history's band at tau = 0, no kernels).
+    fn pinned(
+        k: &TubeKernel,
+        C: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        lo: f64,
+        hi: f64,
+    ) -> Option<EngagedSpeed> {
+        let st = TubeSettings::default();
+        EngagedHistory::new(k, C, F, E, (lo, hi), &SemigroupData::new(F), &st, 1.0, 0)
+            .unwrap()
+            .map(|h| h.pinned(lo, hi))
+    }
+
     /// The ceilings never exceed D (which allows any v in Theta); with CE > 0 they are lower
     /// by CE (hi - lo), with CE = 0 (worked example) equal to D's terms.
     #[test]
@@ -239,7 +238,7 @@ mod tests {
             (DMatrix::from_row_slice(1, 2, &[1.0, -0.5]), DMatrix::from_row_slice(2, 1, &[0.0, 1.0]), -0.5),
         ] {
             let k = kernel(&C, &F, &E, &theta);
-            let s = EngagedSpeed::new(&k, &C, &E, -0.1, 0.2, 0.0).unwrap();
+            let s = pinned(&k, &C, &F, &E, -0.1, 0.2).unwrap();
             let (su, sd) = (k.support_upper(&[1.0]), k.support_upper(&[-1.0]));
             // D's two terms: s(u) + sigma_Theta(CE u)
             let d = (su + theta.support(&[ce])).max(sd + theta.support(&[-ce]));
@@ -269,7 +268,7 @@ mod tests {
         let st = TubeSettings::default();
         let k = kernel(&C, &F, &E, &theta);
         let sg = SemigroupData::new(&F);
-        let hist = EngagedHistory::new(&k, &C, &F, &E, &theta, &sg, &st, 0.5, 8).unwrap().unwrap();
+        let hist = EngagedHistory::new(&k, &C, &F, &E, (lo, hi), &sg, &st, 0.5, 8).unwrap().unwrap();
         // tails shrink with the history's length
         for j in 1..hist.tail_up.len() {
             assert!(hist.tail_up[j] + hist.tail_down[j] <= hist.tail_up[j - 1] + hist.tail_down[j - 1] + 1e-9);
@@ -327,10 +326,10 @@ mod tests {
             }
         }
         assert!(missed_without_tail > 0, "negative control: the band without tails was never violated");
-        // tau = 0 is the pinned bound of EngagedSpeed (same terms)
-        let es = EngagedSpeed::new(&k, &C, &E, lo, hi, cf_support_error(&C, &F, &E, 0.0, &sg, 0.2)).unwrap();
+        // tau = 0 is the pinned bound (module docs): [CE lo - s(-1), CE lo + s(+1)]
+        let (su, sd) = (k.support_upper(&[1.0]), k.support_upper(&[-1.0]));
         let (a0, b0) = hist.band(0.0, lo);
-        assert!((b0 - es.ceil_up).abs() < 1e-9 && (a0 + es.floor_up).abs() < 1e-9, "{a0} {b0} {es:?}");
+        assert!((b0 - (su + ce * lo)).abs() < 1e-9 && (a0 - (ce * lo - sd)).abs() < 1e-9, "{a0} {b0} {su} {sd}");
     }
 
     #[test]
@@ -342,8 +341,8 @@ mod tests {
         let C1 = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
         let E1 = DMatrix::from_row_slice(2, 1, &[1.0, 0.0]);
         let k = kernel(&C1, &F, &E1, &theta);
-        assert!(EngagedSpeed::new(&k, &C, &E, -0.1, 0.2, 0.0).is_none());
-        assert!(EngagedSpeed::new(&k, &C1, &E1, 0.1, 0.2, 0.0).is_none(), "0 not in Theta");
-        assert!(EngagedSpeed::new(&k, &C1, &E1, -0.1, 0.2, 0.0).is_some());
+        assert!(pinned(&k, &C, &F, &E, -0.1, 0.2).is_none());
+        assert!(pinned(&k, &C1, &F, &E1, 0.1, 0.2).is_none(), "0 not in Theta");
+        assert!(pinned(&k, &C1, &F, &E1, -0.1, 0.2).is_some());
     }
 }
