@@ -4,7 +4,7 @@
 //! - (path1-local), the partition bound with the step-length-dependent loss
 //!   `min(d, diam Theta + dt D)`: measured path per period `>= path1_local_bound >= path1_bound`.
 //!
-//! Random p = 1 systems (interval Theta, sine inputs; `C E` of either sign) plus the worked
+//! Random p = 1 systems (Theta an interval or a 1-D ball, sine inputs; `C E` of either sign) plus the worked
 //! example, each with the measured side (catching-up pairs, `dt = 1e-3`), compared at a relative
 //! tolerance `1e-3` for the time step. Negative controls, each must be caught on some case:
 //! the speed bound without the tube (`||eta_T'||_inf`, which drops `C F Xi_inf`) and the path
@@ -29,7 +29,12 @@ fn pinned_speed_and_local_path_bound_simulations_with_controls() {
         max_n: 3,
         max_p: 1,
         mu: (-2.0, -0.5),
-        theta: SetStrategyConfig { kinds: vec![SetKind::Interval], max_dim: 1, max_cond: 5.0, scale_exp: 0.75 },
+        theta: SetStrategyConfig {
+            kinds: vec![SetKind::Interval, SetKind::Ball],
+            max_dim: 1,
+            max_cond: 5.0,
+            scale_exp: 0.75,
+        },
         input: InputStrategyConfig { amp_exp: (0.5, 1.5), ..Default::default() },
         ..Default::default()
     };

@@ -265,7 +265,9 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     let d_ok = diam.verified;
     // p = 1: Theta = [lo, hi]; (zinf) with the backlash side pinned (beyond the paper,
     // tube::engaged_speed): the engaged history's band at tau = 0.
-    let lo_hi = (p == 1).then(|| (-theta_set.support(&[-1.0]), theta_set.support(&[1.0])));
+    // (support values from above: exact for an interval, an enclosing interval for any other
+    // set in R^1)
+    let lo_hi = (p == 1).then(|| (-theta_set.support_upper(&[-1.0]), theta_set.support_upper(&[1.0])));
     let engaged_speed = match lo_hi {
         Some((lo, hi)) => {
             EngagedHistory::new(&diam.tube_CF, C, &F, E, (lo, hi), &sg, &tube, 1.0, 0)?.map(|h| h.pinned(lo, hi))
@@ -388,7 +390,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             let steps = settings.engaged_history_steps;
             let dtau = T / (2.0 * steps.max(1) as f64);
             let needed = ((oldest / dtau).floor() as usize).min(steps);
-            let history = if needed > 0 && matches!(theta_set, geometry::Shape::Interval(_)) {
+            let history = if needed > 0 {
                 EngagedHistory::new(&diam.tube_CF, C, &F, E, (lo, hi), &sg, &tube, dtau, needed).unwrap_or_else(|e| {
                     notes.push(format!("engaged history not computed: {e}"));
                     None
