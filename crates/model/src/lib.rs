@@ -4,7 +4,12 @@
 //!
 //! - [`system`]: the validated [`System`] and its linearisation `F = A + E C` (eq. (F)).
 //! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, samples from a CSV).
-//! - [`model_file`]: reading and writing model files with errors that name key and value.
+//! - [`fit`]: `[fit]`, the nominal parameters a grey-box refit may free ([`FitSpec`]) and the
+//!   refits recorded in a fitted model.
+//! - [`signals`]: `[signals]`, units of the recorded signals and tracking references
+//!   ([`Signals`]).
+//! - [`model_file`]: reading and writing model files with errors that name key and value (the
+//!   parser: it builds the domain types above, which do not depend on it).
 //! - [`files`]: regular files only, with a size limit (no FIFO or device blocks a load).
 //! - [`effects`]: optional physics extensions (friction, delay, ...) used by `discovery`;
 //!   all equal to the nominal model at zero.
@@ -13,14 +18,18 @@
 pub mod effects;
 pub mod error;
 pub mod files;
+pub mod fit;
 pub mod input;
 pub mod model_file;
+pub mod signals;
 pub mod system;
 mod toml_access;
 
 pub use effects::Effects;
 pub use error::ModelError;
+pub use fit::{FitRecord, FitSpec, FreeParam, PlantMatrix};
 pub use input::Input;
 pub use model_file::{load, parse_str, to_toml_string};
+pub use signals::Signals;
 pub use system::{check_step, SimDefaults, System, SystemBuilder, MIN_STEPS_PER_PERIOD};
 pub use toml_access::MAX_MAGNITUDE;

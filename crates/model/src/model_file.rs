@@ -46,8 +46,11 @@
 //! t = "s"                     # unit of time (figures' time axes)
 //! reference = "w1"            # output i tracks this input (servo loops): tracking-error metrics
 //! ```
+pub use crate::fit::{parse_param_name, FitRecord, FitSpec, FreeParam, PlantMatrix};
+pub use crate::signals::Signals;
+use crate::system::{check_step, SimDefaults, System};
 use crate::toml_access::*;
-use crate::{Effects, Input, ModelError, SimDefaults, System};
+use crate::{Effects, Input, ModelError};
 use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, GeometryError, Interval, Polytope, Shape};
 use nalgebra::DVector;
 use std::path::Path;
@@ -366,7 +369,7 @@ fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelE
     }
     let effects = Effects::parse(root.get("effects"), n, p)?;
     let mut sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
-    crate::system::check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
+    check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
     sys.fit = parse_fit(sub("fit")?, &sys)?;
     sys.signals = parse_signals(sub("signals")?, sys.m(), sys.p())?;
     Ok(sys)
@@ -471,154 +474,8 @@ pub fn to_toml_string(s: &System) -> String {
     toml::to_string(&root).expect("a TOML table always serialises")
 }
 
-/// The plant matrix a freed nominal parameter lives in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlantMatrix {
-    A,
-    B,
-    C,
-    E,
-}
-
-impl PlantMatrix {
-    pub fn name(&self) -> &'static str {
-        match self {
-            PlantMatrix::A => "A",
-            PlantMatrix::B => "B",
-            PlantMatrix::C => "C",
-            PlantMatrix::E => "E",
-        }
-    }
-    fn of<'s>(&self, sys: &'s System) -> &'s nalgebra::DMatrix<f64> {
-        match self {
-            PlantMatrix::A => &sys.A,
-            PlantMatrix::B => &sys.B,
-            PlantMatrix::C => &sys.C,
-            PlantMatrix::E => &sys.E,
-        }
-    }
-    fn of_mut<'s>(&self, sys: &'s mut System) -> &'s mut nalgebra::DMatrix<f64> {
-        match self {
-            PlantMatrix::A => &mut sys.A,
-            PlantMatrix::B => &mut sys.B,
-            PlantMatrix::C => &mut sys.C,
-            PlantMatrix::E => &mut sys.E,
-        }
-    }
-}
-
-/// One nominal parameter freed by `[fit] free`: the entry `plant.X[row][col]` (0-based) with
-/// optional bounds `[fit.bounds]`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FreeParam {
-    /// Canonical name, e.g. `plant.A[1][1]`.
-    pub name: String,
-    pub matrix: PlantMatrix,
-    pub row: usize,
-    pub col: usize,
-    /// `(lower, upper)`, the nominal value inside.
-    pub bounds: Option<(f64, f64)>,
-}
-
-impl FreeParam {
-    /// The parameter's value in `sys`.
-    pub fn get(&self, sys: &System) -> f64 {
-        self.matrix.of(sys)[(self.row, self.col)]
-    }
-    /// Sets the parameter in `sys`.
-    pub fn set(&self, sys: &mut System, v: f64) {
-        self.matrix.of_mut(sys)[(self.row, self.col)] = v;
-    }
-}
-
-/// A grey-box refit recorded in a fitted model (`[fit.result."plant.A[1][1]"]`): the value
-/// of the model file it was fitted from, the fitted value (the one in `[plant]`) and its
-/// 1-sigma uncertainty (`NaN`, and not written, where not identifiable). Informational:
-/// nothing reads it back into the dynamics.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FitRecord {
-    pub name: String,
-    pub nominal: f64,
-    pub value: f64,
-    pub std: f64,
-}
-
-/// `[fit]`: the nominal parameters `moreau diagnose` may refit (empty: none).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct FitSpec {
-    pub free: Vec<FreeParam>,
-    pub result: Vec<FitRecord>,
-}
-
-impl FitSpec {
-    pub fn is_empty(&self) -> bool {
-        self.free.is_empty() && self.result.is_empty()
-    }
-}
-
-/// `[signals]`: units of the recorded outputs and inputs, for reports (empty: unitless).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Signals {
-    /// One unit per output (`y = "m"` gives every output the same unit).
-    pub y: Vec<String>,
-    /// One unit per input.
-    pub w: Vec<String>,
-    /// Unit of time (`""` when not stated).
-    pub t: String,
-    /// For each output, the input (0-based) that is its reference in a tracking loop (`w1` in
-    /// the file is `0`); empty when not stated. `diagnose` then also reports the fit of the
-    /// tracking error `w_ref - y`.
-    pub reference: Vec<usize>,
-}
-
-impl Signals {
-    /// Unit of output `i` (`""` when not stated).
-    pub fn y_unit(&self, i: usize) -> &str {
-        self.y.get(i).map_or("", |s| s.as_str())
-    }
-    /// Unit of input `j` (`""` when not stated).
-    pub fn w_unit(&self, j: usize) -> &str {
-        self.w.get(j).map_or("", |s| s.as_str())
-    }
-    pub fn is_empty(&self) -> bool {
-        self.y.is_empty() && self.w.is_empty() && self.t.is_empty() && self.reference.is_empty()
-    }
-
-    /// The common unit of all outputs (`""` when not stated or when they differ).
-    pub fn y_common_unit(&self) -> &str {
-        match self.y.first() {
-            Some(u) if self.y.iter().all(|v| v == u) => u,
-            _ => "",
-        }
-    }
-}
-
 const FREE_FORM: &str =
     "a nominal parameter `plant.X[row][col]` with X one of A, B, C, E and 0-based indices, e.g. \"plant.A[1][1]\"";
-
-/// `plant.X[i][j]` -> `(X, i, j)`; `None` when malformed.
-pub fn parse_param_name(s: &str) -> Option<(PlantMatrix, usize, usize)> {
-    let rest = s.trim().strip_prefix("plant.")?;
-    let mut ch = rest.chars();
-    let mat = match ch.next()? {
-        'A' => PlantMatrix::A,
-        'B' => PlantMatrix::B,
-        'C' => PlantMatrix::C,
-        'E' => PlantMatrix::E,
-        _ => return None,
-    };
-    let rest = ch.as_str().strip_prefix('[')?;
-    let (i, rest) = rest.split_once(']')?;
-    let rest = rest.strip_prefix('[')?;
-    let (j, rest) = rest.split_once(']')?;
-    if !rest.is_empty() {
-        return None;
-    }
-    let idx = |v: &str| -> Option<usize> {
-        (!v.is_empty() && v.chars().all(|c| c.is_ascii_digit())).then(|| v.parse().ok()).flatten()
-    };
-    Some((mat, idx(i)?, idx(j)?))
-}
 
 fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
     let Some(t) = t else { return Ok(FitSpec::default()) };
@@ -640,7 +497,7 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
             let Some((matrix, row, col)) = parse_param_name(s) else {
                 return Err(ModelError::WrongType { key, expected: FREE_FORM, found: describe(it) });
             };
-            let m = matrix.of(sys);
+            let m = sys.plant_matrix(matrix);
             if row >= m.nrows() || col >= m.ncols() {
                 return Err(ModelError::Dimension {
                     key,

@@ -1,5 +1,9 @@
 //! The validated closed-loop system of eqs. (xy), (yz).
-use crate::{Effects, Input, ModelError};
+use crate::effects::Effects;
+use crate::error::ModelError;
+use crate::fit::{FitSpec, FreeParam, PlantMatrix};
+use crate::input::Input;
+use crate::signals::Signals;
 use geometry::{ConvexSet, Shape};
 use nalgebra::{Complex, DMatrix, DVector};
 
@@ -61,9 +65,9 @@ pub struct System {
     pub effects: Effects,
     /// `[fit]`: nominal parameters freed for a grey-box refit by `moreau diagnose` (empty:
     /// the nominal is taken as known).
-    pub fit: crate::model_file::FitSpec,
+    pub fit: FitSpec,
     /// `[signals]`: units of the recorded signals, for reports (empty: unitless).
-    pub signals: crate::model_file::Signals,
+    pub signals: Signals,
 }
 
 fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
@@ -342,5 +346,35 @@ impl System {
     /// Copy with another input (e.g. a different amplitude in a sweep).
     pub fn with_input(&self, input: Input) -> Self {
         Self { input, ..self.clone() }
+    }
+    /// The plant matrix `which` (`A`, `B`, `C` or `E`).
+    pub fn plant_matrix(&self, which: PlantMatrix) -> &DMatrix<f64> {
+        match which {
+            PlantMatrix::A => &self.A,
+            PlantMatrix::B => &self.B,
+            PlantMatrix::C => &self.C,
+            PlantMatrix::E => &self.E,
+        }
+    }
+    /// The plant matrix `which`, mutable.
+    pub fn plant_matrix_mut(&mut self, which: PlantMatrix) -> &mut DMatrix<f64> {
+        match which {
+            PlantMatrix::A => &mut self.A,
+            PlantMatrix::B => &mut self.B,
+            PlantMatrix::C => &mut self.C,
+            PlantMatrix::E => &mut self.E,
+        }
+    }
+}
+
+/// A freed parameter ([`crate::fit`]) read and written in a system.
+impl FreeParam {
+    /// The parameter's value in `sys`.
+    pub fn get(&self, sys: &System) -> f64 {
+        sys.plant_matrix(self.matrix)[(self.row, self.col)]
+    }
+    /// Sets the parameter in `sys`.
+    pub fn set(&self, sys: &mut System, v: f64) {
+        sys.plant_matrix_mut(self.matrix)[(self.row, self.col)] = v;
     }
 }
