@@ -47,7 +47,7 @@ pub fn convergence_study(sys: &model::System, st: &ConvergenceSettings) -> Resul
         let (reference, events) =
             event_driven(sys, &EventDrivenSettings { dt_out: h0, t_end: st.t_end, ..Default::default() })?;
         ladder(st, h0, events, &reference, |h, steps, every| {
-            simulate_catching_up(sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, steps, every)
+            simulate_catching_up(sys, &CatchingUpSettings { dt: h, hold: InputHold::Foh }, steps, every)
         })
     } else {
         let rr = 1usize << st.levels;

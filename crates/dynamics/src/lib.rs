@@ -5,7 +5,8 @@
 //! Module map:
 //! - [`linear`]: `e^{hA}`, `t Psi(tA)` (eq. (Psi)) and `int_0^h e^{(h-s)A} s ds` from one
 //!   augmented matrix exponential ([`linear::expm`]); exact step maps with `w` held or linearly
-//!   interpolated ([`linear::step_map`]). **`DMatrix`-based and public for reuse** (discovery:
+//!   interpolated ([`linear::step_map`]), the hold declared once as [`InputHold`]
+//!   ([`linear::hold`]). **`DMatrix`-based and public for reuse** (discovery:
 //!   `StepMap::new(&A, h)`, `apply_held`, `apply_linear`, `SystemStepMap::new(&A, &B, &E, h, hold)`).
 //! - [`integrators::catching_up`]: Moreau's scheme `z_{k+1} = P_{y_{k+1} + Theta}(z_k)` with the
 //!   exact linear step, any [`geometry::Shape`]; [`Simulator`] picks a fixed-size fast path.
@@ -21,10 +22,17 @@
 //! - [`rate::lyapunov_exponent`]: `(1/2) limsup (1/t) ln V`, `V` of eq. (V_Gamma), by
 //!   regression over periods with a 95% interval and Benettin renormalisation;
 //!   [`rate::path_length`]: path length of `z` per period and `max |z'|`.
-//! - [`trajectory`]: recorded trajectories and their CSV.
+//! - [`record`]: the recorded [`record::Trajectory`] of a run and its CSV (written by every
+//!   integrator and the extended model);
+//!   [`trajectory`]: simulating a model file into one (`simulate_model`: catching-up, or the
+//!   extended model for a model with `[[effects]]`; `simulate_catching_up`).
 //! - [`extended`]: the model extended by its `[[effects]]` (friction, backlash inertia, input
 //!   delay and saturation, sensor offset, extra play) and its fixed-step simulator, the one
 //!   used for every model with effects.
+//!
+//! Layers, bottom up (a module uses only modules on its own or lower lines; no circle):
+//! `error`, `linear`, `record` -> `integrators` -> `periodic` -> `extended` -> `trajectory`,
+//! `rate` -> `convergence`.
 //!
 //! Entry points for `bounds`, the theorem campaign and the CLI:
 //! - simulation: `Simulator::new(&sys, &CatchingUpSettings { dt, hold })?` then
@@ -47,6 +55,7 @@ pub mod integrators;
 pub mod linear;
 pub mod periodic;
 pub mod rate;
+pub mod record;
 pub mod trajectory;
 
 pub use error::DynamicsError;

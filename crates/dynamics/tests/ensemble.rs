@@ -113,19 +113,19 @@ fn worked_example_is_reproduced_bit_for_bit_with_ragged_sizes() {
 fn every_input_kind_and_hold_agrees_with_the_single_path() {
     let base = example("worked-example");
     let mut cases: Vec<(&str, System, InputHold)> = Vec::new();
-    cases.push(("sine, held", base.clone(), InputHold::Held));
+    cases.push(("sine, held", base.clone(), InputHold::Zoh));
     let mut sq = base.clone();
     sq.input = Input::Square { amplitudes: vec![0.7], omega: 2.3, phase: 0.4 };
-    cases.push(("square, linear", sq.clone(), InputHold::Linear));
-    cases.push(("square, held", sq, InputHold::Held));
+    cases.push(("square, linear", sq.clone(), InputHold::Foh));
+    cases.push(("square, held", sq, InputHold::Zoh));
     let mut zero = base.clone();
     zero.input = Input::Zero { m: 1 };
-    cases.push(("zero", zero, InputHold::Linear));
+    cases.push(("zero", zero, InputHold::Foh));
     // two input channels (4 forcing terms per step, the run-time-count kernel)
     let mut two = base.clone();
     two.B = DMatrix::from_row_slice(2, 2, &[0.0, 0.3, 1.0, -0.2]);
     two.input = Input::Square { amplitudes: vec![1.0, 0.5], omega: 1.3, phase: 0.0 };
-    cases.push(("two channels, linear", two, InputHold::Linear));
+    cases.push(("two channels, linear", two, InputHold::Foh));
     for (what, sys, hold) in cases {
         let (df, ds) = compare::<2, 1>(&sys, &settings(2e-3, hold), 37, &[3_000, 1_111]);
         assert!(df <= TOL && ds <= TOL, "{what}: vs fast {df:e}, vs simulator {ds:e}");

@@ -25,7 +25,7 @@ pub struct StepMaps {
     pub PsiE: Vec<f64>,
 }
 
-fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+pub(super) fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(m.len());
     for i in 0..m.nrows() {
         for j in 0..m.ncols() {

@@ -28,13 +28,13 @@ pub const SINE_RESEED: usize = 512;
 pub struct CatchingUpSettings {
     /// Step `h`. Default `1e-3`.
     pub dt: f64,
-    /// Representation of `w` over a step. Default [`InputHold::Linear`].
+    /// Representation of `w` over a step. Default [`InputHold::Foh`].
     pub hold: InputHold,
 }
 
 impl Default for CatchingUpSettings {
     fn default() -> Self {
-        Self { dt: 1e-3, hold: InputHold::Linear }
+        Self { dt: 1e-3, hold: InputHold::Foh }
     }
 }
 
@@ -102,7 +102,7 @@ impl CatchingUp {
         let g1b = self.map.g1B.as_slice();
         let g2b = self.map.g2B.as_slice();
         let c = self.C.as_slice();
-        let linear = self.map.hold == InputHold::Linear;
+        let linear = self.map.hold == InputHold::Foh;
         self.input.eval(t0, &mut self.w0);
         for k in 0..steps {
             let t1 = t0 + (k + 1) as f64 * h;
@@ -227,7 +227,7 @@ impl<const N: usize, const P: usize, S: FastSet<P>> FastCatchingUp<N, P, S> {
             return Err(DynamicsError::Dimension { what: "p (fast path)", expected: P, got: sys.p() });
         }
         let map = SystemStepMap::for_system(sys, settings.dt, settings.hold)?;
-        let linear = settings.hold == InputHold::Linear;
+        let linear = settings.hold == InputHold::Foh;
         let forcing = match &sys.input {
             Input::Zero { .. } => FastForcing::Zero,
             Input::Sine { amplitudes, omega, phase } if linear => {
@@ -407,14 +407,14 @@ mod tests {
     #[test]
     fn fast_and_dynamic_paths_agree() {
         let sys = worked();
-        for hold in [InputHold::Linear, InputHold::Held] {
+        for hold in [InputHold::Foh, InputHold::Zoh] {
             let (a, b) = run_both(&sys, hold, 20_000);
             for (u, v) in a.iter().zip(&b) {
                 assert!((u - v).abs() < 1e-10, "{hold:?}: {a:?} vs {b:?}");
             }
         }
         let ell = model::parse_str(include_str!("../../../../examples/ellipse-p2.toml")).unwrap();
-        let (a, b) = run_both(&ell, InputHold::Linear, 20_000);
+        let (a, b) = run_both(&ell, InputHold::Foh, 20_000);
         for (u, v) in a.iter().zip(&b) {
             assert!((u - v).abs() < 1e-10, "{a:?} vs {b:?}");
         }
@@ -449,13 +449,13 @@ mod tests {
         sys.x0 = nalgebra::DVector::from_vec(vec![0.5, 0.0]);
         sys.z0 = &sys.C * &sys.x0;
         let h = 1e-4;
-        let mut sim = Simulator::new(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }).unwrap();
+        let mut sim = Simulator::new(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Foh }).unwrap();
         let (mut x, mut z) = (sys.x0.as_slice().to_vec(), sys.z0.as_slice().to_vec());
         let steps = 50_000;
         sim.run(0.0, &mut x, &mut z, steps, |_, _, _, _| {});
         // reference: x' = F x + B sin t with the exact step map on a fine grid
         let F = sys.F();
-        let sm = crate::linear::step_map::SystemStepMap::new(&F, &sys.B, &sys.E, 1e-3, InputHold::Linear).unwrap();
+        let sm = crate::linear::step_map::SystemStepMap::new(&F, &sys.B, &sys.E, 1e-3, InputHold::Foh).unwrap();
         let mut xr = sys.x0.clone();
         for k in 0..5000 {
             let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);

@@ -165,7 +165,7 @@ enum Forcing {
 impl Forcing {
     fn new(sys: &System, map: &SystemStepMap) -> Self {
         let n = sys.n();
-        let linear = map.hold == InputHold::Linear;
+        let linear = map.hold == InputHold::Foh;
         let col = |M: &nalgebra::DMatrix<f64>, j: usize| (0..n).map(|i| M[(i, j)]).collect::<Vec<f64>>();
         match &sys.input {
             Input::Zero { .. } => Forcing::Zero,

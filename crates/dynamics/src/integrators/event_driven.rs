@@ -20,7 +20,7 @@
 //! Inputs: zero and sine (the exosystem). Other inputs give [`DynamicsError::UnsupportedInput`].
 use crate::error::{check_dt, DynamicsError};
 use crate::linear::expm::expm;
-use crate::trajectory::Trajectory;
+use crate::record::Trajectory;
 use geometry::Shape;
 use model::{Input, System};
 use nalgebra::{DMatrix, DVector};
@@ -395,14 +395,13 @@ mod tests {
         let (ev, events) =
             event_driven(&sys, &EventDrivenSettings { dt_out: 100.0 * h, t_end, ..Default::default() }).unwrap();
         assert!(events >= 40, "backlash must engage and release every half period: {events} events");
-        let cu =
-            simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, steps, 100).unwrap();
+        let cu = simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Foh }, steps, 100).unwrap();
         assert_eq!(cu.len(), ev.len());
         let d = max_diff(&ev, &cu, 1);
         assert!(d < 1e-3, "max difference {d}");
         // negative control: a coarse catching-up run (h = 0.05) is further than 1e-3 away
         let coarse =
-            simulate_catching_up(&sys, &CatchingUpSettings { dt: 100.0 * h, hold: InputHold::Linear }, steps / 100, 1)
+            simulate_catching_up(&sys, &CatchingUpSettings { dt: 100.0 * h, hold: InputHold::Foh }, steps / 100, 1)
                 .unwrap();
         assert!(max_diff(&ev, &coarse, 1) > 1e-3);
         // invariants of the reference: q in Theta at every sample
@@ -420,8 +419,7 @@ mod tests {
         let (ev, events) =
             event_driven(&sys, &EventDrivenSettings { dt_out: 64.0 * h, t_end, ..Default::default() }).unwrap();
         assert!(events >= 2, "{events}");
-        let cu =
-            simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, 125_632, 64).unwrap();
+        let cu = simulate_catching_up(&sys, &CatchingUpSettings { dt: h, hold: InputHold::Foh }, 125_632, 64).unwrap();
         assert_eq!(cu.len(), ev.len());
         let d = max_diff(&ev, &cu, 1);
         assert!(d < 1e-3, "max difference {d}");

@@ -8,19 +8,9 @@
 //! catching-up scheme) and `w` held or linearly interpolated. Public and `DMatrix`-based so that
 //! other crates (discovery) can simulate extended models with the same maps.
 use super::expm::exp_integrals;
+pub use super::hold::InputHold;
 use crate::error::{check_dt, DynamicsError};
 use nalgebra::{DMatrix, DVector};
-use serde::{Deserialize, Serialize};
-
-/// How `w` is represented over one step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum InputHold {
-    /// `w(t_k + s) = w(t_k)` (zero-order hold).
-    Held,
-    /// `w(t_k + s) = w(t_k) + (s/h)(w(t_{k+1}) - w(t_k))` (first-order hold). Default.
-    #[default]
-    Linear,
-}
 
 /// Exact step map of `x' = A x + u` for a step `h`.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,7 +44,7 @@ impl StepMap {
 }
 
 /// The step map of eq. (xy) for a system `(A, B, E)`: `x_{k+1} = Phi x_k + G1E z_k + G1B w_k
-/// + G2B (w_{k+1} - w_k)` with `G2B = Gamma2 B / h` (zero for [`InputHold::Held`]).
+/// + G2B (w_{k+1} - w_k)` with `G2B = Gamma2 B / h` (zero for [`InputHold::Zoh`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemStepMap {
     pub h: f64,
@@ -75,8 +65,8 @@ impl SystemStepMap {
     ) -> Result<Self, DynamicsError> {
         let s = StepMap::new(A, h)?;
         let g2B = match hold {
-            InputHold::Held => DMatrix::zeros(A.nrows(), B.ncols()),
-            InputHold::Linear => &s.gamma2 * B / h,
+            InputHold::Zoh => DMatrix::zeros(A.nrows(), B.ncols()),
+            InputHold::Foh => &s.gamma2 * B / h,
         };
         Ok(Self { h, hold, g1E: &s.gamma1 * E, g1B: &s.gamma1 * B, g2B, phi: s.phi })
     }

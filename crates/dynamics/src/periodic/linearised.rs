@@ -178,7 +178,7 @@ pub fn linearised_periodic(sys: &System, settings: &LinearisedSettings) -> Resul
             exact = false;
             let sub = settings.substeps;
             let hs = dt / sub as f64;
-            let map = SystemStepMap::new(&F, &sys.B, &sys.E, hs, InputHold::Linear)?;
+            let map = SystemStepMap::new(&F, &sys.B, &sys.E, hs, InputHold::Foh)?;
             let m = other.m();
             let mut w0 = vec![0.0; m];
             let mut w1 = vec![0.0; m];
@@ -337,7 +337,7 @@ mod tests {
         let F = sys.F();
         let T = L.period;
         let hs = T / (400.0 * 16.0);
-        let map = SystemStepMap::new(&F, &sys.B, &sys.E, hs, InputHold::Linear).unwrap();
+        let map = SystemStepMap::new(&F, &sys.B, &sys.E, hs, InputHold::Foh).unwrap();
         let mut x = DVector::<f64>::zeros(2);
         for k in 0..(400 * 16 * 40) {
             let t0 = k as f64 * hs;

@@ -28,7 +28,7 @@ pub struct PoincareSettings {
 
 impl Default for PoincareSettings {
     fn default() -> Self {
-        Self { dt: 1e-3, hold: InputHold::Linear, tol_residual: 1e-11, max_periods: 5000 }
+        Self { dt: 1e-3, hold: InputHold::Foh, tol_residual: 1e-11, max_periods: 5000 }
     }
 }
 
@@ -132,7 +132,7 @@ mod tests {
         // negative control: the initial state (rest) is not periodic
         let mut x = sys.x0.as_slice().to_vec();
         let mut z = sys.z0.as_slice().to_vec();
-        let mut sim = Simulator::new(&sys, &CatchingUpSettings { dt: r.h, hold: InputHold::Linear }).unwrap();
+        let mut sim = Simulator::new(&sys, &CatchingUpSettings { dt: r.h, hold: InputHold::Foh }).unwrap();
         sim.run(0.0, &mut x, &mut z, r.steps_per_period, |_, _, _, _| {});
         assert!(dist_inf(&x, sys.x0.as_slice()) > 1e-3);
     }

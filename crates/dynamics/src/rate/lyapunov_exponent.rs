@@ -50,7 +50,7 @@ impl Default for RateSettings {
     fn default() -> Self {
         Self {
             dt: 1e-3,
-            hold: InputHold::Linear,
+            hold: InputHold::Foh,
             periods: 60,
             transient_periods: 10,
             pairs: 3,

@@ -102,7 +102,7 @@ fn c_xstar_exact(sys: &model::System, h: f64, steps: usize) -> Option<Vec<f64>> 
 
 /// `C x^h_*(t_k)`: the scheme's own feedback-free state (linear hold of `w`).
 fn c_xstar_scheme(sys: &model::System, h: f64, steps: usize) -> Option<Vec<f64>> {
-    let map = SystemStepMap::for_system(sys, h, InputHold::Linear).ok()?;
+    let map = SystemStepMap::for_system(sys, h, InputHold::Foh).ok()?;
     let m = sys.m();
     let mut x = sys.x0.clone();
     let (mut w0, mut w1) = (DVector::zeros(m), DVector::zeros(m));
@@ -145,7 +145,7 @@ pub fn rest_set(sys: &model::System, horizon: f64) -> Option<RestSet> {
 
 /// Runs the scheme from `(x0, z)` over the grid: `(max |z_k - z|, path length)`.
 fn run_from(sys: &model::System, rs: &RestSet, z: f64) -> Option<(f64, f64)> {
-    let mut cu = CatchingUp::new(sys, &CatchingUpSettings { dt: rs.h, hold: InputHold::Linear }).ok()?;
+    let mut cu = CatchingUp::new(sys, &CatchingUpSettings { dt: rs.h, hold: InputHold::Foh }).ok()?;
     let mut x: Vec<f64> = sys.x0.iter().copied().collect();
     let mut zz = [z];
     let (mut dev, mut path, mut prev) = (0.0f64, 0.0, z);

@@ -1,0 +1,442 @@
+//! The fixed-step free-run simulator of an [`ExtendedModel`], and the runs built on it: a
+//! recorded trajectory of a model file ([`simulate_trajectory`]) and the regime reached under a
+//! periodic input ([`regime_by_simulation`]).
+//!
+//! One sample interval is `substeps` sub-steps (one of them split in two at a delayed input's
+//! breakpoint, see [`super::input`]); each sub-step is, in order:
+//! 1. the input over the sub-step by the model's hold (`InputDrive::advance`);
+//! 2. the exact linear step `x+ = Phi x + Psi B w0 + Psi1 B dw + Psi E q (+ Psi b)`, then the
+//!    cogging and friction forces ([`super::forces`]) (`ExtendedModel::step_plant`);
+//! 3. the play: the backlash output coasts (with inertia) and is projected back into
+//!    `y + Theta` (`ExtendedModel::step_play`).
+use super::input::InputPath;
+use super::model::ExtendedModel;
+use super::step_maps::StepMaps;
+use crate::error::{check_dt, DynamicsError};
+use crate::linear::hold::InputHold;
+use crate::periodic::steps_per_period;
+use crate::record::Trajectory;
+use model::System;
+
+/// Result of a simulation on the sample grid.
+#[derive(Debug, Clone)]
+pub struct SimOutput {
+    /// `y_meas[k]` flat, `k * p + i`.
+    pub y: Vec<f64>,
+    /// Whether the play is in contact (`q` on the boundary of Theta) at sample `k`.
+    pub contact: Vec<bool>,
+    /// The backlash output `z[k]` flat, `k * p + i` (equal to `C x` without a play).
+    pub z: Vec<f64>,
+    /// Whether the state was finite throughout.
+    pub finite: bool,
+    /// Root mean square of each state over the run (scales for fitting).
+    pub x_rms: Vec<f64>,
+    /// The state `x[k]` flat, `k * n + i`.
+    pub x: Vec<f64>,
+}
+
+impl SimOutput {
+    fn zeros(ns: usize, n: usize, p: usize) -> Self {
+        SimOutput {
+            y: vec![0.0; ns * p],
+            contact: vec![false; ns],
+            z: vec![0.0; ns * p],
+            finite: true,
+            x_rms: vec![0.0; n],
+            x: vec![0.0; ns * n],
+        }
+    }
+
+    /// Records sample `k` (`y_meas = y + offset`) and accumulates the squares of `x`.
+    #[inline]
+    fn record(&mut self, k: usize, st: &RunState, offset: &[f64]) {
+        let (n, p) = (st.x.len(), st.y.len());
+        for i in 0..p {
+            self.y[k * p + i] = st.y[i] + offset[i];
+            self.z[k * p + i] = st.z[i];
+        }
+        for i in 0..n {
+            self.x_rms[i] += st.x[i] * st.x[i];
+            self.x[k * n + i] = st.x[i];
+        }
+    }
+
+    /// The state left the finite numbers after sample `k`: every later output is `NaN`.
+    fn diverged_after(&mut self, k: usize, ns: usize, p: usize) {
+        self.finite = false;
+        for kk in k + 1..ns {
+            for i in 0..p {
+                self.y[kk * p + i] = f64::NAN;
+            }
+        }
+    }
+}
+
+/// Per-step constants of one step length.
+struct Piece<'a> {
+    maps: &'a StepMaps,
+    /// `Psi b` (constant force).
+    fb: Vec<f64>,
+    decay: f64,
+    coast: f64,
+}
+
+impl<'a> Piece<'a> {
+    fn new(maps: &'a StepMaps, force: &[f64], inertia_tau: f64) -> Self {
+        let n = maps.n;
+        let h = maps.h;
+        let decay = if inertia_tau > 0.0 && inertia_tau.is_finite() { (-h / inertia_tau).exp() } else { 1.0 };
+        let coast = if inertia_tau > 0.0 {
+            if inertia_tau.is_finite() {
+                inertia_tau * (1.0 - decay)
+            } else {
+                h
+            }
+        } else {
+            0.0
+        };
+        let fb = (0..n).map(|i| (0..n).map(|j| maps.Psi[i * n + j] * force[j]).sum()).collect();
+        Self { maps, fb, decay, coast }
+    }
+}
+
+/// The pieces of one run: the regular sub-step and, with an input delay, the split sub-step's
+/// two parts (`(substep, at, first, second)`).
+struct Pieces<'a> {
+    main: Piece<'a>,
+    split: Option<(usize, f64, Piece<'a>, Piece<'a>)>,
+}
+
+impl<'a> Pieces<'a> {
+    fn new(model: &'a ExtendedModel) -> Self {
+        let (force, tau) = (&model.forces.force, model.inertia_tau);
+        let main = Piece::new(&model.maps, force, tau);
+        let split = model
+            .split
+            .as_ref()
+            .map(|sp| (sp.substep, sp.at, Piece::new(&sp.first, force, tau), Piece::new(&sp.second, force, tau)));
+        Self { main, split }
+    }
+
+    /// Sub-step `s` of `sub` as one or two pieces `(fa, fb, piece)` (fractions of the sample
+    /// interval); the count is the second value.
+    #[inline]
+    fn of_substep(&self, s: usize, sub: usize) -> ([(f64, f64, &Piece<'a>); 2], usize) {
+        let f0 = s as f64 / sub as f64;
+        let f1 = (s + 1) as f64 / sub as f64;
+        match &self.split {
+            Some((ss, at, a, b)) if *ss == s => {
+                let fm = f0 + at / sub as f64;
+                ([(f0, fm, a), (fm, f1, b)], 2)
+            }
+            _ => ([(f0, f1, &self.main), (f1, f1, &self.main)], 1),
+        }
+    }
+}
+
+/// The running state of one simulation.
+struct RunState {
+    x: Vec<f64>,
+    /// The next state (a linear step's end, then the forces).
+    xn: Vec<f64>,
+    /// The play's deviation `q = z - y`.
+    q: Vec<f64>,
+    z: Vec<f64>,
+    y: Vec<f64>,
+    /// Coasting velocity of the backlash output (`backlash_inertia`).
+    v: Vec<f64>,
+    scratch: Vec<f64>,
+    /// `q` before the projection.
+    qp: Vec<f64>,
+}
+
+/// The input over each piece of a step: the start value `w0` and the increment `dw` (zero
+/// under a zero-order hold).
+struct InputDrive<'w> {
+    w: &'w [f64],
+    m: usize,
+    ns: usize,
+    /// The delay in samples.
+    shift: f64,
+    /// Zero-order hold: the saturated, played samples (empty under a first-order hold).
+    held: Vec<f64>,
+    /// First-order hold: input play state, input at the piece's start and end.
+    uplay: Vec<f64>,
+    ucur: Vec<f64>,
+    unext: Vec<f64>,
+    w0: Vec<f64>,
+    dw: Vec<f64>,
+}
+
+impl<'w> InputDrive<'w> {
+    fn new(input: &InputPath, w: &'w [f64], dt: f64, m: usize, ns: usize) -> Self {
+        let shift = input.delay / dt;
+        // Zero-order hold: saturation and input play act on the held samples exactly.
+        let held = match input.hold {
+            InputHold::Zoh => input.held_samples(w, m, ns),
+            InputHold::Foh => Vec::new(),
+        };
+        let mut uplay = input.play_start(w, m);
+        let mut ucur = vec![0.0; m];
+        input.foh_at(w, m, ns, -shift, &mut uplay, &mut ucur);
+        Self { w, m, ns, shift, held, uplay, ucur, unext: vec![0.0; m], w0: vec![0.0; m], dw: vec![0.0; m] }
+    }
+
+    /// Sets `w0`, `dw` for the piece `[fa, fb]` of sample interval `k`.
+    #[inline]
+    fn advance(&mut self, input: &InputPath, k: usize, fa: f64, fb: f64) {
+        let (m, ns) = (self.m, self.ns);
+        match input.hold {
+            InputHold::Zoh => {
+                let tau = k as f64 + 0.5 * (fa + fb) - self.shift;
+                let idx = if tau <= 0.0 { 0 } else { (tau.floor() as usize).min(ns - 1) };
+                self.w0.copy_from_slice(&self.held[idx * m..(idx + 1) * m]);
+                self.dw.iter_mut().for_each(|d| *d = 0.0);
+            }
+            InputHold::Foh => {
+                input.foh_at(self.w, m, ns, k as f64 + fb - self.shift, &mut self.uplay, &mut self.unext);
+                for j in 0..m {
+                    self.w0[j] = self.ucur[j];
+                    self.dw[j] = self.unext[j] - self.ucur[j];
+                }
+                self.ucur.copy_from_slice(&self.unext);
+            }
+        }
+    }
+}
+
+impl ExtendedModel {
+    /// Free-run simulation from `x0` (with `q0 = 0`, i.e. `z0 = C x0`) driven by the measured
+    /// input `w` (flat, `k * m + j`, sample spacing `dt`, the spacing the model was compiled
+    /// for). Returns `y_meas` on the sample grid.
+    pub fn simulate(&self, w: &[f64], dt: f64, x0: &[f64]) -> SimOutput {
+        self.simulate_from(w, dt, x0, None)
+    }
+
+    /// As [`ExtendedModel::simulate`] from `(x0, z0)`; `z0 = None` starts at rest in the play
+    /// (`z0 = C x0`). `z0 - C x0` is taken as it is (it should lie in the play's set).
+    ///
+    /// Between samples the input follows the model's [`InputHold`]: linear interpolation of
+    /// the samples (first-order hold, the default) or the sample held until the next one
+    /// (zero-order hold). Either is integrated exactly by the linear step maps: an input delay
+    /// moves the input's breakpoints to `t_k + delay`, and the sub-step that contains one is
+    /// split there (two extra step maps, computed once per model). Saturation and a play at
+    /// the input act on the held samples exactly (ZOH) or on the sub-step knots (FOH).
+    pub fn simulate_from(&self, w: &[f64], dt: f64, x0: &[f64], z0: Option<&[f64]>) -> SimOutput {
+        let (n, m, p) = (self.n, self.m, self.p);
+        let ns = w.len() / m;
+        let mut out = SimOutput::zeros(ns, n, p);
+        let mut st = self.start(x0, z0);
+        if ns == 0 {
+            return out;
+        }
+        let sub = self.substeps;
+        let pieces = Pieces::new(self);
+        let mut drive = InputDrive::new(&self.input, w, dt, m, ns);
+        for k in 0..ns {
+            out.record(k, &st, &self.offset);
+            if k + 1 == ns {
+                break;
+            }
+            for s in 0..sub {
+                let (parts, np) = pieces.of_substep(s, sub);
+                for (pi, &(fa, fb, pc)) in parts[..np].iter().enumerate() {
+                    drive.advance(&self.input, k, fa, fb);
+                    self.step_plant(&mut st, pc, &drive.w0, &drive.dw);
+                    let hit = self.step_play(&mut st, pc);
+                    if s + 1 == sub && pi + 1 == np {
+                        if let Some(hit) = hit {
+                            out.contact[k + 1] = hit;
+                        }
+                    }
+                }
+            }
+            if !st.x.iter().all(|v| v.is_finite()) {
+                out.diverged_after(k, ns, p);
+                break;
+            }
+        }
+        out.x_rms.iter_mut().for_each(|v| *v = (*v / ns as f64).sqrt());
+        out
+    }
+
+    /// `y = C x`.
+    #[inline]
+    fn output(&self, x: &[f64], y: &mut [f64]) {
+        let n = self.n;
+        for i in 0..self.p {
+            y[i] = (0..n).map(|j| self.C[i * n + j] * x[j]).sum();
+        }
+    }
+
+    /// The state at `t = 0`: `x0`, `y = C x0`, `z = z0` (with a play) or `y`.
+    fn start(&self, x0: &[f64], z0: Option<&[f64]>) -> RunState {
+        let (n, p) = (self.n, self.p);
+        let mut st = RunState {
+            x: x0.to_vec(),
+            xn: vec![0.0; n],
+            q: vec![0.0; p],
+            z: vec![0.0; p],
+            y: vec![0.0; p],
+            v: vec![0.0; p],
+            scratch: vec![0.0; p],
+            qp: vec![0.0; p],
+        };
+        self.output(&st.x, &mut st.y);
+        st.z.copy_from_slice(&st.y);
+        if let (Some(z0), true) = (z0, self.has_play()) {
+            st.z.copy_from_slice(z0);
+            for i in 0..p {
+                st.q[i] = st.z[i] - st.y[i];
+            }
+        }
+        st
+    }
+
+    /// The plant over one piece: the exact linear step with `q` and the forces held, then the
+    /// cogging and friction forces; `x` advances and `y = C x`.
+    #[inline]
+    fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
+        let (n, m, p) = (self.n, self.m, self.p);
+        let mp = pc.maps;
+        let (x, xn) = (&st.x, &mut st.xn);
+        for i in 0..n {
+            let mut acc = 0.0;
+            for j in 0..n {
+                acc += mp.Phi[i * n + j] * x[j];
+            }
+            for j in 0..m {
+                acc += mp.PsiB[i * m + j] * w0[j] + mp.Psi1B[i * m + j] * dw[j];
+            }
+            for j in 0..p {
+                acc += mp.PsiE[i * p + j] * st.q[j];
+            }
+            if self.forces.has_force {
+                acc += pc.fb[i];
+            }
+            xn[i] = acc;
+        }
+        self.forces.apply(x, xn, &mp.Psi);
+        std::mem::swap(&mut st.x, &mut st.xn);
+        self.output(&st.x, &mut st.y);
+    }
+
+    /// The play over one piece: `z` coasts (with inertia), `q` is projected into `Theta` and
+    /// `z = y + q`. Returns whether the play is in contact (`None` without a play: `z = y`).
+    #[inline]
+    fn step_play(&self, st: &mut RunState, pc: &Piece) -> Option<bool> {
+        if !self.has_play() {
+            st.z.copy_from_slice(&st.y);
+            return None;
+        }
+        let p = self.p;
+        // z_pred: massless output stays; with inertia it coasts.
+        for i in 0..p {
+            st.scratch[i] = st.z[i] + st.v[i] * pc.coast;
+            st.q[i] = st.scratch[i] - st.y[i];
+        }
+        // The deviation before projection: the contact is decided on `q` itself
+        // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
+        // a contact and slow the coasting decay spuriously).
+        st.qp.copy_from_slice(&st.q);
+        let hit = self.play.project_q(&mut st.q, &mut st.scratch);
+        for i in 0..p {
+            let znew = st.y[i] + st.q[i];
+            if self.inertia_tau > 0.0 {
+                st.v[i] = if st.q[i] != st.qp[i] { (znew - st.z[i]) / pc.maps.h } else { st.v[i] * pc.decay };
+            }
+            st.z[i] = znew;
+        }
+        Some(hit)
+    }
+}
+
+/// Simulates `sys` with its own `[[effects]]` from `(sys.x0, sys.z0)` for `steps` steps of `h`
+/// (the input sampled at `k h` and interpolated linearly in between, as the catching-up
+/// scheme does), recording every `record_every`-th sample and the last. The trajectory's `y`
+/// includes the sensor offset. Without effects this is the catching-up scheme of eq. (zdot)
+/// (a test checks the two agree).
+pub fn simulate_trajectory(
+    sys: &System,
+    h: f64,
+    steps: usize,
+    record_every: usize,
+) -> Result<Trajectory, DynamicsError> {
+    check_dt(h)?;
+    let (n, m, p) = (sys.n(), sys.m(), sys.p());
+    let ns = steps + 1;
+    let mut w = vec![0.0; ns * m];
+    for k in 0..ns {
+        sys.input.eval(k as f64 * h, &mut w[k * m..(k + 1) * m]);
+    }
+    let ext = ExtendedModel::new(sys, &[], h, 1)?;
+    let out = ext.simulate_from(&w, h, sys.x0.as_slice(), Some(sys.z0.as_slice()));
+    if !out.finite {
+        let k = (0..ns).find(|&k| !out.x[k * n..(k + 1) * n].iter().all(|v| v.is_finite())).unwrap_or(steps);
+        return Err(DynamicsError::NonFinite { t: k as f64 * h });
+    }
+    let every = record_every.max(1);
+    let mut tr = Trajectory::new(n, m, p);
+    tr.y_offset = ext.sensor_offset().to_vec();
+    for k in (0..ns).filter(|&k| k % every == 0 || k == steps) {
+        tr.push(k as f64 * h, &w[k * m..(k + 1) * m], &out.x[k * n..(k + 1) * n], &out.z[k * p..(k + 1) * p]);
+    }
+    Ok(tr)
+}
+
+/// The regime reached by simulating a model with `[[effects]]` under a `T`-periodic input (the
+/// paper's uniqueness argument does not cover effects, so no fixed point is claimed: the
+/// residuals say whether successive periods still differ).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub struct SimulatedRegime {
+    pub period: f64,
+    pub h: f64,
+    pub steps_per_period: usize,
+    pub periods: usize,
+    /// State at the start of the last simulated period.
+    pub x0: Vec<f64>,
+    pub z0: Vec<f64>,
+    /// `max |(x, z)(kT) - (x, z)((k-1)T)|_inf` for `k = 1..=periods`.
+    pub residuals: Vec<f64>,
+    /// Path length of `z` over the last period.
+    pub path_length_last_period: f64,
+    /// `max |z'|` over the last period (difference quotients).
+    pub max_z_speed_last_period: f64,
+}
+
+/// Simulates `periods` periods of `sys` (with its effects) at a step close to `dt` dividing
+/// the period; see [`SimulatedRegime`].
+pub fn regime_by_simulation(sys: &System, dt: f64, periods: usize) -> Result<SimulatedRegime, DynamicsError> {
+    let T = sys.period().ok_or(DynamicsError::NotPeriodic { kind: sys.input.kind() })?;
+    if periods == 0 {
+        return Err(DynamicsError::ZeroPeriods { periods });
+    }
+    let (spp, h) = steps_per_period(T, dt)?;
+    let tr = simulate_trajectory(sys, h, spp * periods, 1)?;
+    let state = |k: usize| -> Vec<f64> { tr.x_at(k).iter().chain(tr.z_at(k)).copied().collect() };
+    let residuals = (1..=periods)
+        .map(|k| {
+            let (a, b) = (state(k * spp), state((k - 1) * spp));
+            a.iter().zip(&b).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max)
+        })
+        .collect();
+    let start = (periods - 1) * spp;
+    let (mut path, mut speed) = (0.0f64, 0.0f64);
+    for k in start..start + spp {
+        let dz = geometry::linalg::dist(tr.z_at(k + 1), tr.z_at(k));
+        path += dz;
+        speed = speed.max(dz / h);
+    }
+    Ok(SimulatedRegime {
+        period: T,
+        h,
+        steps_per_period: spp,
+        periods,
+        x0: tr.x_at(start).to_vec(),
+        z0: tr.z_at(start).to_vec(),
+        residuals,
+        path_length_last_period: path,
+        max_z_speed_last_period: speed,
+    })
+}
