@@ -10,12 +10,17 @@
 //!   production kernels of `bounds::tube` (the numbers `moreau theta` prints), not a copy;
 //! - [`campaign`]: the deterministic runner (cases, minimum normalised slack, violations,
 //!   shrunk counterexample).
+//! - [`seeding`]: the deterministic ChaCha generator of a chunk of cases (`seed`, property
+//!   name, chunk), used by the runner and by [`strategies::draw`].
+//!
+//! Layers, bottom up: `seeding` -> `strategies` -> `properties` -> `campaign`.
 //!
 //! Where each result is computed, tested and what the campaign found: `proofs-notes/`.
 #![allow(non_snake_case)]
 
 pub mod campaign;
 pub mod properties;
+pub mod seeding;
 pub mod strategies;
 
 pub use campaign::{registry, run, run_property, CampaignError, CampaignSettings, PropertyReport};

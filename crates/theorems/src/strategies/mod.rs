@@ -14,7 +14,7 @@ pub fn draw<T: std::fmt::Debug>(strategy: &proptest::strategy::BoxedStrategy<T>,
     use proptest::strategy::{Strategy, ValueTree};
     let mut runner = proptest::test_runner::TestRunner::new_with_rng(
         proptest::test_runner::Config::default(),
-        crate::campaign::chunk_rng(seed, "draw", 0),
+        crate::seeding::chunk_rng(seed, "draw", 0),
     );
     (0..count).map(|_| strategy.new_tree(&mut runner).expect("strategies never reject").current()).collect()
 }
