@@ -5,7 +5,7 @@
 //!
 //! Pipeline ([`diagnose::diagnose`]):
 //! 1. [`recording`]: read and check the CSV, resample irregular time stamps to a uniform grid.
-//! 2. [`simulate`] (= `dynamics::extended`): free-run simulation of the model extended by [`model::effects`]
+//! 2. [`dynamics::extended`]: free-run simulation of the model extended by [`model::effects`]
 //!    (exact linear step, catching-up projection for the play, implicit stick-slip friction).
 //! 3. [`metrics`]: fit % and RMSE on the validation segment (the last 30 % of the record).
 //! 4. [`residual`]: whiteness and input cross-correlation tests of the nominal residual.
@@ -38,8 +38,6 @@ pub mod play_width;
 pub mod recording;
 pub mod residual;
 pub mod select;
-/// The extended-model simulator lives in `dynamics` (one simulator for every command).
-pub use dynamics::extended as simulate;
 
 pub use diagnose::{diagnose, DiagnoseSettings, HoldChoice, InitialState, Report};
 pub use error::DiscoveryError;
