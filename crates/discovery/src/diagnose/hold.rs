@@ -73,7 +73,6 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
 ///
 /// Returns the other hold and the note that explains the switch where one of them fits better
 /// under it (then `report` states the switch); `None` where the choice stands.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn overturned_by_effects(
     data: &Setup,
     ctx: &FitContext,

@@ -179,7 +179,6 @@ fn initial_state(data: &Setup, pass: &Pass, nothing_chosen: bool, notes: &mut Ve
 }
 
 /// The report of the stages' results.
-#[allow(clippy::too_many_arguments)]
 fn assemble(
     data: &Setup,
     pass: Pass,

@@ -157,7 +157,6 @@ fn nominal_values(data: &Setup, chosen: Option<&Ranked>, unc: &Uncertainty) -> V
 
 /// `fitted.toml`'s system: the model file's with the fitted nominal parameters (grey-box
 /// refit), the selected effects, the fitted initial state, and the recording's input.
-#[allow(clippy::too_many_arguments)]
 fn fitted_system(
     data: &Setup,
     ctx: &FitContext,

@@ -90,7 +90,6 @@ pub(crate) fn failed_fit(p: usize) -> Fit {
 
 /// Fits one (composite) hypothesis on the estimation segment; `refit`: the freed nominal
 /// parameters are fitted too, from these values.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_hypothesis(
     ctx: &FitContext,
     plan: &Plan,
