@@ -3,7 +3,7 @@
 //! machine, find where simulation and recording disagree, name the physical effect the model
 //! lacks, add it, refit, and show the improvement on a validation segment fitting never saw.
 //!
-//! Pipeline ([`diagnose::diagnose`], a list of named stages: see [`diagnose`]'s module map):
+//! Pipeline ([`diagnose::diagnose`], a list of named stages: see [`diagnose`](mod@diagnose)'s module map):
 //! 1. [`recording`]: read and check the CSV, resample irregular time stamps to a uniform grid.
 //! 2. [`dynamics::extended`]: free-run simulation of the model extended by [`model::effects`]
 //!    (exact linear step, catching-up projection for the play, implicit stick-slip friction).
@@ -16,7 +16,7 @@
 //!    evidence against their effect); [`select`]: BIC with a margin (plus the remaining
 //!    discretisation error's worth) and blocked cross-validation over contiguous folds
 //!    ("not testable" where an effect lives in one fold), greedy forward selection.
-//! 7. [`diagnose`]: the verdict, the fitted model (`fitted.toml`) and the report
+//! 7. [`diagnose`](mod@diagnose): the verdict, the fitted model (`fitted.toml`) and the report
 //!    ([`diagnose::report`], rendered as `report.md`), from [`diagnose::settings`].
 //!
 //! Before fitting: the input hold between samples (zero-/first-order, `auto` from the data)

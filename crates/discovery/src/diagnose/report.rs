@@ -138,7 +138,7 @@ pub struct Report {
     pub fit_before: Fit,
     /// Selected model on the validation segment.
     pub fit_after: Fit,
-    /// `fit` or `rmse`: what the verdict's headline states (see [`Metric`]).
+    /// `fit` or `rmse`: what the verdict's headline states (see [`Metric`](super::settings::Metric)).
     pub headline_metric: &'static str,
     /// The verdict's metric part (fit % or RMSE in units, velocity RMSE and fit %).
     pub headline: String,

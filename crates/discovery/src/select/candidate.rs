@@ -1,6 +1,6 @@
 //! One hypothesis (single or composite, with or without the grey-box refit of the freed
 //! nominal parameters) fitted on the estimation segment and scored: BIC against the nominal
-//! model, fit % and SSE on the validation segment. [`fit_singles`] fits every single
+//! model, fit % and SSE on the validation segment. `fit_singles` fits every single
 //! hypothesis of the library.
 use super::context::FitContext;
 use super::{bic, Plan};
