@@ -1,8 +1,8 @@
 //! Speed of `diagnose` on a 50,000-sample recording against all hypotheses (rayon over
 //! hypotheses; run with RAYON_NUM_THREADS=2 for the 2-core target of <= 30 s).
 use criterion::{criterion_group, criterion_main, Criterion};
-use discovery::simulate::ExtendedModel;
 use discovery::{diagnose, DiagnoseSettings, Recording};
+use dynamics::extended::ExtendedModel;
 
 fn long_recording() -> (model::System, Recording) {
     let case = discovery::bench_gen::generate("coulomb_friction", 3, 0);

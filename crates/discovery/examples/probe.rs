@@ -4,7 +4,7 @@
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
-use discovery::simulate::StepMaps;
+use dynamics::extended::StepMaps;
 use model::effects::Effect;
 
 fn main() {
@@ -119,7 +119,7 @@ fn main() {
                 weights: vec![1.0 / sd],
                 maps: maps.clone(),
                 substeps: sub,
-                hold: discovery::simulate::InputHold::Foh,
+                hold: dynamics::extended::InputHold::Foh,
                 z0: None,
                 exclude: None,
                 refit: None,

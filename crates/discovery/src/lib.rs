@@ -3,9 +3,9 @@
 //! machine, find where simulation and recording disagree, name the physical effect the model
 //! lacks, add it, refit, and show the improvement on a validation segment fitting never saw.
 //!
-//! Pipeline ([`diagnose::diagnose`]):
+//! Pipeline ([`diagnose::diagnose`], a list of named stages: see [`diagnose`](mod@diagnose)'s module map):
 //! 1. [`recording`]: read and check the CSV, resample irregular time stamps to a uniform grid.
-//! 2. [`simulate`] (= `dynamics::extended`): free-run simulation of the model extended by [`model::effects`]
+//! 2. [`dynamics::extended`]: free-run simulation of the model extended by [`model::effects`]
 //!    (exact linear step, catching-up projection for the play, implicit stick-slip friction).
 //! 3. [`metrics`]: fit % and RMSE on the validation segment (the last 30 % of the record).
 //! 4. [`residual`]: whiteness and input cross-correlation tests of the nominal residual.
@@ -16,6 +16,8 @@
 //!    evidence against their effect); [`select`]: BIC with a margin (plus the remaining
 //!    discretisation error's worth) and blocked cross-validation over contiguous folds
 //!    ("not testable" where an effect lives in one fold), greedy forward selection.
+//! 7. [`diagnose`](mod@diagnose): the verdict, the fitted model (`fitted.toml`) and the report
+//!    ([`diagnose::report`], rendered as `report.md`), from [`diagnose::settings`].
 //!
 //! Before fitting: the input hold between samples (zero-/first-order, `auto` from the data)
 //! and the sub-steps per sample by convergence against the noise level ([`discretisation`]);
@@ -38,8 +40,6 @@ pub mod play_width;
 pub mod recording;
 pub mod residual;
 pub mod select;
-/// The extended-model simulator lives in `dynamics` (one simulator for every command).
-pub use dynamics::extended as simulate;
 
 pub use diagnose::{diagnose, DiagnoseSettings, HoldChoice, InitialState, Report};
 pub use error::DiscoveryError;

@@ -9,7 +9,7 @@
 //! SSE ratios throughout, so it is unaffected).
 //!
 //! Servo-grade metrics: a tightly tracking position loop fits 99.9 % whether or not the model
-//! is right, so fit % hides the result. [`headline`] then states the RMSE in the output's units
+//! is right, so fit % hides the result. [`headline_rmse`] then states the RMSE in the output's units
 //! (`[signals] y = "m"` in the model file) before -> after, and the same for the derived
 //! velocity ([`velocity`]: a filtered differentiation, identical on measurement and
 //! simulation) with its own fit %.

@@ -8,8 +8,8 @@
 //! `cargo run --release -p discovery --example bench_one 8 SEED classic friction`.
 use discovery::bench_gen::{self, FRICTION_CLASSES};
 use discovery::hypothesis::{self, Kind, Scales};
-use discovery::simulate::ExtendedModel;
 use discovery::DiagnoseSettings;
+use dynamics::extended::ExtendedModel;
 use model::effects::Effect;
 
 #[test]

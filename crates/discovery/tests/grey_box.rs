@@ -7,8 +7,8 @@
 //! `GREY_BOX_SEEDS` (default `1,2`: the development seeds) and plants per seed from
 //! `GREY_BOX_PLANTS` (default 8).
 use discovery::bench_gen::servo_loop::{self, mass_and_viscous};
-use discovery::simulate::{ExtendedModel, InputHold};
 use discovery::{diagnose, DiagnoseSettings, Recording};
+use dynamics::extended::{ExtendedModel, InputHold};
 
 /// Diagnoses a servo case; returns the report and the recovered (mass, viscous).
 fn run(case: &servo_loop::ServoCase, s: &DiagnoseSettings) -> (discovery::Report, f64, f64) {

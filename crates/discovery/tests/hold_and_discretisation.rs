@@ -6,8 +6,8 @@ use discovery::bench_gen::{self, Profile};
 use discovery::diagnose::HoldChoice;
 use discovery::fit::{self, FitSettings, FitStatus};
 use discovery::hypothesis::{self, Kind, Scales};
-use discovery::simulate::{ExtendedModel, InputHold};
 use discovery::{diagnose, DiagnoseSettings, InitialState, Recording};
+use dynamics::extended::{ExtendedModel, InputHold};
 use model::effects::Effect;
 
 fn scalar_sys() -> model::System {

@@ -4,7 +4,7 @@
 mod common;
 use discovery::fit::{self, FitSettings, LONG_RECORD};
 use discovery::hypothesis::{self, Kind};
-use discovery::simulate::ExtendedModel;
+use dynamics::extended::ExtendedModel;
 use model::effects::Effect;
 
 fn mass() -> model::System {

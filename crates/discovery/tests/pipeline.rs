@@ -1,8 +1,8 @@
 //! End-to-end tests of the diagnosis: a fixed-seed slice of the concealed-effect benchmark,
 //! effects that vanish at zero, stick-slip, bad input, and the fitted-model round trip.
 use discovery::bench_gen::{self, CLASSES};
-use discovery::simulate::ExtendedModel;
 use discovery::{diagnose, DiagnoseSettings, DiscoveryError, Recording};
+use dynamics::extended::ExtendedModel;
 use model::effects::{Effect, PlayLocation};
 
 #[test]

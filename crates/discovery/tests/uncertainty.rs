@@ -4,7 +4,7 @@ mod common;
 use discovery::fit::jackknife::{self, Estimate};
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::{self, Kind};
-use discovery::simulate::ExtendedModel;
+use dynamics::extended::ExtendedModel;
 use model::effects::Effect;
 
 fn mass(k: f64) -> model::System {

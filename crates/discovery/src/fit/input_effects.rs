@@ -14,7 +14,7 @@
 //! points. Clamp and play act on the sub-step values. `fitted.toml` then carries the input as
 //! the plant sees it (the model-file format has no per-input effects).
 use crate::hypothesis::{Hypothesis, Kind, Scales, DECADES, LEVEL_LOG_SHIFT};
-use crate::simulate::InputHold;
+use dynamics::extended::InputHold;
 use model::effects::{Effect, PlayLocation};
 use model::System;
 use serde::Serialize;

@@ -292,6 +292,9 @@ fn lm(
 ///
 /// With more than [`SCREENED_STARTS`] starts (decades of a level-like parameter), every start
 /// is first evaluated once and only the best [`SCREENED_STARTS`] are iterated.
+///
+/// Steps: `starts` -> `best_start` (screening and a few iterations from each) -> refinement
+/// of the best on the whole estimation segment -> `conclude` (covariance and status).
 pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>, s: &FitSettings) -> FitResult {
     let lo = pb.lower();
     let k = lo.len();
@@ -309,25 +312,72 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         Vars { pb, xs: xs.clone(), x0_fixed: x0_init.to_vec(), k, kn, ns: ns.clone(), nlo, nhi, k_end: pb.k_est };
     let mut evals = 0;
     if k == 0 && kn == 0 && xs.is_empty() {
-        // Nothing to fit: the nominal model from a known initial state.
-        let r = vars.res(&[], &mut evals);
-        let (cost, n_res, status) = match &r {
-            Some(r) => (sse(r), r.len(), FitStatus::Converged),
-            None => (f64::INFINITY, 0, FitStatus::Failed),
-        };
-        return FitResult {
-            theta: vec![],
-            std: vec![],
-            nominal: vec![],
-            nominal_std: vec![],
-            x0: x0_init.to_vec(),
-            sse: cost,
-            n_res,
-            status,
-            evaluations: evals,
-        };
+        return nothing_to_fit(&vars, x0_init, &mut evals);
     }
     let x0v: Vec<f64> = if xs.is_empty() { vec![] } else { x0_init.iter().zip(&xs).map(|(a, b)| a / b).collect() };
+    let starts = starts(pb, k, warm, &nomv, &x0v);
+    // Long records: screening and the start iterations see a leading part of the estimation
+    // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
+    // see all of it, from the best start. Several starts only: a single (warm) start goes
+    // straight to the whole segment.
+    let short;
+    let start_vars = if starts.len() > 1 && pb.k_est >= s.long_record {
+        short = Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() };
+        &short
+    } else {
+        &vars
+    };
+    let best = best_start(start_vars, starts, s, &mut evals);
+    let failed = |evals: usize| FitResult {
+        theta: lo.clone(),
+        std: vec![f64::NAN; k],
+        nominal: nom0.clone(),
+        nominal_std: vec![f64::NAN; kn],
+        x0: x0_init.to_vec(),
+        sse: f64::INFINITY,
+        n_res: 0,
+        status: FitStatus::Failed,
+        evaluations: evals,
+    };
+    let Some(b) = best else { return failed(evals) };
+    let refined = match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
+        Some(done) => Some(done),
+        // the best start's residual is of the leading part after a short start phase: the
+        // fallback is evaluated on the whole segment
+        None if start_vars.k_end < vars.k_end => vars.res(&b.0, &mut evals).map(|r| {
+            let c = sse(&r);
+            (b.0, r, c, false)
+        }),
+        None => Some(b),
+    };
+    let Some(done) = refined else { return failed(evals) };
+    conclude(&vars, done, s, evals)
+}
+
+/// Nothing to fit: the nominal model from a known initial state.
+fn nothing_to_fit(vars: &Vars, x0_init: &[f64], evals: &mut usize) -> FitResult {
+    let r = vars.res(&[], evals);
+    let (cost, n_res, status) = match &r {
+        Some(r) => (sse(r), r.len(), FitStatus::Converged),
+        None => (f64::INFINITY, 0, FitStatus::Failed),
+    };
+    FitResult {
+        theta: vec![],
+        std: vec![],
+        nominal: vec![],
+        nominal_std: vec![],
+        x0: x0_init.to_vec(),
+        sse: cost,
+        n_res,
+        status,
+        evaluations: *evals,
+    }
+}
+
+/// The starts in solver units (`k` effect parameters): start `i` of every part together, then the
+/// freed nominal parameters `nomv` and the scaled initial state `x0v`. A warm start keeps the
+/// given leading parameters and takes the starts of the parts beyond them.
+fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64]) -> Vec<Vec<f64>> {
     let nstart = if warm.is_some_and(|w| w.len() >= k) {
         1
     } else {
@@ -358,65 +408,48 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
             starts.push(v);
         }
     }
-    // Long records: screening and the start iterations see a leading part of the estimation
-    // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
-    // see all of it, from the best start. Several starts only: a single (warm) start goes
-    // straight to the whole segment.
-    let short;
-    let start_vars = if starts.len() > 1 && pb.k_est >= s.long_record {
-        short = Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() };
-        &short
-    } else {
-        &vars
-    };
+    starts
+}
+
+/// Screens the starts (more than [`SCREENED_STARTS`]: the best by their first cost), runs
+/// `max_iter_start` iterations from each kept one and returns the best end point.
+fn best_start(
+    vars: &Vars,
+    mut starts: Vec<Vec<f64>>,
+    s: &FitSettings,
+    evals: &mut usize,
+) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
     if starts.len() > SCREENED_STARTS {
-        let mut scored: Vec<(f64, Vec<f64>)> = starts
-            .into_iter()
-            .map(|v| (start_vars.res(&v, &mut evals).map_or(f64::INFINITY, |r| sse(&r)), v))
-            .collect();
+        let mut scored: Vec<(f64, Vec<f64>)> =
+            starts.into_iter().map(|v| (vars.res(&v, evals).map_or(f64::INFINITY, |r| sse(&r)), v)).collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
         starts = scored.into_iter().take(SCREENED_STARTS).map(|(_, v)| v).collect();
     }
     let mut best: Option<(Vec<f64>, Vec<f64>, f64, bool)> = None;
     for v in starts {
-        if let Some(res) = lm(start_vars, v, s.max_iter_start, s, &mut evals) {
+        if let Some(res) = lm(vars, v, s.max_iter_start, s, evals) {
             if best.as_ref().is_none_or(|b| res.2 < b.2) {
                 best = Some(res);
             }
         }
     }
-    let failed = |evals: usize| FitResult {
-        theta: lo.clone(),
-        std: vec![f64::NAN; k],
-        nominal: nom0.clone(),
-        nominal_std: vec![f64::NAN; kn],
-        x0: x0_init.to_vec(),
-        sse: f64::INFINITY,
-        n_res: 0,
-        status: FitStatus::Failed,
-        evaluations: evals,
-    };
-    let Some(b) = best else { return failed(evals) };
-    let refined = match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
-        Some(done) => Some(done),
-        // the best start's residual is of the leading part after a short start phase: the
-        // fallback is evaluated on the whole segment
-        None if start_vars.k_end < vars.k_end => vars.res(&b.0, &mut evals).map(|r| {
-            let c = sse(&r);
-            (b.0, r, c, false)
-        }),
-        None => Some(b),
-    };
-    let Some((v, r, cost, conv)) = refined else { return failed(evals) };
+    best
+}
+
+/// The result at the solution `(v, r, cost, converged)`: parameters in physical units, their
+/// 1-sigma (the larger of Gauss-Newton and the batch-means sandwich) and the fit's status.
+fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings, mut evals: usize) -> FitResult {
+    let (v, r, cost, conv) = done;
+    let (pb, k, kn) = (vars.pb, vars.k, vars.kn);
     // Gauss-Newton covariance of the effect parameters.
-    let J = jacobian(&vars, &v, &r, s.tol_fd, &mut evals);
+    let J = jacobian(vars, &v, &r, s.tol_fd, &mut evals);
     let nres = r.len();
     let dof = (nres as f64 - v.len() as f64).max(1.0);
     let s2 = cost / dof;
     let JtJ = J.transpose() * &J;
     let slope = pb.slope(&v[..k]);
     // Physical units per solver unit: effect slopes, then the nominal scales.
-    let unit: Vec<f64> = slope.iter().map(|s| s.abs()).chain(ns.iter().copied()).collect();
+    let unit: Vec<f64> = slope.iter().map(|s| s.abs()).chain(vars.ns.iter().copied()).collect();
     let std_all: Vec<f64> = match JtJ.clone().try_inverse() {
         Some(inv) => {
             // The larger of the white-noise and the coloured-residual (batch-means sandwich)

@@ -11,7 +11,7 @@
 use crate::fit::input_effects::{self, InputOp};
 use crate::fit::nominal::Refit;
 use crate::hypothesis::{Hypothesis, Kind, Scales};
-use crate::simulate::{ExtendedModel, InputHold, SimOutput, StepMaps};
+use dynamics::extended::{ExtendedModel, InputHold, SimOutput, StepMaps};
 use model::effects::Effect;
 use model::System;
 

@@ -119,6 +119,27 @@ pub fn test(e: &[f64], u: &[Vec<f64>], lags: usize, lag_step: usize) -> Residual
     }
 }
 
+/// The tests of every output of a time-major residual `e` (`n` samples of `p` outputs) against
+/// every input of `w` (`n` samples of `m` inputs): white, uncorrelated and zero-mean only when
+/// every output is; the statistics are those of the first output.
+pub fn test_outputs(e: &[f64], w: &[f64], n: usize, m: usize, p: usize, lags: usize, lag_step: usize) -> ResidualTests {
+    let mut t: Option<ResidualTests> = None;
+    let us: Vec<Vec<f64>> = (0..m).map(|j| (0..n).map(|k| w[k * m + j]).collect()).collect();
+    for i in 0..p {
+        let ei: Vec<f64> = (0..n).map(|k| e[k * p + i]).collect();
+        let ti = test(&ei, &us, lags, lag_step);
+        t = Some(match t {
+            None => ti,
+            Some(prev) => {
+                let (white, unc, zm) =
+                    (prev.white && ti.white, prev.uncorrelated && ti.uncorrelated, prev.zero_mean && ti.zero_mean);
+                ResidualTests { white, uncorrelated: unc, zero_mean: zm, ..prev }
+            }
+        });
+    }
+    t.expect("p >= 1")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,7 +1,7 @@
 //! Shared by the integration tests that drive the solver directly.
 use discovery::fit::Problem;
 use discovery::hypothesis::{Hypothesis, Scales};
-use discovery::simulate::{InputHold, StepMaps};
+use dynamics::extended::{InputHold, StepMaps};
 
 /// The least-squares problem of one hypothesis on a one-input, one-output record: estimation
 /// segment `[0, k_est)`, output weight `weight`, `substeps` per sample with a first-order hold,

@@ -1,0 +1,245 @@
+//! The diagnosis pipeline: nominal fit, residual tests, localisation, hypotheses, selection,
+//! fitted model and report.
+//!
+//! Segments: the first `estimation_fraction` (default 70 %) of the record is the estimation
+//! segment (every hypothesis is fitted on it and ranked by BIC there); the rest is the
+//! validation segment, simulated free-running from the start of the record with the
+//! estimation fit (the fit % reported). A candidate is accepted by blocked cross-validation
+//! over `cv_folds` contiguous folds of the whole record (each fold held out in turn, the
+//! hypothesis and the nominal refitted on the others, the held-out fold predicted by a
+//! free run through it), not by one validation segment.
+//!
+//! Before any of that: the input hold (zero- or first-order, `auto` by the nominal fit), the
+//! sub-steps per sample (by convergence against the noise level, see [`crate::discretisation`])
+//! and the initial state (the model file's when it states one, else estimated).
+//!
+//! [`diagnose`] runs the stages in order, each in its own place:
+//! 1. [`settings`]: [`DiagnoseSettings::validate`] against the model and the recording;
+//!    `setup`: the recording prepared (signals, weights, noise level, scales, initial state).
+//! 2. `hold`: hold and discretisation, then the nominal fit under them.
+//! 3. `pass`: nominal residual -> localisation -> hypotheses -> selection and
+//!    cross-validation ([`crate::select`]); the pass is redone where the best effects overturn
+//!    an `auto` hold or the selected model needs more sub-steps.
+//! 4. Conclusion (here): recorded columns the model leaves out, the initial state.
+//! 5. `refit`: the selected model's uncertainty (jackknife) and the fitted model
+//!    (`fitted.toml`).
+//! 6. Report: `verdict` (headline and text), `notes`, [`report`] (the types of
+//!    `report.json`) and `markdown` (`report.md`, [`Report::to_markdown`]).
+pub mod report;
+pub mod settings;
+
+mod hold;
+mod markdown;
+mod notes;
+mod pass;
+mod refit;
+mod setup;
+mod verdict;
+
+pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
+pub use report::{
+    FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Report, Series, FITTED_INPUT_FILE,
+};
+pub use settings::{DiagnoseSettings, HoldChoice, InitialState, Metric, SERVO_FIT_PERCENT};
+
+use crate::fit::missing_input::{self, MissingInput, MISSING_MARGIN, MISSING_SHARE};
+use crate::metrics::{self, Fit};
+use crate::select::{self, Selection};
+use crate::{DiscoveryError, Recording};
+use model::System;
+use pass::{NominalFindings, Pass};
+use refit::{Fitted, Uncertainty};
+use setup::Setup;
+use verdict::Headline;
+
+/// Diagnoses `rec` against nominal model `sys`.
+pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<Report, DiscoveryError> {
+    s.validate(sys, rec)?;
+    let data = Setup::new(sys, rec, s)?;
+    // Hold and discretisation, then the nominal fit under them.
+    let mut pass = Pass::first(&data);
+    // Nominal residual -> localisation -> hypotheses -> selection and cross-validation,
+    // redone where the effects overturn the hold or the selected model needs more sub-steps.
+    let (nominal, selection) = pass.run(&data)?;
+    let mut notes = std::mem::take(&mut pass.notes);
+    // What the selection leaves standing: missing inputs, the initial state.
+    let mut outcome = conclude(&data, &pass, &nominal, selection, &mut notes);
+    notes::selection(&data, &pass, nominal.delta_bic_disc, &outcome.cv_rejected, &mut notes);
+    // Refit: the selected model's uncertainty and the fitted model.
+    let unc = refit::uncertainty(&data, &pass.ctx, outcome.chosen.as_mut());
+    let chosen = outcome.chosen.as_ref();
+    let fitted = refit::fitted(&data, &pass.ctx, pass.hold, &pass.nom, &nominal.nom_sim, chosen, &unc, &mut notes);
+    // Report: headline, verdict, notes.
+    let headline = verdict::headline(&data, &outcome.fit_before, &fitted.fit_after, &mut notes);
+    let verdict = verdict::verdict(
+        nominal.nominal_adequate,
+        &outcome.missing_inputs,
+        outcome.chosen.as_ref(),
+        &fitted.nominal_refit,
+        &outcome.cv_rejected,
+        &headline.text,
+    );
+    notes::closing(&data, &pass, &outcome, &fitted, headline.use_rmse, &mut notes);
+    Ok(assemble(&data, pass, nominal, outcome, unc, fitted, headline, verdict, notes))
+}
+
+/// What the selection leaves standing.
+struct Outcome {
+    /// Nominal model on the validation segment.
+    fit_before: Fit,
+    ranking: Vec<Ranked>,
+    /// The selected model (`None` too where a recorded input is missing from the model).
+    chosen: Option<Ranked>,
+    ties: Vec<String>,
+    cv_rejected: Vec<(String, f64, String)>,
+    missing_inputs: Vec<MissingInput>,
+    initial_state: InitialStateReport,
+}
+
+/// The nominal model's validation fit, the recorded columns the model leaves out (an input
+/// the model lacks is not physics to be stood in for by an effect: nothing is selected then),
+/// and the initial state.
+fn conclude(
+    data: &Setup,
+    pass: &Pass,
+    nominal: &NominalFindings,
+    selection: Selection,
+    notes: &mut Vec<String>,
+) -> Outcome {
+    let (ctx, nom_sim) = (&pass.ctx, &nominal.nom_sim);
+    let (p, k_est, n_samp) = (data.p, data.k_est, data.n_samp);
+    let mut fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, data.dt);
+    fit_before.tracking_fit_percent =
+        metrics::tracking_fit(&ctx.y, &nom_sim.y, &ctx.w, (p, ctx.m), &data.sys.signals.reference, k_est, n_samp);
+    let Selection { ranking, mut chosen, mut ties, cv_rejected } = selection;
+    let missing_inputs = missing_inputs(data, pass, nominal, &ranking);
+    if missing_inputs.iter().any(|c| c.missing) {
+        // An input the model leaves out is not physics to be stood in for by an effect.
+        chosen = None;
+        ties.clear();
+    }
+    let initial_state = initial_state(data, pass, chosen.is_none(), notes);
+    Outcome { fit_before, ranking, chosen, ties, cv_rejected, missing_inputs, initial_state }
+}
+
+/// Recorded columns the model does not use: does the residual follow one of them?
+fn missing_inputs(data: &Setup, pass: &Pass, nominal: &NominalFindings, ranking: &[Ranked]) -> Vec<MissingInput> {
+    let rec = data.rec;
+    if nominal.nominal_adequate || rec.extra.is_empty() {
+        return vec![];
+    }
+    let best = ranking
+        .iter()
+        .filter(|r| r.sse_estimation.is_finite())
+        .min_by(|a, b| a.sse_estimation.total_cmp(&b.sse_estimation));
+    let (best_share, best_label) = best
+        .map(|r| ((1.0 - r.sse_estimation / pass.nom.sse.max(1e-300)).max(0.0), r.label.clone()))
+        .unwrap_or((0.0, "none".into()));
+    let ctx = &pass.ctx;
+    rec.extra
+        .iter()
+        .filter_map(|(name, u)| {
+            let share = missing_input::explained_share(
+                data.sys,
+                u,
+                &nominal.e_nom,
+                &ctx.weights,
+                data.k_est,
+                data.dt,
+                ctx.substeps,
+                pass.hold,
+            )?;
+            Some(MissingInput {
+                column: name.clone(),
+                explained: share,
+                best_hypothesis_explained: best_share,
+                best_hypothesis: best_label.clone(),
+                missing: share >= MISSING_SHARE && share > best_share + MISSING_MARGIN,
+            })
+        })
+        .collect()
+}
+
+/// The initial state used; with the model file's `x0`, how much freeing it would gain (a note
+/// where that clears the margin and nothing was selected).
+fn initial_state(data: &Setup, pass: &Pass, nothing_chosen: bool, notes: &mut Vec<String>) -> InitialStateReport {
+    let nom = &pass.nom;
+    if !data.x0_fixed {
+        return InitialStateReport { source: "estimated", x0: nom.x0.clone(), delta_bic_free: None };
+    }
+    let bic_nom = select::bic(nom.sse, data.n_res, pass.ctx.x_scale.len());
+    let free = data.fit_nominal(&data.context(pass.hold, pass.ctx.substeps, data.x_scale_free.clone()));
+    let d = bic_nom - select::bic(free.sse, data.n_res, data.nx);
+    if d > data.s.select.margin_bic && nothing_chosen {
+        notes.push(format!(
+            "The model file's initial state may not match the start of the recording: with the nominal model, estimating it would gain {d:.1} in BIC. Run with --estimate-x0 if the file's x0 is not the recorded machine's."
+        ));
+    }
+    InitialStateReport { source: "model file", x0: nom.x0.clone(), delta_bic_free: Some(d) }
+}
+
+/// The report of the stages' results.
+fn assemble(
+    data: &Setup,
+    pass: Pass,
+    nominal: NominalFindings,
+    outcome: Outcome,
+    unc: Uncertainty,
+    fitted: Fitted,
+    headline: Headline,
+    verdict: String,
+    notes: Vec<String>,
+) -> Report {
+    let (rec, n_samp, k_est) = (data.rec, data.n_samp, data.k_est);
+    let loc = nominal.loc;
+    let series = Series {
+        t: (0..n_samp).map(|k| rec.time(k)).collect(),
+        p: data.p,
+        y: pass.ctx.y.clone(),
+        yhat_nominal: nominal.nom_sim.y.clone(),
+        yhat_fitted: fitted.fit_sim.y.clone(),
+        energy: loc.energy.clone(),
+    };
+    Report {
+        model: data.sys.name.clone(),
+        recording: rec.source.clone(),
+        samples: n_samp,
+        dt: data.dt,
+        resampled: rec.resampled,
+        substeps: pass.ctx.substeps,
+        hold: pass.hold_report,
+        discretisation: pass.disc,
+        discretisation_final: pass.disc_final,
+        noise_level: data.noise.clone(),
+        delta_bic_discretisation: nominal.delta_bic_disc,
+        initial_state: outcome.initial_state,
+        estimation_segment: [rec.time(0), rec.time(k_est - 1)],
+        validation_segment: [rec.time(k_est), rec.time(n_samp - 1)],
+        tau_slow: data.tau_slow,
+        fit_before: outcome.fit_before,
+        fit_after: fitted.fit_after,
+        headline_metric: headline.metric,
+        headline: headline.text,
+        units: headline.units,
+        nominal_refit: fitted.nominal_refit,
+        free_parameters: data.free_nominal.as_ref().map(|f| f.names()).unwrap_or_default(),
+        missing_inputs: outcome.missing_inputs,
+        residual_nominal: nominal.residual_nominal,
+        residual_fitted: fitted.residual_fitted,
+        nominal_adequate: nominal.nominal_adequate,
+        verdict,
+        effects: fitted.effects,
+        uncertainty_method: unc.method,
+        jackknife: unc.jack,
+        ties: outcome.ties,
+        windows: loc.windows,
+        regimes: loc.regimes,
+        velocity_windows: loc.velocity_windows,
+        velocity_regimes: loc.velocity_regimes,
+        localisation: LocalisationInfo { scales: loc.scales, null: loc.null },
+        ranking: outcome.ranking,
+        notes,
+        fitted_model: Some(fitted.system),
+        series,
+    }
+}

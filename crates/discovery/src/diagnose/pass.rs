@@ -1,0 +1,175 @@
+//! One pass of the pipeline under an input hold and a sub-step count: nominal residual ->
+//! localisation -> hypotheses -> selection and cross-validation ([`Pass::once`]).
+//!
+//! A pass ends in a restart (the next pass starts from the singles of this one) where
+//! - the best effects overturn an `auto` hold ([`super::hold::overturned_by_effects`], once), or
+//! - the selected model needs more sub-steps than the nominal (once): the whole selection is
+//!   rerun at the sub-steps it needs.
+use super::hold;
+use super::report::HoldReport;
+use super::setup::Setup;
+use crate::discretisation::{self, SubstepCheck};
+use crate::fit::FitResult;
+use crate::localise::{self, Localisation};
+use crate::residual::ResidualTests;
+use crate::select::{self, FitContext, Ranked, Selection};
+use crate::DiscoveryError;
+use dynamics::extended::{ExtendedModel, InputHold, SimOutput};
+
+/// The state carried from pass to pass: hold, sub-steps and the nominal fit under them.
+pub(super) struct Pass<'a> {
+    pub hold: InputHold,
+    pub hold_report: HoldReport,
+    /// Sub-step convergence of the nominal model, and of the selected model (once checked).
+    pub disc: SubstepCheck,
+    pub disc_final: Option<SubstepCheck>,
+    pub ctx: FitContext<'a>,
+    /// Nominal fit (initial state only, where free).
+    pub nom: FitResult,
+    pub notes: Vec<String>,
+    /// Passes rerun for the selected model's sub-steps (at most one).
+    substep_reruns: usize,
+    /// Singles of the previous pass (warm starts).
+    prev_singles: Option<Vec<Ranked>>,
+}
+
+/// What the last pass found about the nominal model.
+pub(super) struct NominalFindings {
+    /// Nominal simulation, its residual `y - yhat` and the residual tests.
+    pub nom_sim: SimOutput,
+    pub e_nom: Vec<f64>,
+    pub residual_nominal: ResidualTests,
+    /// Whether the nominal residual passes every test (nothing is selected then).
+    pub nominal_adequate: bool,
+    pub loc: Localisation,
+    /// BIC gain the remaining discretisation error could buy.
+    pub delta_bic_disc: f64,
+}
+
+/// How a pass ended.
+enum Step {
+    Done(Box<(NominalFindings, Selection)>),
+    Restart,
+}
+
+impl<'a> Pass<'a> {
+    /// Hold and discretisation, then the nominal fit under them.
+    pub(super) fn first(data: &'a Setup<'a>) -> Self {
+        let (hold, hold_report, disc) = hold::first_choice(data);
+        let ctx = data.context(hold, disc.substeps, data.x_scale.clone());
+        let nom = data.fit_nominal(&ctx);
+        Self {
+            hold,
+            hold_report,
+            disc,
+            disc_final: None,
+            ctx,
+            nom,
+            notes: Vec::new(),
+            substep_reruns: 0,
+            prev_singles: None,
+        }
+    }
+
+    /// Passes until one stands: what it found about the nominal model, and its selection.
+    pub(super) fn run(&mut self, data: &'a Setup<'a>) -> Result<(NominalFindings, Selection), DiscoveryError> {
+        loop {
+            if let Step::Done(found) = self.once(data)? {
+                return Ok(*found);
+            }
+        }
+    }
+
+    /// Nominal residual -> localisation -> hypotheses -> (hold check) -> selection and
+    /// cross-validation -> (sub-step check of the selected model).
+    fn once(&mut self, data: &'a Setup<'a>) -> Result<Step, DiscoveryError> {
+        let s = data.s;
+        // Nominal residual.
+        let nom_sim = self
+            .ctx
+            .problem(vec![], vec![])
+            .simulate(&[], &self.nom.x0, None)
+            .ok_or(DiscoveryError::Unstable { mu: data.mu })?;
+        let e_nom: Vec<f64> = self.ctx.y.iter().zip(&nom_sim.y).map(|(a, b)| a - b).collect();
+        let residual_nominal = data.residual_tests(&e_nom, &self.ctx.w);
+        let nominal_adequate = residual_nominal.white && residual_nominal.uncorrelated && residual_nominal.zero_mean;
+        // Localisation.
+        let loc = self.localise(data, &nom_sim, &e_nom)?;
+        // Selection margin: the settings' plus what the remaining discretisation error buys.
+        let err = self.disc.error_rms.max(self.disc_final.as_ref().map_or(0.0, |d| d.error_rms));
+        let delta_bic_disc = discretisation::delta_bic_of_error(err, self.nom.sse / data.n_res as f64, data.n_res);
+        let margin = s.select.margin_bic + delta_bic_disc;
+        // Hypotheses. State scales and the nominal run for data-derived bounds and starts
+        // (hypothesis.rs).
+        self.ctx.scales = self.ctx.scales.clone().with_nominal(&nom_sim.x, &nom_sim.y, &self.ctx.y, data.k_est);
+        let plan = s.plan();
+        let singles =
+            select::candidate::fit_singles(&self.ctx, &plan, data.sys, &self.nom, self.prev_singles.as_deref());
+        let overturned = hold::overturned_by_effects(
+            data,
+            &self.ctx,
+            &self.nom,
+            &singles,
+            margin,
+            nominal_adequate,
+            self.hold,
+            &mut self.hold_report,
+        );
+        if let Some((other, note)) = overturned {
+            self.notes.push(note);
+            self.hold = other;
+            self.disc_final = None;
+            self.restart(data, self.ctx.substeps, singles);
+            return Ok(Step::Restart);
+        }
+        // Selection and cross-validation.
+        let selection = select::forward::select_all(&self.ctx, &plan, singles, &self.nom, nominal_adequate, margin);
+        if self.needs_more_substeps(data, &selection) {
+            return Ok(Step::Restart);
+        }
+        let nominal = NominalFindings { nom_sim, e_nom, residual_nominal, nominal_adequate, loc, delta_bic_disc };
+        Ok(Step::Done(Box::new((nominal, selection))))
+    }
+
+    /// Residual energy per regime and the windows where it concentrates (window sizes from
+    /// the data: velocity scale, residual correlation length; not tau_slow).
+    fn localise(&self, data: &Setup, nom_sim: &SimOutput, e_nom: &[f64]) -> Result<Localisation, DiscoveryError> {
+        let nominal_ext = ExtendedModel::from_maps(data.sys, &[], self.ctx.maps.clone(), self.ctx.substeps)?;
+        let contact = nominal_ext.has_play().then_some(&nom_sim.contact[..]);
+        Ok(localise::localise(data.rec.t0, data.dt, &self.ctx.y, e_nom, data.p, &self.ctx.w, data.m, contact, 10))
+    }
+
+    /// Final model: does it need more sub-steps than the nominal? Records its convergence;
+    /// the first time it needs more, restarts the pass at its sub-steps (`true`).
+    fn needs_more_substeps(&mut self, data: &'a Setup<'a>, selection: &Selection) -> bool {
+        let Some(c) = &selection.chosen else { return false };
+        let effects = self.ctx.problem(vec![], c.parts.clone()).effects(&c.params);
+        let sys_c = match (c.refit, &data.free_nominal) {
+            (true, Some(f)) => f.system_at(&c.nominal),
+            _ => data.sys.clone(),
+        };
+        let chk = data.converge_model(&sys_c, &effects, &c.x0, self.hold, self.ctx.substeps);
+        let more = chk.substeps > self.ctx.substeps;
+        let k = chk.substeps;
+        self.disc_final = Some(chk);
+        if !(more && self.substep_reruns == 0) {
+            return false;
+        }
+        self.substep_reruns += 1;
+        self.notes.push(format!(
+            "The selected model ({}) needed {k} sub-steps per sample where the nominal converged at {}: the whole selection was rerun at {k}.",
+            c.label, self.ctx.substeps
+        ));
+        self.restart(data, k, selection.ranking.clone());
+        true
+    }
+
+    /// The next pass: sub-steps converged from `k_from` under the current hold, the nominal
+    /// refitted, `prev` the singles to warm-start from.
+    fn restart(&mut self, data: &'a Setup<'a>, k_from: usize, prev: Vec<Ranked>) {
+        self.disc = data.converge_nominal(self.hold, k_from);
+        self.ctx = data.context(self.hold, self.disc.substeps, data.x_scale.clone());
+        self.nom = data.fit_nominal(&self.ctx);
+        self.prev_singles = Some(prev);
+    }
+}

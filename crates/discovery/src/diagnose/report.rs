@@ -1,0 +1,190 @@
+//! The report of a diagnosis (`report.json`, [`Report`]) and the types it is made of; the
+//! ranking's entries ([`Ranked`]) are declared with the selection that fills them
+//! ([`crate::select`]). Rendered as `report.md` by [`Report::to_markdown`].
+use super::settings::HoldChoice;
+use crate::discretisation::SubstepCheck;
+use crate::fit::jackknife::Jackknife;
+use crate::fit::missing_input::MissingInput;
+use crate::localise::{self, RegimeShare, Window};
+use crate::metrics::Fit;
+use crate::residual::ResidualTests;
+use crate::select::Ranked;
+use model::System;
+use serde::Serialize;
+
+/// Which input hold was used and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoldReport {
+    /// `auto`, `zoh` or `foh` as requested.
+    pub requested: HoldChoice,
+    /// `zoh` or `foh`.
+    pub chosen: &'static str,
+    /// Nominal estimation SSE (weighted) under each hold (`None` where not computed).
+    pub sse_zoh: Option<f64>,
+    pub sse_foh: Option<f64>,
+    /// `BIC(other hold) - BIC(chosen)` of the nominal model (same parameter count).
+    pub delta_bic: Option<f64>,
+    /// Whether the data decide (`delta_bic` at least the tie margin).
+    pub decisive: bool,
+    /// `auto` only: `BIC(best single effect, chosen hold) - BIC(same effect refitted with
+    /// the other hold)` (negative: the effect confirms the hold). The nominal's preference can
+    /// be an artefact of the missing effect; where the best effect prefers the other hold by
+    /// the tie margin (by any margin when it is an input delay, with which the hold is
+    /// confounded), the hold is switched and the diagnosis redone.
+    pub effect_delta_bic: Option<f64>,
+    /// Whether the hold was switched by that check.
+    pub switched: bool,
+}
+
+/// The initial state used.
+#[derive(Debug, Clone, Serialize)]
+pub struct InitialStateReport {
+    /// `model file` or `estimated`.
+    pub source: &'static str,
+    /// Nominal `x0` (fixed or fitted).
+    pub x0: Vec<f64>,
+    /// With the model file's `x0`: `BIC(fixed) - BIC(estimated)` of the nominal model
+    /// (a large value says the file's `x0` does not match the recording's start).
+    pub delta_bic_free: Option<f64>,
+}
+
+/// File name of the input samples written beside `fitted.toml` (the model's `input.file`).
+pub const FITTED_INPUT_FILE: &str = "fitted-input.csv";
+
+/// One fitted effect in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct FittedEffect {
+    pub kind: String,
+    pub label: String,
+    pub description: String,
+    pub params: Vec<(String, f64)>,
+    /// Reported 1-sigma: `sqrt(statistical^2 + jackknife^2)` ([`crate::fit::jackknife::combine`];
+    /// the statistical part alone where the jackknife is not defined).
+    pub uncertainty: Vec<(String, f64)>,
+    /// Its statistical part: the larger of Gauss-Newton and the batch-means sandwich (noise,
+    /// white or coloured, for an exact model).
+    pub uncertainty_statistical: Vec<(String, f64)>,
+    /// Its model-error part: the delete-a-group jackknife over contiguous folds of the
+    /// estimation segment, widened by [`crate::fit::jackknife::t_factor`] for its degrees of
+    /// freedom (`NaN`, JSON `null`, where not computed).
+    pub uncertainty_jackknife: Vec<(String, f64)>,
+    /// `input_delay` only: the equivalent parameters under the other input hold (a zero-order
+    /// hold acts as a first-order hold delayed by h/2): `(hold, params)`. Where the data do not
+    /// decide the hold (see the report's `hold`), the recording cannot tell the two apart and
+    /// the user's knowledge of the hold must.
+    pub other_hold: Option<(String, Vec<(String, f64)>)>,
+}
+
+/// One refitted nominal parameter in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct NominalValue {
+    /// `plant.X[i][j]`.
+    pub name: String,
+    /// Value in the model file.
+    pub nominal: f64,
+    /// Fitted value (written into `fitted.toml`).
+    pub value: f64,
+    /// 1-sigma uncertainty (as for effects; `NaN`, JSON `null`, where not identifiable).
+    pub std: f64,
+    /// Its statistical and jackknife (model-error) parts, as for effects.
+    pub std_statistical: f64,
+    pub std_jackknife: f64,
+    /// `value / nominal - 1` (`None` for a zero nominal).
+    pub relative_change: Option<f64>,
+    pub bounds: Option<(f64, f64)>,
+}
+
+/// Scales and null reference of the localisation (see [`localise`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct LocalisationInfo {
+    pub scales: localise::Scales,
+    pub null: localise::NullReference,
+}
+
+/// Time series kept for figures.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    pub t: Vec<f64>,
+    pub p: usize,
+    pub y: Vec<f64>,
+    pub yhat_nominal: Vec<f64>,
+    pub yhat_fitted: Vec<f64>,
+    pub energy: Vec<f64>,
+}
+
+/// The diagnosis report (`report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub model: String,
+    pub recording: String,
+    pub samples: usize,
+    pub dt: f64,
+    pub resampled: bool,
+    pub substeps: usize,
+    /// Input hold between samples.
+    pub hold: HoldReport,
+    /// Sub-step convergence of the nominal model (and of the final model).
+    pub discretisation: SubstepCheck,
+    pub discretisation_final: Option<SubstepCheck>,
+    /// Noise level of each output (difference estimator, units of y).
+    pub noise_level: Vec<f64>,
+    /// BIC gain the remaining discretisation error could buy (added to the selection margin).
+    pub delta_bic_discretisation: f64,
+    pub initial_state: InitialStateReport,
+    pub estimation_segment: [f64; 2],
+    pub validation_segment: [f64; 2],
+    pub tau_slow: f64,
+    /// Nominal model (initial state fitted) on the validation segment.
+    pub fit_before: Fit,
+    /// Selected model on the validation segment.
+    pub fit_after: Fit,
+    /// `fit` or `rmse`: what the verdict's headline states (see [`Metric`](super::settings::Metric)).
+    pub headline_metric: &'static str,
+    /// The verdict's metric part (fit % or RMSE in units, velocity RMSE and fit %).
+    pub headline: String,
+    /// Units of the outputs (`[signals] y`; empty strings where not stated).
+    pub units: Vec<String>,
+    /// Grey-box refit: the freed nominal parameters (`[fit] free`) as selected (empty when
+    /// the refit was not selected or none is freed), written into `fitted.toml`.
+    pub nominal_refit: Vec<NominalValue>,
+    /// The freed nominal parameters' names (`[fit] free`), refitted or not.
+    pub free_parameters: Vec<String>,
+    /// Recorded columns that are not model inputs, tested as missing inputs.
+    pub missing_inputs: Vec<MissingInput>,
+    pub residual_nominal: ResidualTests,
+    pub residual_fitted: ResidualTests,
+    /// Whether the nominal residual passes both tests.
+    pub nominal_adequate: bool,
+    pub verdict: String,
+    pub effects: Vec<FittedEffect>,
+    /// What the reported 1-sigma of the fitted parameters includes, and what it does not.
+    pub uncertainty_method: String,
+    /// The jackknife of the selected model (fold estimates), where computed.
+    pub jackknife: Option<Jackknife>,
+    /// Hypotheses indistinguishable from the selected one (BIC within `tie_bic`).
+    pub ties: Vec<String>,
+    pub windows: Vec<Window>,
+    pub regimes: Vec<RegimeShare>,
+    /// Localisation of the derived velocity residual (the servo metrics' differentiation).
+    pub velocity_windows: Vec<Window>,
+    pub velocity_regimes: Vec<RegimeShare>,
+    /// Data-derived scales and the null reference of the localisation.
+    pub localisation: LocalisationInfo,
+    pub ranking: Vec<Ranked>,
+    pub notes: Vec<String>,
+    #[serde(skip)]
+    pub fitted_model: Option<System>,
+    #[serde(skip)]
+    pub series: Series,
+}
+
+impl Report {
+    /// The label of the selected hypothesis (`"none"` if nothing was added).
+    pub fn selected(&self) -> String {
+        if self.effects.is_empty() {
+            "none".into()
+        } else {
+            self.effects.iter().map(|e| e.kind.clone()).collect::<Vec<_>>().join("+")
+        }
+    }
+}

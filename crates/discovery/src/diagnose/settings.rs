@@ -1,0 +1,211 @@
+//! Settings of the diagnosis ([`DiagnoseSettings`], checked by its one
+//! [`DiagnoseSettings::validate`] at the entry of [`super::diagnose`]) and the choices they
+//! offer: the input hold ([`HoldChoice`]), the verdict's headline metric ([`Metric`]) and the
+//! model file's initial state ([`InitialState`]).
+use crate::fit::FitSettings;
+use crate::select::{Plan, SelectSettings};
+use crate::{DiscoveryError, Recording};
+use model::System;
+use serde::Serialize;
+
+/// Settings of the diagnosis.
+#[derive(Debug, Clone)]
+pub struct DiagnoseSettings {
+    /// Fraction of the record used for estimation. Default 0.7.
+    pub estimation_fraction: f64,
+    /// Largest number of linear sub-steps per sample. Default 64.
+    pub max_substeps: usize,
+    /// First number of sub-steps tried: `h <= tau_fast / substep_ratio`. Default 10.
+    pub substep_ratio: f64,
+    /// Sub-steps are doubled until the simulated output changes by at most this fraction of
+    /// the noise level (weighted RMS). Default 0.1.
+    pub substep_tol: f64,
+    /// Input between samples: `Auto` (decided by the nominal fit), `Zoh` or `Foh`.
+    pub input_hold: HoldChoice,
+    /// The initial state stated by the model file (`None`: not stated, estimated).
+    pub initial_state: Option<InitialState>,
+    /// Estimate the initial state even when the model file states one. Default false.
+    pub estimate_x0: bool,
+    /// Contiguous folds of the blocked cross-validation. Default 5.
+    pub cv_folds: usize,
+    /// Candidates (best BIC first) cross-validated per selection step, until one passes.
+    /// Default 3.
+    pub max_cv: usize,
+    /// LM iterations per fold refit (from the estimation fit). Default 6.
+    pub cv_iter: usize,
+    /// LM iterations per fold of the jackknife of the selected model's parameters (its
+    /// model-error spread over `cv_folds` contiguous folds of the estimation segment, see
+    /// [`crate::fit::jackknife`]); 0 leaves the jackknife out. Default 6.
+    pub jackknife_iter: usize,
+    /// Greatest number of effects added by forward selection. Default 2.
+    pub max_effects: usize,
+    /// How many of the best single hypotheses are tried as second effects. Default 4.
+    pub max_second: usize,
+    /// Lags of the residual tests. Default 20.
+    pub lags: usize,
+    pub fit: FitSettings,
+    pub select: SelectSettings,
+    /// Run hypotheses in parallel (rayon). Default true.
+    pub parallel: bool,
+    /// Refit the nominal parameters the model file frees (`[fit] free`). Default true.
+    pub refit_nominal: bool,
+    /// Headline metric of the verdict: `Auto` (RMSE in the output's units when a validation
+    /// fit % exceeds 99 %, else fit %), `Fit` or `Rmse`.
+    pub metric: Metric,
+}
+
+/// Headline metric of the verdict (`--metric`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// RMSE when a validation fit % exceeds [`SERVO_FIT_PERCENT`] (a tightly tracking loop
+    /// saturates fit %), else fit %.
+    #[default]
+    Auto,
+    Fit,
+    Rmse,
+}
+
+impl Metric {
+    /// From `auto`, `fit` or `rmse`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(Metric::Auto),
+            "fit" => Some(Metric::Fit),
+            "rmse" => Some(Metric::Rmse),
+            _ => None,
+        }
+    }
+}
+
+/// Fit % above which `Metric::Auto` headlines the RMSE.
+pub const SERVO_FIT_PERCENT: f64 = 99.0;
+
+impl Default for DiagnoseSettings {
+    fn default() -> Self {
+        Self {
+            estimation_fraction: 0.7,
+            max_substeps: 64,
+            substep_ratio: 10.0,
+            substep_tol: 0.1,
+            input_hold: HoldChoice::Auto,
+            initial_state: None,
+            estimate_x0: false,
+            cv_folds: 5,
+            max_cv: 3,
+            cv_iter: 6,
+            jackknife_iter: 6,
+            max_effects: 2,
+            max_second: 4,
+            lags: 20,
+            fit: FitSettings::default(),
+            select: SelectSettings::default(),
+            parallel: true,
+            refit_nominal: true,
+            metric: Metric::Auto,
+        }
+    }
+}
+
+impl DiagnoseSettings {
+    /// Checks the settings and their agreement with the model `sys` and the recording `rec`:
+    /// the estimation fraction in `[0.2, 0.95]`, at least 2 folds, the recording's inputs and
+    /// outputs those of the model, a stated initial state of the model's dimensions.
+    pub fn validate(&self, sys: &System, rec: &Recording) -> Result<(), DiscoveryError> {
+        if !(0.2..=0.95).contains(&self.estimation_fraction) {
+            return Err(DiscoveryError::BadSetting {
+                field: "estimation_fraction",
+                value: self.estimation_fraction,
+                reason: "must lie in [0.2, 0.95]",
+            });
+        }
+        if self.cv_folds < 2 {
+            return Err(DiscoveryError::BadSetting {
+                field: "cv_folds",
+                value: self.cv_folds as f64,
+                reason: "at least 2 folds are needed",
+            });
+        }
+        let (m, p) = (rec.m(), rec.p());
+        if sys.m() != m {
+            return Err(DiscoveryError::DimensionMismatch {
+                what: "inputs m",
+                model: sys.m(),
+                recording: m,
+                columns: "w columns".into(),
+            });
+        }
+        if sys.p() != p {
+            return Err(DiscoveryError::DimensionMismatch {
+                what: "outputs p",
+                model: sys.p(),
+                recording: p,
+                columns: "y columns".into(),
+            });
+        }
+        if let Some(is) = &self.initial_state {
+            if is.x0.len() != sys.n() {
+                return Err(DiscoveryError::BadSetting {
+                    field: "initial_state.x0 length",
+                    value: is.x0.len() as f64,
+                    reason: "must equal the model's n",
+                });
+            }
+            if is.z0.as_ref().is_some_and(|z| z.len() != p) {
+                return Err(DiscoveryError::BadSetting {
+                    field: "initial_state.z0 length",
+                    value: is.z0.as_ref().map_or(0, |z| z.len()) as f64,
+                    reason: "must equal the model's p",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The settings of fitting, cross-validation and forward selection.
+    pub fn plan(&self) -> Plan<'_> {
+        Plan {
+            fit: &self.fit,
+            select: &self.select,
+            cv_folds: self.cv_folds,
+            cv_iter: self.cv_iter,
+            max_cv: self.max_cv,
+            max_effects: self.max_effects,
+            max_second: self.max_second,
+            parallel: self.parallel,
+        }
+    }
+}
+
+/// How the input behaves between samples (`--input-hold`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HoldChoice {
+    /// Decided from the data: the hold under which the nominal model fits better.
+    #[default]
+    Auto,
+    /// Zero-order hold: each sample held until the next (a digital controller's command).
+    Zoh,
+    /// First-order hold: linear interpolation between samples.
+    Foh,
+}
+
+impl HoldChoice {
+    /// From `auto`, `zoh` or `foh`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(HoldChoice::Auto),
+            "zoh" => Some(HoldChoice::Zoh),
+            "foh" => Some(HoldChoice::Foh),
+            _ => None,
+        }
+    }
+}
+
+/// An initial state stated by the model file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    pub x0: Vec<f64>,
+    /// Backlash output `z0` when stated (else at rest in the play, `z0 = C x0`).
+    pub z0: Option<Vec<f64>>,
+}

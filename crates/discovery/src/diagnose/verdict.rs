@@ -1,0 +1,128 @@
+//! The verdict: its headline metric ([`headline`]: fit %, or the RMSE in the output's units
+//! where fit % saturates) and its text ([`verdict`]: nothing missing, an input missing, the
+//! missing physics or refitted plant parameters, or nothing the library explains).
+use super::markdown::{fmt_opt, fmt_units, g4};
+use super::report::NominalValue;
+use super::settings::{Metric, SERVO_FIT_PERCENT};
+use super::setup::Setup;
+use crate::fit::missing_input::MissingInput;
+use crate::metrics::{self, Fit};
+use crate::select::Ranked;
+
+/// The verdict's metric part.
+pub(super) struct Headline {
+    /// Whether the RMSE is the headline (`--metric`, or `auto` with a saturated fit %).
+    pub use_rmse: bool,
+    /// `fit` or `rmse` (report's `headline_metric`).
+    pub metric: &'static str,
+    pub text: String,
+    /// Units of the outputs (`[signals] y`; empty strings where not stated).
+    pub units: Vec<String>,
+}
+
+/// The headline metric and its text (validation segment, nominal -> fitted); with `auto`
+/// turning to the RMSE, a note says why.
+pub(super) fn headline(data: &Setup, fit_before: &Fit, fit_after: &Fit, notes: &mut Vec<String>) -> Headline {
+    let s = data.s;
+    let units: Vec<String> = (0..data.p).map(|i| data.sys.signals.y_unit(i).to_string()).collect();
+    let use_rmse = match s.metric {
+        Metric::Rmse => true,
+        Metric::Fit => false,
+        Metric::Auto => metrics::saturated(fit_before, fit_after, SERVO_FIT_PERCENT),
+    };
+    let metric = if use_rmse || !fit_before.constant_outputs.is_empty() { "rmse" } else { "fit" };
+    let text = if use_rmse {
+        metrics::headline_rmse(fit_before, fit_after, &units)
+    } else if fit_before.constant_outputs.is_empty() {
+        format!("validation fit {} -> {} %", fmt_opt(&fit_before.fit_percent), fmt_opt(&fit_after.fit_percent))
+    } else {
+        format!(
+            "validation RMSE {} -> {}; fit % undefined, the validation output is constant",
+            fmt_units(&fit_before.rmse, &units),
+            fmt_units(&fit_after.rmse, &units)
+        )
+    };
+    if use_rmse && s.metric == Metric::Auto {
+        notes.push(format!(
+            "The validation fit % exceeds {SERVO_FIT_PERCENT} % (a tightly tracking loop saturates it): the verdict states the RMSE in the output's units{} and the derived velocity's RMSE and fit % (5-point moving average, then central difference, the same filter on measurement and simulation).",
+            if units.iter().all(|u| u.is_empty()) { " (no `[signals] y` unit in the model file: unitless)" } else { "" }
+        ));
+    }
+    Headline { use_rmse, metric, text, units }
+}
+
+/// The verdict's text.
+pub(super) fn verdict(
+    nominal_adequate: bool,
+    missing_inputs: &[MissingInput],
+    chosen: Option<&Ranked>,
+    nominal_refit: &[NominalValue],
+    cv_rejected: &[(String, f64, String)],
+    headline: &str,
+) -> String {
+    let missing: Vec<&MissingInput> = missing_inputs.iter().filter(|c| c.missing).collect();
+    let untestable = chosen.is_some_and(|c| c.cv.as_ref().is_some_and(|v| v.status == "not_testable"));
+    let refit_only = chosen.is_some_and(|c| c.refit && c.parts.is_empty());
+    if nominal_adequate {
+        "no missing physics found: the nominal residual is white, zero-mean and uncorrelated with the input (1 % level)"
+            .to_string()
+    } else if !missing.is_empty() {
+        missing
+            .iter()
+            .map(|c| {
+                format!(
+                    "input {} is missing from the model: fed through the nominal dynamics it explains {:.0} % of the nominal residual (the best hypothesis of the library, {}, {:.0} %); add it to the model's inputs (a column of B) instead of fitting an effect",
+                    c.column,
+                    100.0 * c.explained,
+                    c.best_hypothesis,
+                    100.0 * c.best_hypothesis_explained
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    } else if let Some(c) = chosen {
+        let tail = if untestable {
+            " (supported by the estimation data; not testable on validation: its effect lies in one fold of the record)"
+        } else {
+            ""
+        };
+        if refit_only {
+            format!(
+                "the plant's parameters were off, not missing physics: {}{tail} ({headline})",
+                fmt_nominal(nominal_refit)
+            )
+        } else if c.refit {
+            let effects_label = c.parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>().join(" + ");
+            format!(
+                "missing physics: {effects_label}{tail}, with the plant's parameters refitted ({}) ({headline})",
+                fmt_nominal(nominal_refit)
+            )
+        } else {
+            format!("missing physics: {}{tail} ({headline})", c.label)
+        }
+    } else if !cv_rejected.is_empty() {
+        format!(
+            "the nominal residual is not white; {} improve(s) the estimation fit but not the held-out folds of the blocked cross-validation, so nothing is added (see the ranking)",
+            cv_rejected.iter().map(|c| c.0.clone()).collect::<Vec<_>>().join(", ")
+        )
+    } else {
+        "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library".to_string()
+    }
+}
+
+/// Refitted nominal parameters for a verdict: `name nominal -> value +- std (change %)`.
+fn fmt_nominal(v: &[NominalValue]) -> String {
+    v.iter()
+        .map(|x| {
+            format!(
+                "{} {} -> {} +- {}{}",
+                x.name,
+                g4(x.nominal),
+                g4(x.value),
+                if x.std.is_finite() { format!("{:.2e}", x.std) } else { "undefined".into() },
+                x.relative_change.map_or(String::new(), |r| format!(" ({:+.1} %)", 100.0 * r))
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,93 @@
+//! Model selection: every hypothesis fitted on the estimation segment and ranked by BIC, the
+//! best accepted by blocked cross-validation, then greedy forward selection of a second effect;
+//! ties between hypotheses that explain the data equally well.
+//!
+//! `BIC = N log(SSE / N) + k log N` with `N` the number of estimation residuals and `k` the
+//! number of free parameters (effect parameters + `n` initial states). A hypothesis is a
+//! candidate when `BIC_current - BIC >= margin` (`margin_bic`, default 10: "very strong" on the
+//! Kass-Raftery scale, plus the discretisation allowance of the diagnosis) and is accepted when
+//! its held-out SSE over the folds is at most `1 - min_val_gain` times the current model's
+//! (default gain 0.1). Two hypotheses whose BIC differ by less than `tie_bic` (default 6) are
+//! reported as indistinguishable on this recording.
+//!
+//! - [`context`]: the data every candidate is fitted and scored on, at one input hold and
+//!   sub-step count ([`FitContext`]).
+//! - [`candidate`]: one (composite) hypothesis fitted on the estimation segment and scored
+//!   ([`Ranked`], its cross-validation [`CvResult`]), the singles of the library.
+//! - [`cross_validation`]: blocked cross-validation over contiguous folds.
+//! - [`forward`]: acceptance by BIC margin and cross-validation, simpler forms preferred, greedy
+//!   forward selection, the final ranking ([`Selection`]).
+pub mod candidate;
+pub mod context;
+pub mod cross_validation;
+pub mod forward;
+
+pub use candidate::{CvResult, Ranked, NOMINAL_REFIT};
+pub use context::FitContext;
+pub use cross_validation::NOT_TESTABLE_SHARE;
+pub use forward::Selection;
+
+use crate::fit::FitSettings;
+use serde::Serialize;
+
+/// Settings of selection.
+#[derive(Debug, Clone)]
+pub struct SelectSettings {
+    pub margin_bic: f64,
+    pub min_val_gain: f64,
+    pub tie_bic: f64,
+}
+
+impl Default for SelectSettings {
+    fn default() -> Self {
+        Self { margin_bic: 10.0, min_val_gain: 0.1, tie_bic: 6.0 }
+    }
+}
+
+/// How candidates are fitted, cross-validated and added: the diagnosis settings of the same
+/// names (see [`crate::diagnose::DiagnoseSettings`] for their meaning and defaults).
+#[derive(Debug, Clone, Copy)]
+pub struct Plan<'a> {
+    pub fit: &'a FitSettings,
+    pub select: &'a SelectSettings,
+    pub cv_folds: usize,
+    pub cv_iter: usize,
+    pub max_cv: usize,
+    pub max_effects: usize,
+    pub max_second: usize,
+    pub parallel: bool,
+}
+
+/// `N log(SSE/N) + k log N`.
+pub fn bic(sse: f64, n: usize, k: usize) -> f64 {
+    let nf = n.max(1) as f64;
+    nf * (sse.max(1e-300) / nf).ln() + k as f64 * nf.ln()
+}
+
+/// Whether a candidate (BIC `b`, validation SSE `v`) beats the current (`b0`, `v0`).
+pub fn beats(b: f64, v: f64, b0: f64, v0: f64, s: &SelectSettings) -> bool {
+    b0 - b >= s.margin_bic && v <= (1.0 - s.min_val_gain) * v0
+}
+
+/// Summary of one decision, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Decision {
+    pub margin_bic: f64,
+    pub min_val_gain: f64,
+    pub tie_bic: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn margin_and_validation_both_required() {
+        let s = SelectSettings::default();
+        let b0 = bic(100.0, 1000, 2);
+        assert!(beats(bic(50.0, 1000, 3), 5.0, b0, 10.0, &s));
+        // Better BIC but no validation gain: rejected (overfitting guard).
+        assert!(!beats(bic(50.0, 1000, 3), 9.5, b0, 10.0, &s));
+        // Tiny estimation gain: the extra parameter does not pay.
+        assert!(!beats(bic(99.9, 1000, 3), 5.0, b0, 10.0, &s));
+    }
+}
