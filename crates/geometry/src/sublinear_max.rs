@@ -73,7 +73,7 @@
 //! The method needs sublinearity: for a function that is not convex on the cones (a narrow
 //! bump) the "upper bound" can lie below a sampled value (see the negative-control tests).
 use crate::sphere_max::ordered_by_ub;
-use crate::{sphere_max, Bounds, SphereMaxSettings};
+use crate::{sphere_max, Enclosure, SphereMaxSettings};
 use std::collections::BinaryHeap;
 
 /// Upper bound of a sublinear `g` over the arc from angle 0 to `delta` given its end values.
@@ -102,10 +102,10 @@ pub fn sublinear_sphere_max(
     mut g: impl FnMut(&[f64]) -> f64,
     lipschitz: f64,
     s: &SphereMaxSettings,
-) -> Bounds {
+) -> Enclosure {
     match p {
-        0 => Bounds::exact(f64::NAN),
-        1 => Bounds::exact(g(&[1.0]).max(g(&[-1.0]))),
+        0 => Enclosure::exact(f64::NAN),
+        1 => Enclosure::exact(g(&[1.0]).max(g(&[-1.0]))),
         2 => {
             let mut ev = |a: f64| g(&[a.cos(), a.sin()]);
             let n0 = 64;
@@ -137,7 +137,7 @@ pub fn sublinear_sphere_max(
                 heap.push(Arc { ub: arc_bound(gm, arc.g1, arc.a1 - am), a0: am, a1: arc.a1, g0: gm, g1: arc.g1 });
             }
             let upper = heap.peek().map(|a| a.ub).unwrap_or(lower).max(lower);
-            Bounds::new(lower, upper)
+            Enclosure::new(lower, upper)
         }
         3 => triangles_max(g, s),
         4..=MAX_CONE_DIM => cones_max(p, g, s),
@@ -158,7 +158,7 @@ pub fn sublinear_sphere_max(
             }
             let crude = m2.sqrt() * (1.0 + (p as f64 + 2.0) * EPS);
             let b = sphere_max(p, g, lipschitz, s);
-            Bounds::new(b.lower, b.upper.min(crude).max(b.lower))
+            Enclosure::new(b.lower, b.upper.min(crude).max(b.lower))
         }
     }
 }
@@ -194,7 +194,7 @@ fn tri_bound(v: &[[f64; 3]; 3], g: &[f64; 3]) -> f64 {
     b * (1.0 + 1e-12) + 1e-12 * gmax
 }
 
-fn triangles_max(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bounds {
+fn triangles_max(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Enclosure {
     let mut evals = 0usize;
     let mut lower = f64::NEG_INFINITY;
     let mut ev = |v: &[f64; 3], evals: &mut usize, lower: &mut f64| {
@@ -250,7 +250,7 @@ fn triangles_max(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bou
         }
     }
     let upper = heap.peek().map(|t| t.ub).unwrap_or(lower).max(lower);
-    Bounds::new(lower, upper)
+    Enclosure::new(lower, upper)
 }
 
 /// Largest dimension handled by the simplicial-cone branch and bound [`cones_max`]; above it
@@ -527,7 +527,7 @@ fn cone_bound_p<const P: usize>(verts: &[f64], gval: &[f64], idx: &[u32]) -> (f6
 /// `max_{|v| = 1} g(v)` for sublinear `g` and `2 <= p <= MAX_CONE_DIM` by branch and bound on
 /// simplicial cones (module docs; `sublinear_sphere_max` uses it for `p >= 4`). `lower` is the
 /// best sampled value, `upper` a certified bound, valid (only wider) when the budget runs out.
-pub fn cones_max(p: usize, g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bounds {
+pub fn cones_max(p: usize, g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Enclosure {
     assert!((2..=MAX_CONE_DIM).contains(&p), "cones_max: dimension must be in 2..={MAX_CONE_DIM}");
     match p {
         2 => cones_max_p::<2>(g, s),
@@ -550,7 +550,7 @@ struct Entry {
 ordered_by_ub!(Entry);
 
 /// [`cones_max`] for a dimension known at compile time.
-fn cones_max_p<const P: usize>(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Bounds {
+fn cones_max_p<const P: usize>(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Enclosure {
     let p = P;
     let mut verts: Vec<f64> = Vec::with_capacity(p * 4096);
     let mut gval: Vec<f64> = Vec::with_capacity(4096);
@@ -645,13 +645,13 @@ fn cones_max_p<const P: usize>(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSe
     let U = heap.peek().map(|c| c.ub).unwrap_or(lower);
     if U.is_nan() {
         // a NaN value of g voids the bound (and `f64::max` would hide it)
-        return Bounds::new(lower, f64::NAN);
+        return Enclosure::new(lower, f64::NAN);
     }
     // covering slivers of the floating midpoints (module docs): max g <= U / (1 - D delta)
     let delta = 4.0 * (p as f64).sqrt() * (p as f64 + 4.0) * EPS;
     let cover = f64::from(max_depth) * delta;
     let upper = if U > 0.0 { U / (1.0 - cover) * (1.0 + 2.0 * EPS) } else { U };
-    Bounds::new(lower, upper.max(lower))
+    Enclosure::new(lower, upper.max(lower))
 }
 
 #[cfg(test)]

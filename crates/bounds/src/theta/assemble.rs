@@ -26,6 +26,7 @@ use geometry::{ConvexSet, SphereMaxSettings};
 use lmi::{optimise_lambda, LambdaSearchSettings, LmiError};
 use model::System;
 use nalgebra::DMatrix;
+use rounding::{ulp_down_nonzero, ulp_up};
 
 /// Settings of [`assemble`]. All parts have documented defaults; `measure = None` and
 /// `stationary = None` skip the two costly optional parts (for sweeps).
@@ -290,8 +291,8 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // 8u relative on top of the <= 3 roundings of each formula.
     let (gamma_1, gamma_inf) = if strongly_convex {
         (
-            down((osc - d).max(0.0) / (T * R) * (1.0 - 4.0 * f64::EPSILON)),
-            (zdot_bound / R * (1.0 + 4.0 * f64::EPSILON)).next_up(),
+            ulp_down_nonzero((osc - d).max(0.0) / (T * R) * (1.0 - 4.0 * f64::EPSILON)),
+            ulp_up(zdot_bound / R * (1.0 + 4.0 * f64::EPSILON)),
         )
     } else {
         (0.0, 0.0)
@@ -301,7 +302,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
             "R = {R}: Theta is not strongly convex, gamma = 0 (the paper's footnote case): theta = psi(0) >= 0 for every admissible Pi (proofs-notes/psi0.md), so eq. (theta) cannot certify convergence here"
         ));
     }
-    let kappa = if gamma_inf > 0.0 { down(gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
+    let kappa = if gamma_inf > 0.0 { ulp_down_nonzero(gamma_1 / gamma_inf).clamp(0.0, 1.0) } else { 0.0 };
 
     // alpha, eq. (alpha), and the lambda search (eqs. (ALI), (bet), (theta)).
     let al = alpha(C, E);
@@ -429,16 +430,17 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
     // Rounding of the sums of distances (at most 2000 terms, each within a few ulps): a relative
     // margin far above it.
     let path_safe = path_best * (1.0 - 1e-10);
-    let gamma_1_star = if strongly_convex { down(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
+    let gamma_1_star = if strongly_convex { ulp_down_nonzero(path_safe / (T * R)).max(gamma_1) } else { 0.0 };
     // gamma_inf*: the pinned speed bound, or the profile's largest cell ceiling if lower
     let max_cell_speed = profile.as_ref().map_or(f64::INFINITY, |p| p.max_speed());
     let (zdot_star, gamma_inf_star) = if strongly_convex {
-        let zdot_star = zdot_star.min((max_cell_speed * R * (1.0 + 4.0 * f64::EPSILON)).next_up());
-        (zdot_star, (zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).next_up().min(gamma_inf).min(max_cell_speed))
+        let zdot_star = zdot_star.min(ulp_up(max_cell_speed * R * (1.0 + 4.0 * f64::EPSILON)));
+        (zdot_star, ulp_up(zdot_star / R * (1.0 + 4.0 * f64::EPSILON)).min(gamma_inf).min(max_cell_speed))
     } else {
         (zdot_star, 0.0)
     };
-    let kappa_star = if gamma_inf_star > 0.0 { down(gamma_1_star / gamma_inf_star).clamp(0.0, 1.0) } else { 0.0 };
+    let kappa_star =
+        if gamma_inf_star > 0.0 { ulp_down_nonzero(gamma_1_star / gamma_inf_star).clamp(0.0, 1.0) } else { 0.0 };
     // Certified (lambda, b_hat) points for theta*: the paper's curve, plus a second lambda search
     // with theta* as its objective when gamma_1* > gamma_1 (theta*'s best lambda differs from
     // theta's); every point is a verified certificate, so the minimum over all is a bound.
@@ -806,15 +808,6 @@ impl ThetaReport {
 /// The largest divisor of `k` that is at most `at_most` (at least 1).
 fn largest_divisor_at_most(k: usize, at_most: usize) -> usize {
     (1..=at_most.min(k).max(1)).rev().find(|&d| k.is_multiple_of(d)).unwrap_or(1)
-}
-
-/// The largest float below `x` (for values that must be rounded down; `x` finite).
-fn down(x: f64) -> f64 {
-    if x.is_finite() && x != 0.0 {
-        x.next_down()
-    } else {
-        x
-    }
 }
 
 /// `F` of eq. (F) (convenience re-export for callers holding only the report's system).

@@ -61,33 +61,14 @@ use crate::error::BoundsError;
 use dynamics::linear::expm::{expm, expm_enclosure, frobenius_up};
 use geometry::{ConvexSet, Shape};
 use nalgebra::DMatrix;
-
-/// Unit roundoff `u = 2^-53`.
-const U: f64 = f64::EPSILON / 2.0;
-
-/// `gamma_k = k u / (1 - k u)` (`+inf` when `k u >= 1`).
-fn gamma(k: usize) -> f64 {
-    let ku = k as f64 * U;
-    if ku >= 1.0 {
-        f64::INFINITY
-    } else {
-        ku / (1.0 - ku)
-    }
-}
-
-/// Knuth's TwoSum: `(fl(a + b), e)` with `a + b = fl(a + b) + e` exactly.
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    (s, (a - (s - bb)) + (b - bb))
-}
+use rounding::{gamma, two_sum, ulp_up, UNIT_ROUNDOFF};
 
 /// `e^{hF}` for a short step: `(S, e_S)` with `e_S >= ||S - e^{hF}||_2` (the `expm` enclosure of
 /// `fl(h F)` plus the perturbation from rounding `h F`).
 fn exp_step(F: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, f64) {
     let A = F * h;
     let nA = frobenius_up(&A);
-    let dA = U * nA * (1.0 + 4.0 * U);
+    let dA = UNIT_ROUNDOFF * nA * (1.0 + 4.0 * UNIT_ROUNDOFF);
     let (X, eX) = expm_enclosure(&A);
     let pert = dA * (nA + 2.0 * dA).exp() * (1.0 + 1e-6);
     (X, eX + pert)
@@ -101,7 +82,7 @@ fn exp_at(F: &DMatrix<f64>, t: f64, msup: f64) -> (DMatrix<f64>, f64) {
     if t == 0.0 {
         return (X, eX);
     }
-    let eps = U * frobenius_up(&A) * (1.0 + 4.0 * U) / t.abs();
+    let eps = UNIT_ROUNDOFF * frobenius_up(&A) * (1.0 + 4.0 * UNIT_ROUNDOFF) / t.abs();
     let pert = t.abs() * msup * msup * eps * (msup * eps * t.abs()).exp() * (1.0 + 1e-6);
     (X, eX + pert)
 }
@@ -767,7 +748,7 @@ impl TubeKernel {
                     (frob(&(LF2 * &Pc)) + gn * nLF2 * nP + nLF2 * dP + e_LF2 * (nP + dP)) * grow * nE * (1.0 + 1e-12);
                 let Km = &K - &K1 * rr;
                 let Kp = &K + &K1 * rr;
-                let e_pm = e_K + rr * e_K1 + 2.01 * U * (nK + rr * nK1);
+                let e_pm = e_K + rr * e_K1 + 2.01 * UNIT_ROUNDOFF * (nK + rr * nK1);
                 acc.norm_pm += rr * (frob(&Km) + frob(&Kp));
                 acc.norm_mid += 2.0 * rr * nK;
                 acc.err_pm += 2.0 * rr * e_pm;
@@ -791,7 +772,9 @@ impl TubeKernel {
             s_max.abs()
         } else {
             let d0 = t_hi - s_max;
-            (d0 + t_lo + prev_rr).abs() + 4.0 * U * (d0.abs() + t_lo.abs() + prev_rr + t_lo_abs) + 4.0 * U * U * t_hi
+            (d0 + t_lo + prev_rr).abs()
+                + 4.0 * UNIT_ROUNDOFF * (d0.abs() + t_lo.abs() + prev_rr + t_lo_abs)
+                + 4.0 * UNIT_ROUNDOFF * UNIT_ROUNDOFF * t_hi
         };
         acc.tiling = (defects + end_gap) * nL * msup * nE * (1.0 + 1e-10);
         // The sums of positive terms above: relative gamma_{cells+4}.
@@ -849,15 +832,15 @@ impl TubeKernel {
     /// Enclosure `[lower, upper]` of `sigma_{L Xi}(v)`: `upper` is a proven upper bound, the
     /// floating-point evaluation included (module docs); `lower` subtracts the same terms but
     /// rests on the stated allowance for `sigma_Theta` evaluated to nearest.
-    pub fn support_bounds(&self, v: &[f64]) -> geometry::Bounds {
+    pub fn support_bounds(&self, v: &[f64]) -> rounding::Enclosure {
         let mut buf = vec![0.0; self.p];
         let nv = geometry::linalg::norm(v) * (1.0 + 2.0 * gamma(self.r + 2));
         let up = self.upper_value(v, nv, &mut buf);
         let lo_tail = if self.zero_in_theta { 0.0 } else { nv * self.tail };
         let lo = 2.0 * self.sum(&self.mid, v, &mut buf, false)
-            - nv * (self.remainder + self.rounding_lo) * (1.0 + 8.0 * U)
+            - nv * (self.remainder + self.rounding_lo) * (1.0 + 8.0 * UNIT_ROUNDOFF)
             - lo_tail;
-        geometry::Bounds::new(lo, up.max(lo))
+        rounding::Enclosure::new(lo, up.max(lo))
     }
 
     /// `(sum_j w_j sup(M_j^T v))` over `minus` and over `plus` in one pass, each accumulated in
@@ -884,7 +867,8 @@ impl TubeKernel {
     /// The upper sums over `minus` and `plus` with `sigma_Theta` from above: the closed forms of
     /// `geometry::Shape::support_upper` inlined per shape, else [`ThetaSupport::support_upper`].
     fn upper_sums(&self, v: &[f64], buf: &mut [f64]) -> (f64, f64) {
-        use geometry::shapes::upper::{ball_support_upper, ellipsoid_support_upper, mul_up};
+        use geometry::shapes::upper::{ball_support_upper, ellipsoid_support_upper};
+        use rounding::mul_up;
         match &self.theta {
             ThetaSupport::Shape(Shape::Interval(i)) => {
                 self.upper_sums_with(v, buf, |u| mul_up(u[0], if u[0] >= 0.0 { i.hi } else { i.lo }))
@@ -902,12 +886,7 @@ impl TubeKernel {
     /// The proven upper value of [`Self::support_bounds`] (`nv`: `|v|` rounded up as there).
     fn upper_value(&self, v: &[f64], nv: f64, buf: &mut [f64]) -> f64 {
         let (am, ap) = self.upper_sums(v, buf);
-        let up = am + ap + nv * (self.remainder + self.tail + self.rounding_up) * (1.0 + 8.0 * U);
-        if up.is_finite() {
-            up.next_up()
-        } else {
-            up
-        }
+        ulp_up(am + ap + nv * (self.remainder + self.tail + self.rounding_up) * (1.0 + 8.0 * UNIT_ROUNDOFF))
     }
 
     /// Upper bound of `sigma_{L Xi}(v)`: the upper value of [`Self::support_bounds`] (proven,
