@@ -12,7 +12,7 @@
 //!
 //! `SPEED_PATH_CASES=N` (default 12) random systems (about 0.5 s).
 use bounds::orbit::{partition_bound_local, EtaOrbit};
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use geometry::ConvexSet;
 use theorems::strategies::inputs::InputStrategyConfig;

@@ -7,7 +7,7 @@
 //! Support functions of `C Xi_inf` and `C F Xi_inf` by the certified quadrature of
 //! [`TubeKernel`]; the maxima by `geometry::sublinear_sphere_max` (both functions are sublinear)
 //! with Lipschitz constants built from the kernels' `int ||K(s)|| ds` and `D(Theta, {0})`.
-//! Used by `theta::assemble` and by the Theorem 2 properties of the `theorems` campaign, so the
+//! Used by `crate::assemble()` and by the Theorem 2 properties of the `theorems` campaign, so the
 //! campaign checks the numbers that the report prints.
 use crate::error::BoundsError;
 use crate::tube::xi_support::SemigroupData;
