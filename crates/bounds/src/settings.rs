@@ -25,7 +25,7 @@ pub struct ThetaSettings {
     /// Grid points of the (path1) dynamic programme (`O(K^2)`). Default `600`.
     pub path1_points: usize,
     /// p = 1: steps of the engaged-history table over half a period
-    /// ([`crate::tube::EngagedHistory`]; two finite-horizon kernels each). `0` disables it.
+    /// ([`crate::beyond_paper::EngagedHistory`]; two finite-horizon kernels each). `0` disables it.
     /// Default `16`.
     pub engaged_history_steps: usize,
     /// Number of `eps` values of the (path2) packing search. Default `64`.

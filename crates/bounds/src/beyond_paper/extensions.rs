@@ -7,12 +7,13 @@
 //! [`extensions`] is a list of named steps: [`speed_profiles`] -> [`speeds_star`] ->
 //! [`theta_star`] -> [`theta_profile`] -> [`theta_engaged`] -> [`best`]. [`pinned_speed`] runs
 //! earlier, right after the paper's tube stage whose kernels it shares.
+use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
 use crate::beyond_paper::speed_profile::SpeedProfile;
 use crate::error::BoundsError;
 use crate::exponent::psi::Psi;
 use crate::orbit::{partition_bound_local, EtaOrbit};
 use crate::settings::ThetaSettings;
-use crate::tube::{EngagedHistory, EngagedSpeed, SemigroupData, TubeKernel, TubeSettings};
+use crate::tube::{SemigroupData, TubeKernel, TubeSettings};
 use geometry::ConvexSet;
 use lmi::optimise_lambda;
 use model::System;
@@ -65,7 +66,7 @@ pub(crate) struct Pinned {
     pub speed: Option<EngagedSpeed>,
 }
 
-/// p = 1: Theta = [lo, hi]; (zinf) with the backlash side pinned (tube::engaged_speed): the
+/// p = 1: Theta = [lo, hi]; (zinf) with the backlash side pinned (beyond_paper::engaged_speed): the
 /// engaged history's band at tau = 0.
 pub(crate) fn pinned_speed(
     sys: &System,
@@ -170,7 +171,7 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
     let profile = match (paper.strongly_convex, orbit.eta_dot_cells(cells)) {
         (true, Some((edot, nodes))) => {
             let prof = SpeedProfile::new(T, nodes, &edot, d_ftheta, d, R);
-            // p = 1: the signed speed bounds (tube::engaged_speed) lower the cells' ceilings
+            // p = 1: the signed speed bounds (beyond_paper::engaged_speed) lower the cells' ceilings
             match (&pinned.speed, orbit.deta_cells_scalar(cells)) {
                 (Some(es), Some((low, high))) => Some(prof.with_signed_speed(&low, &high, es)),
                 _ => Some(prof),
@@ -187,7 +188,7 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
             let width = (hi - lo) * (1.0 + 1e-12);
             let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
             // the engaged history narrows the band of z' - eta_T' on engaged cells
-            // (tube::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
+            // (beyond_paper::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
             // tau_j = j T / (2 history_steps) up to the longest engaged history of the profile
             let oldest = prof.engaged_age.iter().flatten().map(|&(_, a)| a).max().unwrap_or(0) as f64 * prof.h;
             let steps = settings.engaged_history_steps;

@@ -10,11 +10,14 @@
 //!   is provably engaged (proofs-notes/theta-engaged.md).
 //!
 //! Modules: [`extensions`] (the stage of [`crate::assemble`] that computes them from the
-//! paper's quantities) and [`speed_profile`] (the time-resolved speed bounds). Their tube
-//! kernels for `p = 1` (the signed speed and the engaged history) are in
-//! [`crate::tube::engaged_speed`], next to the tube quadrature they reuse.
+//! paper's quantities), [`speed_profile`] (the time-resolved speed bounds) and
+//! [`engaged_speed`] (p = 1: (zinf) with the backlash's side pinned, [`EngagedSpeed`], and the
+//! engaged history, [`EngagedHistory`], from the paper's tube kernels of [`crate::tube`]).
+pub mod engaged_speed;
 pub mod extensions;
 pub mod speed_profile;
+
+pub use engaged_speed::{EngagedHistory, EngagedSpeed};
 
 pub(crate) use extensions::{extensions, pinned_speed, Extensions, FromPaper};
 pub use speed_profile::SpeedProfile;

@@ -30,8 +30,8 @@
 //! holds from an earlier time `u >= l_c := (min_c sigma eta_T' - D) / R`. A cell then carries the
 //! chord of `psi` over `[l_c, g_c]` instead of `[0, g_c]`, and the path bound of an interval only
 //! has to be met by the speed above the floors. With every `l_c = 0` the bound is `theta_profile`.
+use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
 use crate::exponent::psi::Psi;
-use crate::tube::{EngagedHistory, EngagedSpeed};
 use geometry::linalg::dist;
 use rounding::scale_up;
 

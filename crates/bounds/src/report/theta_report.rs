@@ -84,7 +84,7 @@ pub struct ThetaReport {
     /// `gamma_1* = max((path), (path1), (path2)) / (T R)` (from below; `>= gamma_1`).
     pub gamma_1_star: f64,
     /// Upper bound of `limsup |z'|` with the backlash side pinned (p = 1,
-    /// [`crate::tube::EngagedSpeed`]); `zdot_bound` otherwise. Never above `zdot_bound`.
+    /// [`crate::beyond_paper::EngagedSpeed`]); `zdot_bound` otherwise. Never above `zdot_bound`.
     pub zdot_star_bound: f64,
     /// `gamma_inf* = zdot_star_bound / R` (from above; `<= gamma_inf`).
     pub gamma_inf_star: f64,

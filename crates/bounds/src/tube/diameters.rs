@@ -97,10 +97,10 @@ pub fn tube_diameters_with(
         lip_f,
         sphere,
     );
-    // the kernel's L = fl(C F) against C F_exact (tube::engaged_speed::cf_support_error)
+    // the kernel's L = fl(C F) against C F_exact (tube::cf_rounding::cf_support_error)
     let df_b = Enclosure {
         lower: df_b.lower,
-        upper: df_b.upper + crate::tube::engaged_speed::cf_support_error(C, F, E, tube.f_radius, sg, d_theta),
+        upper: df_b.upper + crate::tube::cf_rounding::cf_support_error(C, F, E, tube.f_radius, sg, d_theta),
     };
     let df_lower = df_b.lower - tube_CF.remainder_bound() - tube_CF.tail_bound();
     // The upper values are proofs when every enclosure they were built from is finite and the

@@ -17,15 +17,11 @@
 //! `v` in `Theta` for either sign); they are lower by `CE (hi - lo)` when `CE > 0`. The floors
 //! hold only while the backlash is engaged (`theta_engaged` decides where).
 use crate::error::BoundsError;
+use crate::tube::cf_rounding::{cf_support_error, PAD};
 use crate::tube::{Horizon, SemigroupData, TubeKernel, TubeSettings};
-use dynamics::linear::expm::frobenius_up;
 use geometry::{ConvexSet, Shape};
 use nalgebra::DMatrix;
-use rounding::{gamma, pad_down, pad_up, UNIT_ROUNDOFF};
-
-/// Relative margin of the enclosures here ([`pad_up`], [`pad_down`]): `8u`, on top of an
-/// absolute `MIN_POSITIVE` (each value is one sum of a few terms).
-const PAD: f64 = 8.0 * UNIT_ROUNDOFF;
+use rounding::{pad_down, pad_up};
 
 /// Offsets of the signed speed of `z` for `p = 1` (module docs), each an upper bound: the band of
 /// [`EngagedHistory`] at `tau = 0` ([`EngagedHistory::pinned`]).
@@ -49,32 +45,6 @@ impl EngagedSpeed {
     }
 }
 
-/// Upper bound of `||C F_exact - fl(C F)||_F` for the computed `F` with `||F_exact - F||_2 <=
-/// f_radius` (the product's rounding `gamma_n ||C|| ||F||` and `||C|| f_radius`).
-pub fn cf_error(C: &DMatrix<f64>, F: &DMatrix<f64>, f_radius: f64) -> f64 {
-    // n eps / (1 - n eps) = gamma_{2n}
-    let g = gamma(2 * F.nrows());
-    pad_up(frobenius_up(C) * (f_radius + g * frobenius_up(F)) * (1.0 + 1e-10), PAD)
-}
-
-/// Upper bound of the effect of `L = fl(C F)` (instead of `C F_exact`) on a support integral
-/// `int_0^inf sigma_Theta((L e^{sF_exact} E)^T v) ds`, `|v| = 1`: `D(Theta, {0}) ||dL|| ||E||
-/// int ||e^{s F_exact}||`, with `int ||e^{s F_exact}|| <= I + eps I^2 / (1 - eps I)` (`I` the
-/// proven integral for `F`, `eps = f_radius`). Infinite when `F` has no proven semigroup bound.
-pub fn cf_support_error(
-    C: &DMatrix<f64>,
-    F: &DMatrix<f64>,
-    E: &DMatrix<f64>,
-    f_radius: f64,
-    sg: &SemigroupData,
-    d_theta: f64,
-) -> f64 {
-    let Some(b) = sg.exp_norm() else { return f64::INFINITY };
-    let i = b.integral;
-    let i_exact = if f_radius * i < 0.5 { i + f_radius * i * i / (1.0 - f_radius * i) } else { f64::INFINITY };
-    pad_up(d_theta * cf_error(C, F, f_radius) * frobenius_up(E) * i_exact * (1.0 + 1e-10), PAD)
-}
-
 /// The engaged history of the backlash for `p = 1` (beyond the paper; proofs-notes/theta-engaged.md,
 /// "Engaged history"). With `k(u) = C F e^{uF} E` and `dev(t) = int_0^inf e^{uF} E v(t - u) du`
 /// (asymptotically), if the backlash has been engaged from one side for the last `tau`
@@ -91,7 +61,7 @@ pub fn cf_support_error(
 /// finite-horizon [`TubeKernel`]s (lower values: proven here because `sigma_Theta` of an
 /// interval, or of the point `{1}` for `I`, is one multiplication, within the kernel's
 /// allowance), those over `[0, inf)` from the caller's `sigma_{C F Xi_inf}` kernel (upper
-/// values), each widened by the effect of `||C F_exact - fl(C F)||` ([`cf_error`]).
+/// values), each widened by the effect of `||C F_exact - fl(C F)||` ([`crate::tube::cf_rounding::cf_error`]).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct EngagedHistory {
