@@ -11,7 +11,8 @@
 //! - [`exponent`]: Section 6: `alpha` (eq. (alpha)), `psi` (eq. (phipsi)) and `theta` as the
 //!   convex combination of eq. (theta);
 //! - [`beyond_paper`]: the bounds that are ours, not the paper's: `theta*`, `theta_profile`,
-//!   `theta_engaged` and the speed profile they use (proofs in `proofs-notes/theta-*.md`);
+//!   `theta_engaged`, the speed profile and the pinned speed (p = 1) they use (proofs in
+//!   `proofs-notes/theta-*.md`);
 //! - [`mod@assemble`]: [`assemble()`], every quantity of one model as a list of named stages
 //!   (plant -> tubes -> orbit -> gammas -> certificate -> theta -> path lengths -> beyond the
 //!   paper -> stationary, measured -> report), with its [`settings`] ([`ThetaSettings`]);
