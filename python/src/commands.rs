@@ -3,7 +3,7 @@
 //! checks, so that a Python call and the command print the same numbers and the same one-line
 //! error messages. Nothing here needs Python; `py.rs` only converts arguments and results.
 use anyhow::{bail, Context};
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use dynamics::trajectory::Trajectory;
 use model::{Input, ModelError, System};
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
-//! `bounds::theta::assemble` on the examples with p <= 2 (the `moreau theta` workload minus
+//! `bounds::assemble` on the examples with p <= 2 (the `moreau theta` workload minus
 //! file parsing and printing): bound only, and with the measured side and the stationary set.
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 fn load(name: &str) -> model::System {

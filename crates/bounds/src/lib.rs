@@ -8,10 +8,17 @@
 //!   (Xinfsupp)) with rigorous quadrature remainders and the tail bound (DXX);
 //! - [`orbit`]: Section 5, Theorem 2: the linearised periodic orbit `eta_T` (eqs. (xiT),
 //!   (etaT)), `osc` (eq. (mho)), `||eta_T'||_inf`, and the path bounds (path), (path1), (path2);
-//! - [`theta`]: Section 6: `alpha` (eq. (alpha)), `psi` (eq. (phipsi)) and [`assemble`], which
-//!   puts every quantity together into eq. (theta);
+//! - [`exponent`]: Section 6: `alpha` (eq. (alpha)), `psi` (eq. (phipsi)) and `theta` as the
+//!   convex combination of eq. (theta);
+//! - [`beyond_paper`]: the bounds that are ours, not the paper's: `theta*`, `theta_profile`,
+//!   `theta_engaged`, the speed profile and the pinned speed (p = 1) they use (proofs in
+//!   `proofs-notes/theta-*.md`);
+//! - [`mod@assemble`]: [`assemble()`], every quantity of one model as a list of named stages
+//!   (plant -> tubes -> orbit -> gammas -> certificate -> theta -> path lengths -> beyond the
+//!   paper -> stationary, measured -> report), with its [`settings`] ([`ThetaSettings`]);
 //! - [`report`]: the one declaration of every reported quantity ([`report::QUANTITIES`]): key,
 //!   symbol, equation, bound direction; text tables, JSON keys and sweep columns derive from it;
+//!   the report of one model, [`ThetaReport`], and its JSON ([`report::theta_report`]);
 //! - [`error`]: why a quantity does not exist ([`BoundsError`]).
 //!
 //! # Example
@@ -39,14 +46,20 @@
 //! ```
 #![allow(non_snake_case)]
 
+pub mod assemble;
+pub mod beyond_paper;
 pub mod equations;
 pub mod error;
+pub mod exponent;
 pub mod orbit;
 pub mod report;
+pub mod settings;
 pub mod stationary;
-pub mod theta;
 pub mod tube;
 
+pub use assemble::assemble;
 pub use error::BoundsError;
+pub use exponent::Psi;
 pub use report::{BoundKind, Quantity};
-pub use theta::{assemble, MeasuredSide, ThetaReport, ThetaSettings};
+pub use report::{MeasuredSide, ThetaReport};
+pub use settings::ThetaSettings;

@@ -1,7 +1,7 @@
 //! A model with `[[effects]]` is outside the paper's class: `assemble` computes the nominal
 //! bound but never verifies it, and says which effects are to blame. Negative control: the
 //! same model without the effects is verified.
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 
 fn with_effects(extra: &str) -> model::System {
     let base =

@@ -1,8 +1,8 @@
-//! The worked example of NOTES.md (a = 1 and a = 5) through `bounds::theta::assemble`, and the
+//! The worked example of NOTES.md (a = 1 and a = 5) through `bounds::assemble`, and the
 //! bad-input cases of `assemble` (non-Hurwitz F, no period, polytope with R infinite).
 #![allow(non_snake_case)]
-use bounds::theta::{assemble, ThetaSettings};
 use bounds::BoundsError;
+use bounds::{assemble, ThetaSettings};
 
 fn load(name: &str) -> model::System {
     model::load(std::path::Path::new(&format!("{}/../../examples/{name}", env!("CARGO_MANIFEST_DIR")))).unwrap()
@@ -111,7 +111,7 @@ fn bad_inputs_give_named_errors_or_reported_cases() {
 #[test]
 fn assemble_is_deterministic_and_thread_safe() {
     fn assert_send_sync<T: Send + Sync>() {}
-    assert_send_sync::<bounds::theta::ThetaReport>();
+    assert_send_sync::<bounds::ThetaReport>();
     let sys = load("ellipse-p2.toml");
     let s = ThetaSettings::bound_only();
     let reference = assemble(&sys, &s).unwrap();
@@ -147,7 +147,7 @@ fn theta_star_is_sharper_and_verified_on_the_worked_example() {
     assert!(r.theta_engaged <= -0.15 && r.engaged_cells > 0, "theta_engaged = {}", r.theta_engaged);
     assert_eq!((r.theta_best_method, r.theta_best), ("theta_engaged", r.theta_engaged));
     // Negative control: an overestimated path (d ignored) gives a smaller, invalid theta*.
-    let psi = bounds::theta::Psi { alpha: r.alpha.lower, lambda: r.lambda_star, beta: r.beta_star };
+    let psi = bounds::Psi { alpha: r.alpha.lower, lambda: r.lambda_star, beta: r.beta_star };
     let too_long = (r.osc * 2.0) / (r.period * r.R);
     assert!(psi.theta(too_long, r.gamma_inf) < r.theta_star);
 }
@@ -161,7 +161,7 @@ fn psi_at_zero_is_never_negative_on_the_examples() {
         let r = assemble(&load(name), &ThetaSettings::bound_only()).unwrap();
         assert!(r.psi_0 >= 0.0, "{name}: psi(0) = {}", r.psi_0);
         for &(l, b, _) in &r.curve {
-            let psi = bounds::theta::Psi { alpha: r.alpha.lower, lambda: l, beta: b };
+            let psi = bounds::Psi { alpha: r.alpha.lower, lambda: l, beta: b };
             assert!(psi.at_zero() >= 0.0, "{name}: psi(0) = {} at lambda = {l}", psi.at_zero());
         }
     }

@@ -1,6 +1,6 @@
 //! The trait every convex compact set of the paper implements.
 use crate::linalg::{dist, dot, norm};
-use crate::{Bounds, StrongConvexity};
+use crate::{Enclosure, StrongConvexity};
 
 /// A nonempty convex compact set `S` in `R^p`.
 ///
@@ -67,7 +67,7 @@ pub trait ConvexSet: std::fmt::Debug + Send + Sync {
     }
 
     /// Diameter `max_{s, s' in S} |s - s'| = max_{|u|=1} sigma_S(u) + sigma_S(-u)`.
-    fn diameter(&self) -> Bounds {
+    fn diameter(&self) -> Enclosure {
         let p = self.dim();
         let lip = 2.0 * self.deviation_from_origin().upper;
         let mut neg = vec![0.0; p];
@@ -84,7 +84,7 @@ pub trait ConvexSet: std::fmt::Debug + Send + Sync {
 
     /// Deviation from the origin `D(S, {0}) = max_{s in S} |s| = max_{|u|=1} sigma_S(u)`
     /// (for `0 in S`), eq. (DTheta0).
-    fn deviation_from_origin(&self) -> Bounds;
+    fn deviation_from_origin(&self) -> Enclosure;
 
     /// Strong-convexity constant `R`, eq. (R).
     fn strong_convexity(&self) -> StrongConvexity;
@@ -116,10 +116,10 @@ impl<S: ConvexSet + ?Sized> ConvexSet for Box<S> {
     fn project_normal_cone(&self, q: &[f64], v: &[f64], tol: f64, out: &mut [f64]) {
         (**self).project_normal_cone(q, v, tol, out)
     }
-    fn diameter(&self) -> Bounds {
+    fn diameter(&self) -> Enclosure {
         (**self).diameter()
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         (**self).deviation_from_origin()
     }
     fn strong_convexity(&self) -> StrongConvexity {

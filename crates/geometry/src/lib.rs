@@ -26,7 +26,6 @@
 //! neither allocate nor convert.
 #![allow(non_snake_case)]
 
-pub mod bounds;
 pub mod convex_set;
 pub mod curvature;
 pub mod error;
@@ -40,10 +39,11 @@ pub mod strategies;
 pub mod strong_convexity;
 pub mod sublinear_max;
 
-pub use bounds::Bounds;
 pub use convex_set::ConvexSet;
 pub use error::GeometryError;
 pub use ops::{LinearImage, MinkowskiSum};
+/// The two-sided enclosure of a real quantity (declared in the `rounding` crate).
+pub use rounding::Enclosure;
 pub use shapes::{Ball, BallIntersection, Ellipsoid, Interval, Polytope, Shape, SupportSet};
 pub use sphere_max::{sphere_max, SphereMaxSettings};
 pub use strong_convexity::StrongConvexity;

@@ -10,7 +10,7 @@
 //! centre `c`: `f <= f(c/|c|) + L h`. Boxes are split (branch and bound) until the gap between
 //! the best value found and the largest upper bound is below the tolerance. For `p = 1` the
 //! sphere is `{-1, 1}` and the maximum is exact.
-use crate::Bounds;
+use crate::Enclosure;
 
 /// Orders the items of a branch-and-bound max-heap by their upper bound `ub` (total order on
 /// `f64`, so a NaN bound sorts first and is seen at once).
@@ -78,15 +78,15 @@ struct Cell {
 ordered_by_ub!(Cell);
 
 /// Encloses `max_{|u|=1} f(u)` for an `L`-Lipschitz `f` (with respect to the Euclidean
-/// distance on the sphere). Returns `Bounds { lower, upper }` where `lower` is attained at a
+/// distance on the sphere). Returns `Enclosure { lower, upper }` where `lower` is attained at a
 /// sampled point and `upper` is certified by the Lipschitz constant (up to rounding in `f`).
 /// If the evaluation budget runs out the bounds are still valid, only wider.
-pub fn sphere_max(p: usize, mut f: impl FnMut(&[f64]) -> f64, lipschitz: f64, s: &SphereMaxSettings) -> Bounds {
+pub fn sphere_max(p: usize, mut f: impl FnMut(&[f64]) -> f64, lipschitz: f64, s: &SphereMaxSettings) -> Enclosure {
     assert!(p >= 1, "sphere_max: dimension must be >= 1");
     if p == 1 {
         let a = f(&[1.0]);
         let b = f(&[-1.0]);
-        return Bounds::exact(a.max(b));
+        return Enclosure::exact(a.max(b));
     }
     let lip = lipschitz.max(0.0);
     let d = p - 1;
@@ -154,7 +154,7 @@ pub fn sphere_max(p: usize, mut f: impl FnMut(&[f64]) -> f64, lipschitz: f64, s:
         }
     }
     let upper = heap.peek().map(|c| c.ub).unwrap_or(lower).max(lower);
-    Bounds::new(lower, upper)
+    Enclosure::new(lower, upper)
 }
 
 #[cfg(test)]

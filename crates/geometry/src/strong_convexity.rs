@@ -1,4 +1,5 @@
 //! The strong-convexity constant `R` of eq. (R).
+use rounding::{gamma, UNIT_ROUNDOFF};
 
 /// `R` of eq. (R): the smallest `r` such that the set is contained in every ball of radius
 /// `r` supported at a boundary point by the same hyperplane (equivalently, the smallest `r`
@@ -50,86 +51,6 @@ impl StrongConvexity {
     /// enclosure could not be verified).
     pub fn is_verified_upper(&self) -> bool {
         matches!(self, Self::Exact(_) | Self::UpperBound(_))
-    }
-}
-
-/// Unit roundoff of `f64` (round to nearest), `u = 2^-53`.
-pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
-
-/// `gamma_k = k u / (1 - k u)` (Higham, *Accuracy and Stability*, eq. (3.8)): a sum or dot
-/// product of `k` terms evaluated in any order is within `gamma_k sum |terms|` of the exact
-/// value. `+inf` when `k u >= 1`.
-#[inline]
-pub fn gamma(k: usize) -> f64 {
-    let ku = k as f64 * UNIT_ROUNDOFF;
-    if ku >= 1.0 {
-        f64::INFINITY
-    } else {
-        ku / (1.0 - ku)
-    }
-}
-
-/// `true` when `x` is zero or a normal number far from under- and overflow, so that the exactness
-/// tests below (which read the sign of an `fma` residual) cannot be fooled by underflow.
-#[inline]
-fn tame(x: f64) -> bool {
-    x == 0.0 || (x.is_finite() && x.abs() >= 1e-140 && x.abs() <= 1e140)
-}
-
-/// `a + b` rounded upward: the nearest sum, moved up one ulp when Knuth's TwoSum shows that the
-/// exact sum is larger.
-pub fn add_up(a: f64, b: f64) -> f64 {
-    let s = a + b;
-    if !s.is_finite() {
-        return s;
-    }
-    let bb = s - a;
-    let err = (a - (s - bb)) + (b - bb);
-    if err > 0.0 {
-        s.next_up()
-    } else {
-        s
-    }
-}
-
-/// `a / b` rounded upward (`b > 0`): the quotient `q` is kept when `q b >= a` exactly (sign of
-/// the fused residual `fma(q, b, -a)`), otherwise moved up one ulp.
-pub fn div_up(a: f64, b: f64) -> f64 {
-    let q = a / b;
-    if !(tame(a) && tame(b) && tame(q)) || !(b > 0.0) {
-        return if q.is_finite() { q.next_up().next_up() } else { q };
-    }
-    if q.mul_add(b, -a) >= 0.0 {
-        q
-    } else {
-        q.next_up()
-    }
-}
-
-/// `sqrt(x)` rounded upward (`x >= 0`).
-#[inline]
-pub fn sqrt_up(x: f64) -> f64 {
-    let s = x.sqrt();
-    if !(tame(x) && tame(s)) {
-        return if s.is_finite() && s > 0.0 { s.next_up() } else { s };
-    }
-    if s.mul_add(s, -x) >= 0.0 {
-        s
-    } else {
-        s.next_up()
-    }
-}
-
-/// `sqrt(x)` rounded downward (`x >= 0`).
-pub fn sqrt_down(x: f64) -> f64 {
-    let s = x.sqrt();
-    if !(tame(x) && tame(s)) {
-        return if s.is_finite() && s > 0.0 { s.next_down().max(0.0) } else { s };
-    }
-    if s.mul_add(s, -x) <= 0.0 {
-        s
-    } else {
-        s.next_down()
     }
 }
 

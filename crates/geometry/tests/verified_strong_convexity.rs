@@ -1,11 +1,10 @@
 //! `R` of eq. (R) from verified bounds (issue 15, item 3): ellipsoids from a proven eigenvalue
 //! enclosure of the shape matrix, intervals and balls rounded upward; negative controls show that
 //! a wrong eigenvalue claim is rejected and flips `is_verified_upper`.
-use geometry::strong_convexity::{
-    add_up, div_up, proves_lambda_min_at_least, sqrt_down, sqrt_up, symmetric_eigen_enclosure,
-};
+use geometry::strong_convexity::{proves_lambda_min_at_least, symmetric_eigen_enclosure};
 use geometry::{BallIntersection, ConvexSet, Ellipsoid, Interval, StrongConvexity};
 use nalgebra::DMatrix;
+use rounding::{add_up, div_up, sqrt_down, sqrt_up};
 
 /// `Q diag(l) Q^T` for a rotation by `phi` (the product is rounded; what is verified is the
 /// rounded matrix).

@@ -4,7 +4,7 @@
 //! report *why* a certificate for eqs. (ALI), (bet) could not be produced. There is
 //! deliberately no catch-all `String` variant.
 
-use crate::sdp::SdpStatus;
+use crate::status::SdpStatus;
 
 /// Errors returned by the public functions of this crate.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -4,6 +4,7 @@
 //! Objects, one module each:
 //! - [`spectral_abscissa`]: `mu = max Re eig(F)`, eq. (stab), input validation;
 //! - [`sdp`]: the conic layer over Clarabel ([`ConicProgram`]), shared with Theorem 1's set;
+//! - [`status`]: the solver status [`SdpStatus`], mirrored from Clarabel;
 //! - [`psd_triangle`]: Clarabel's scaled upper-triangle storage of symmetric matrices;
 //! - [`feasibility`]: (ALI) `S(Pi F) <= -lambda Pi`, `Pi > 0`, and the supremum of `lambda`;
 //! - [`beta_sdp`]: minimal `beta = lambda_max(H^T Pi^{-1} H)`, eq. (bet), for given `lambda`;
@@ -25,6 +26,7 @@ pub mod lambda_search;
 pub mod psd_triangle;
 pub mod sdp;
 pub mod spectral_abscissa;
+pub mod status;
 pub mod verify;
 
 pub use beta_sdp::{certified_beta, pi_scale, solve_beta_sdp, BetaSdpSettings, BetaSdpSolution, CertifiedBeta};

@@ -9,8 +9,9 @@
 
 use crate::error::{LmiError, Result};
 use crate::psd_triangle::{svec, triangular_number};
+pub use crate::status::SdpStatus;
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SupportedConeT};
 use nalgebra::DMatrix;
 
 /// Interior-point settings passed to Clarabel.
@@ -75,45 +76,6 @@ impl SdpSettings {
             verbose: self.verbose,
             iterative_refinement_enable: !fast && d.iterative_refinement_enable,
             ..d
-        }
-    }
-}
-
-/// Solver status, mirrored from Clarabel so that its types do not leak into the API.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum SdpStatus {
-    /// Converged to the requested tolerances.
-    Solved,
-    /// Converged to the reduced tolerances.
-    AlmostSolved,
-    /// Primal infeasibility certificate (possibly reduced accuracy).
-    PrimalInfeasible,
-    /// Dual infeasibility certificate, i.e. unbounded (possibly reduced accuracy).
-    DualInfeasible,
-    /// Iteration limit reached.
-    MaxIterations,
-    /// Time limit reached.
-    MaxTime,
-    /// Numerical error in the factorisation.
-    NumericalError,
-    /// Lack of progress.
-    InsufficientProgress,
-    /// Not solved / terminated by callback.
-    Unsolved,
-}
-
-impl From<SolverStatus> for SdpStatus {
-    fn from(s: SolverStatus) -> Self {
-        match s {
-            SolverStatus::Solved => SdpStatus::Solved,
-            SolverStatus::AlmostSolved => SdpStatus::AlmostSolved,
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => SdpStatus::PrimalInfeasible,
-            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => SdpStatus::DualInfeasible,
-            SolverStatus::MaxIterations => SdpStatus::MaxIterations,
-            SolverStatus::MaxTime => SdpStatus::MaxTime,
-            SolverStatus::NumericalError => SdpStatus::NumericalError,
-            SolverStatus::InsufficientProgress => SdpStatus::InsufficientProgress,
-            SolverStatus::Unsolved | SolverStatus::CallbackTerminated => SdpStatus::Unsolved,
         }
     }
 }

@@ -46,22 +46,10 @@
 use crate::error::{LmiError, Result};
 use crate::spectral_abscissa::{check_scalar, check_shape, check_system};
 use nalgebra::DMatrix;
-
-/// Unit roundoff of `f64` (round to nearest), `2^-53`.
-pub const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
+use rounding::{gamma, UNIT_ROUNDOFF};
 
 /// Absolute slack per matrix entry covering gradual underflow (see module docs).
 const UNDERFLOW_SLACK: f64 = 1e-300;
-
-/// `gamma_k = k u / (1 - k u)` (Higham's notation); `+inf` when `k u >= 1`.
-pub fn gamma(k: usize) -> f64 {
-    let ku = k as f64 * UNIT_ROUNDOFF;
-    if ku >= 1.0 {
-        f64::INFINITY
-    } else {
-        ku / (1.0 - ku)
-    }
-}
 
 fn in_safe_range(x: f64) -> bool {
     x == 0.0 || (x.is_finite() && x.abs() >= 1e-200 && x.abs() <= 1e200)
@@ -590,12 +578,6 @@ mod tests {
         let D = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(eigs));
         let M = &Q * D * Q.transpose();
         symmetrize_upper(&M)
-    }
-
-    #[test]
-    fn gamma_values() {
-        assert_relative_eq!(gamma(1), UNIT_ROUNDOFF / (1.0 - UNIT_ROUNDOFF));
-        assert!(gamma(usize::MAX).is_infinite());
     }
 
     #[test]

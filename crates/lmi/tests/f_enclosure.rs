@@ -5,11 +5,12 @@
 #![allow(non_snake_case)]
 use lmi::fixtures::paper_example;
 use lmi::verify::{
-    certify, check_certificate, check_certificate_with, f_enclosure_radius, gamma, lyapunov_matrix,
-    lyapunov_matrix_enclosed, schur_block, schur_block_enclosed, VerifySettings,
+    certify, check_certificate, check_certificate_with, f_enclosure_radius, lyapunov_matrix, lyapunov_matrix_enclosed,
+    schur_block, schur_block_enclosed, VerifySettings,
 };
 use lmi::{certified_beta, BetaSdpSettings};
 use nalgebra::DMatrix;
+use rounding::gamma;
 
 /// A system with a huge loop gain `E C` (entries 1e6), so that the rounding of `A + E C` is
 /// ~2e-10 per entry, while `F = -I` has (ALI) margin `1 - lambda` with `Pi = I`.

@@ -13,7 +13,7 @@
 //! certifies when `(1 - 2/pi) psi(0) - (2/pi) lambda < 0` at some certified `(lambda, b_hat)`.
 use crate::sweep::axis::{apply_all, Parameter};
 use bounds::report::fmt_value as v;
-use bounds::theta::{assemble, Psi, ThetaReport, ThetaSettings};
+use bounds::{assemble, Psi, ThetaReport, ThetaSettings};
 use model::{Input, System};
 
 /// Settings of [`guidance`].

@@ -1,7 +1,7 @@
 //! `--format pgf` equivalent: every figure is also written as pgfplots code (`.tex`) and CSV.
 //! The code is ASCII, balanced and has one `\addplot` per element; when `pdflatex` and
 //! pgfplots are installed (Debian: texlive-latex-base, texlive-pictures), it must compile.
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use moreau::figures::{pgf, psi};
 use std::process::Command;
 

@@ -1,6 +1,6 @@
 //! Figure construction (data, not pixels): the circumscribed cross-section polygon of the
 //! tube, Fig. psi1's reference values, sweep curves grouped by the other axes.
-use bounds::theta::Psi;
+use bounds::Psi;
 use moreau::figures::{psi::psi_figure, sweep::sweep_figure, tube::support_polygon, Element, FigureError};
 use moreau::sweep::table::AxisInfo;
 use moreau::sweep::{Cell, Column, PointRecord, SweepResult};

@@ -2,7 +2,7 @@
 //! a too-small input: the smallest certifying amplitude it reports is certified by an
 //! independent bound computation, the factor just below is not (negative control), the
 //! blocking term is the path (kappa), and the amplitude sensitivity has the right sign.
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use model::Input;
 use moreau::guidance::{guidance, GuidanceSettings};
 

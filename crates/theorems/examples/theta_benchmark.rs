@@ -8,7 +8,7 @@
 //! `theta_star`, `theta_profile`, `theta_engaged`, `theta_best`) it reports how many systems it certifies
 //! (verified `< 0`), the median of bound / measured over the certified ones, and violations
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
-use bounds::theta::{assemble, ThetaReport, ThetaSettings};
+use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use rayon::prelude::*;
 use theorems::strategies::inputs::InputStrategyConfig;
@@ -90,7 +90,7 @@ fn main() {
                     .then(|| {
                         let (g1, ginf) = (m.path_length_per_period / (rep.period * rep.R), m.limsup_zdot / rep.R);
                         let psi = |l: f64, b: f64| {
-                            bounds::theta::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf)
+                            bounds::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf)
                         };
                         let own = lmi::optimise_lambda(&sys.F(), &sys.E, &sys.C, psi, &settings.lambda).ok()?;
                         own.curve
@@ -182,7 +182,7 @@ fn main() {
         r.rep
             .curve
             .iter()
-            .map(|&(lambda, beta, _)| bounds::theta::Psi { alpha: r.rep.alpha.lower, lambda, beta }.theta(g1, ginf))
+            .map(|&(lambda, beta, _)| bounds::Psi { alpha: r.rep.alpha.lower, lambda, beta }.theta(g1, ginf))
             .filter(|t| t.is_finite())
             .min_by(f64::total_cmp)
     };

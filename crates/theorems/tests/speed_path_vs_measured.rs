@@ -1,5 +1,5 @@
 //! The sharpened inputs of theta* against simulation (proofs-notes/theta-star.md):
-//! - the speed bound with the backlash side pinned (p = 1, `bounds::tube::EngagedSpeed`):
+//! - the speed bound with the backlash side pinned (p = 1, `bounds::beyond_paper::EngagedSpeed`):
 //!   measured `limsup |z'| <= zdot_star_bound <= zdot_bound` (eq. (zinf));
 //! - (path1-local), the partition bound with the step-length-dependent loss
 //!   `min(d, diam Theta + dt D)`: measured path per period `>= path1_local_bound >= path1_bound`.
@@ -12,7 +12,7 @@
 //!
 //! `SPEED_PATH_CASES=N` (default 12) random systems (about 0.5 s).
 use bounds::orbit::{partition_bound_local, EtaOrbit};
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use geometry::ConvexSet;
 use theorems::strategies::inputs::InputStrategyConfig;

@@ -1,7 +1,7 @@
 //! theta >= measured exponent whenever `theta < 0` is verified (eq. (theta) against eq. (VV)).
 //!
 //! Random systems from `theorems::strategies::systems` (p = 1, interval Theta, sine inputs)
-//! plus the worked example; `theta` is assembled by `bounds::theta::assemble` (bound only,
+//! plus the worked example; `theta` is assembled by `bounds::assemble` (bound only,
 //! cheap) and, for the candidates with `theta < 0` verified, the measured side (pairs of
 //! catching-up trajectories) is added. Claim: `ci_high <= theta` (the whole 95% CI of the
 //! measured exponent lies below the bound), for theta, theta* and theta_profile (the bounds
@@ -10,7 +10,7 @@
 //!
 //! Default: at most `4` verified random cases (drawn from at most 40 candidates); raise with
 //! `THETA_VS_MEASURED_CASES=N` (then `10 N` candidates).
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use theorems::strategies::inputs::InputStrategyConfig;
 use theorems::strategies::sets::{SetKind, SetStrategyConfig};

@@ -7,13 +7,14 @@
 //! Support functions of `C Xi_inf` and `C F Xi_inf` by the certified quadrature of
 //! [`TubeKernel`]; the maxima by `geometry::sublinear_sphere_max` (both functions are sublinear)
 //! with Lipschitz constants built from the kernels' `int ||K(s)|| ds` and `D(Theta, {0})`.
-//! Used by `theta::assemble` and by the Theorem 2 properties of the `theorems` campaign, so the
+//! Used by `crate::assemble()` and by the Theorem 2 properties of the `theorems` campaign, so the
 //! campaign checks the numbers that the report prints.
 use crate::error::BoundsError;
 use crate::tube::xi_support::SemigroupData;
 use crate::tube::{Horizon, TubeKernel, TubeSettings};
-use geometry::{sublinear_sphere_max, Bounds, ConvexSet, Shape, SphereMaxSettings};
+use geometry::{sublinear_sphere_max, ConvexSet, Shape, SphereMaxSettings};
 use nalgebra::{DMatrix, DVector};
+use rounding::Enclosure;
 
 /// `d` and `D(C(F Xi_inf + E Theta),{0})` with the kernels that produced them.
 #[derive(Debug, Clone)]
@@ -25,9 +26,9 @@ pub struct TubeDiameters {
     pub tube_CF: TubeKernel,
     /// `upper`: a proven upper bound of `d` (eq. (d)); `lower`: indicative only (best sampled
     /// value minus the quadrature widths), not a bound.
-    pub d: Bounds,
+    pub d: Enclosure,
     /// As `d` for `D(C(F Xi_inf + E Theta),{0})` (eq. (zinf)).
-    pub d_ftheta: Bounds,
+    pub d_ftheta: Enclosure,
     /// Both upper values come from valid Lipschitz or conic-combination bounds of upper
     /// quadrature enclosures: false when a value is not finite.
     pub verified: bool,
@@ -96,10 +97,10 @@ pub fn tube_diameters_with(
         lip_f,
         sphere,
     );
-    // the kernel's L = fl(C F) against C F_exact (tube::engaged_speed::cf_support_error)
-    let df_b = geometry::Bounds {
+    // the kernel's L = fl(C F) against C F_exact (tube::cf_rounding::cf_support_error)
+    let df_b = Enclosure {
         lower: df_b.lower,
-        upper: df_b.upper + crate::tube::engaged_speed::cf_support_error(C, F, E, tube.f_radius, sg, d_theta),
+        upper: df_b.upper + crate::tube::cf_rounding::cf_support_error(C, F, E, tube.f_radius, sg, d_theta),
     };
     let df_lower = df_b.lower - tube_CF.remainder_bound() - tube_CF.tail_bound();
     // The upper values are proofs when every enclosure they were built from is finite and the
@@ -114,8 +115,8 @@ pub fn tube_diameters_with(
     Ok(TubeDiameters {
         tube_C,
         tube_CF,
-        d: Bounds { lower: d_lower, upper: d_b.upper },
-        d_ftheta: Bounds { lower: df_lower, upper: df_b.upper },
+        d: Enclosure { lower: d_lower, upper: d_b.upper },
+        d_ftheta: Enclosure { lower: df_lower, upper: df_b.upper },
         verified,
     })
 }
@@ -139,7 +140,7 @@ impl OutputTube {
     }
 
     /// Enclosure of `sigma_{C Xi_inf}(v)` (eq. (Xinfsupp) with `u = C^T v`).
-    pub fn tube_support(&self, v: &[f64]) -> Bounds {
+    pub fn tube_support(&self, v: &[f64]) -> Enclosure {
         self.kernel.support_bounds(v)
     }
 

@@ -7,23 +7,11 @@
 //! ```
 //! Everything takes and returns `DMatrix<f64>` so that other crates (discovery) can reuse it.
 use nalgebra::DMatrix;
+use rounding::{gamma, UNIT_ROUNDOFF};
 
 /// `e^{M}` (scaling and squaring with Pade approximants, nalgebra's `exp`).
 pub fn expm(M: &DMatrix<f64>) -> DMatrix<f64> {
     M.clone().exp()
-}
-
-/// Unit roundoff `u = 2^-53`.
-const U: f64 = f64::EPSILON / 2.0;
-
-/// `gamma_k = k u / (1 - k u)` (Higham's notation; `+inf` when `k u >= 1`).
-fn gamma(k: usize) -> f64 {
-    let ku = k as f64 * U;
-    if ku >= 1.0 {
-        f64::INFINITY
-    } else {
-        ku / (1.0 - ku)
-    }
 }
 
 /// Frobenius norm rounded upward: the computed `sqrt(sum x^2)` has relative error below
@@ -80,7 +68,7 @@ pub fn expm_enclosure(M: &DMatrix<f64>) -> (DMatrix<f64>, f64) {
         let W = &B * &Z;
         let V = W / k as f64;
         let Zn = &I + &V;
-        e = (nb * e + gn * nb * nz) / k as f64 + 2.0 * U * (frobenius_up(&V) + frobenius_up(&Zn));
+        e = (nb * e + gn * nb * nz) / k as f64 + 2.0 * UNIT_ROUNDOFF * (frobenius_up(&V) + frobenius_up(&Zn));
         Z = Zn;
     }
     // Truncation of the Taylor series.
@@ -95,7 +83,7 @@ pub fn expm_enclosure(M: &DMatrix<f64>) -> (DMatrix<f64>, f64) {
         e = gn * ny * ny + e * (2.0 * ny + e);
         Y = &Y * &Y;
     }
-    let diff = frobenius_up(&(&X - &Y)) * (1.0 + 2.0 * U);
+    let diff = frobenius_up(&(&X - &Y)) * (1.0 + 2.0 * UNIT_ROUNDOFF);
     let err = (diff + e) * (1.0 + 1e-6) + 1e-300;
     (X, if err.is_finite() { err } else { f64::INFINITY })
 }

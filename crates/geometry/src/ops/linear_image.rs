@@ -1,7 +1,7 @@
 //! Linear image `M S = {M s : s in S}`: `sigma_{MS}(u) = sigma_S(M^T u)`.
 use crate::curvature::planar_strong_convexity;
 use crate::shapes::support_set::project_via_support;
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 use nalgebra::DMatrix;
 
 /// `M S` for a `q x p` matrix `M` and a set `S` in R^p (e.g. `C Xi_inf` in eq. (d)).
@@ -50,10 +50,10 @@ impl<S: ConvexSet> ConvexSet for LinearImage<S> {
     fn project(&self, x: &[f64], out: &mut [f64]) {
         project_via_support(self, x, out)
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         let lip = self.norm_m * self.set.deviation_from_origin().upper;
         let b = crate::sphere_max(self.dim(), |u| self.support(u), lip, &Default::default());
-        Bounds::new(b.lower.max(0.0), b.upper.min(lip).max(b.lower))
+        Enclosure::new(b.lower.max(0.0), b.upper.min(lip).max(b.lower))
     }
     fn strong_convexity(&self) -> StrongConvexity {
         match self.dim() {

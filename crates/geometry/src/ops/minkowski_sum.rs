@@ -1,7 +1,7 @@
 //! Minkowski sum `S_1 + ... + S_k`: `sigma = sigma_1 + ... + sigma_k`.
 use crate::curvature::planar_strong_convexity;
 use crate::shapes::support_set::project_via_support;
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 
 /// Sum of sets of the same dimension (e.g. `C Xi_inf + Theta` in eq. (d)).
 #[derive(Debug)]
@@ -38,10 +38,10 @@ impl ConvexSet for MinkowskiSum {
     fn project(&self, x: &[f64], out: &mut [f64]) {
         project_via_support(self, x, out)
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         let lip: f64 = self.parts.iter().map(|s| s.deviation_from_origin().upper).sum();
         let b = crate::sphere_max(self.dim(), |u| self.support(u), lip, &Default::default());
-        Bounds::new(b.lower.max(0.0), b.upper.min(lip).max(b.lower))
+        Enclosure::new(b.lower.max(0.0), b.upper.min(lip).max(b.lower))
     }
     /// `R(S_1 + S_2) <= R(S_1) + R(S_2)` (radii of curvature add): a verified upper bound
     /// when every part has one; otherwise the numerical planar value, or unknown.

@@ -1,7 +1,7 @@
 //! Closed Euclidean ball `B_r(c)` in any dimension.
 use super::{check_finite, fmt_vec};
 use crate::linalg::{dist, norm};
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 
 /// `{x : |x - c| <= r}`; `R = r` (eq. (R)). `r = 0` gives the singleton `{c}`
 /// (the linearised system's `Theta = {0}`).
@@ -81,11 +81,11 @@ impl ConvexSet for Ball {
             out[i] = s * (self.centre[i] - q[i]) / d;
         }
     }
-    fn diameter(&self) -> Bounds {
-        Bounds::exact(2.0 * self.radius)
+    fn diameter(&self) -> Enclosure {
+        Enclosure::exact(2.0 * self.radius)
     }
-    fn deviation_from_origin(&self) -> Bounds {
-        Bounds::exact(norm(&self.centre) + self.radius)
+    fn deviation_from_origin(&self) -> Enclosure {
+        Enclosure::exact(norm(&self.centre) + self.radius)
     }
     fn strong_convexity(&self) -> StrongConvexity {
         StrongConvexity::Exact(self.radius)

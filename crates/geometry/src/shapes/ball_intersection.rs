@@ -6,7 +6,7 @@
 use super::{check_finite, fmt_vec};
 use crate::linalg::{dist, dot, for_each_subset, norm, orthogonal_complement, solve_small};
 use crate::normal_cone::project_onto_cone;
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 
 /// `cap_i B_{r_i}(c_i)`, nonempty.
 #[derive(Debug, Clone, PartialEq)]
@@ -374,9 +374,9 @@ impl ConvexSet for BallIntersection {
             .collect();
         project_onto_cone(&gens, v, out);
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         let all: Vec<usize> = (0..self.radii.len()).collect();
-        Bounds::exact(self.farthest_from(&vec![0.0; self.dim()], &all))
+        Enclosure::exact(self.farthest_from(&vec![0.0; self.dim()], &all))
     }
     /// `R` = largest radius among the active balls: on an active sphere the boundary has
     /// curvature `1/r_i`, so `R >= r_i`; and `K` is an intersection of balls of radius

@@ -2,9 +2,10 @@
 //! matrix `M`; its semi-axes are `a_i = sqrt(eig_i(M))`.
 use super::{check_finite, fmt_vec};
 use crate::linalg::norm;
-use crate::strong_convexity::{div_up, sqrt_down, sqrt_up, symmetric_eigen_enclosure, EigenEnclosure};
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::strong_convexity::{symmetric_eigen_enclosure, EigenEnclosure};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 use nalgebra::DMatrix;
+use rounding::{div_up, sqrt_down, sqrt_up};
 
 /// Largest dimension handled without allocation in the projection.
 pub const MAX_DIM: usize = 16;
@@ -36,7 +37,7 @@ pub struct Ellipsoid {
 
 /// Memo of a deterministic function of the ellipsoid: ignored by `==`.
 #[derive(Debug, Clone, Default)]
-struct DeviationCache(std::sync::OnceLock<Bounds>);
+struct DeviationCache(std::sync::OnceLock<Enclosure>);
 
 impl PartialEq for DeviationCache {
     fn eq(&self, _: &Self) -> bool {
@@ -199,11 +200,11 @@ impl Ellipsoid {
 
 impl Ellipsoid {
     /// `D(E, {0})` by its definition (see [`ConvexSet::deviation_from_origin`]), not memoised.
-    fn deviation_from_origin_uncached(&self) -> Bounds {
+    fn deviation_from_origin_uncached(&self) -> Enclosure {
         let up = self.a_max_upper();
         let cn = norm(&self.centre);
         if cn == 0.0 {
-            return Bounds::new(self.lam[self.lam.len() - 1].sqrt().min(up), up);
+            return Enclosure::new(self.lam[self.lam.len() - 1].sqrt().min(up), up);
         }
         crate::sphere_max(self.dim(), |u| self.support(u), (cn + up) * (1.0 + 1e-12), &Default::default())
     }
@@ -349,13 +350,13 @@ impl ConvexSet for Ellipsoid {
         }
     }
     /// `2 a_max`, from above with the verified bound of `lambda_max(M)`.
-    fn diameter(&self) -> Bounds {
+    fn diameter(&self) -> Enclosure {
         let up = 2.0 * self.a_max_upper();
-        Bounds::new((2.0 * self.lam[self.lam.len() - 1].sqrt()).min(up), up)
+        Enclosure::new((2.0 * self.lam[self.lam.len() - 1].sqrt()).min(up), up)
     }
     /// `max_{|u|=1} c^T u + sqrt(u^T M u)`; `a_max` (from above) when `c = 0`, otherwise
     /// certified by [`crate::sphere_max`].
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         *self.deviation.0.get_or_init(|| self.deviation_from_origin_uncached())
     }
     /// `R = lambda_max / sqrt(lambda_min)` from the verified eigenvalue enclosure, rounded upward:

@@ -1,6 +1,6 @@
 //! Interval `[lo, hi]` in R^1: ordinary gear backlash `Theta = [-delta, delta]`.
 use super::check_finite;
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 
 /// `[lo, hi]`, a ball in R^1 of radius `(hi - lo)/2`, hence `R = (hi - lo)/2` (NOTES.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,16 +67,16 @@ impl ConvexSet for Interval {
         };
     }
     /// `hi - lo`, rounded upward (the lower end rounded to nearest).
-    fn diameter(&self) -> Bounds {
-        let up = crate::strong_convexity::add_up(self.hi, -self.lo);
-        Bounds::new((self.hi - self.lo).min(up), up)
+    fn diameter(&self) -> Enclosure {
+        let up = rounding::add_up(self.hi, -self.lo);
+        Enclosure::new((self.hi - self.lo).min(up), up)
     }
-    fn deviation_from_origin(&self) -> Bounds {
-        Bounds::exact(self.lo.abs().max(self.hi.abs()))
+    fn deviation_from_origin(&self) -> Enclosure {
+        Enclosure::exact(self.lo.abs().max(self.hi.abs()))
     }
     /// `R = (hi - lo)/2`, the difference rounded upward (TwoSum), the halving exact.
     fn strong_convexity(&self) -> StrongConvexity {
-        StrongConvexity::Exact(0.5 * crate::strong_convexity::add_up(self.hi, -self.lo))
+        StrongConvexity::Exact(0.5 * rounding::add_up(self.hi, -self.lo))
     }
     fn describe(&self) -> String {
         format!("interval [{}, {}]", self.lo, self.hi)

@@ -3,7 +3,7 @@
 use super::{check_finite, fmt_vec};
 use crate::linalg::{dist, dot, for_each_subset, norm, orthogonal_complement, solve_small};
 use crate::normal_cone::project_onto_cone;
-use crate::{Bounds, ConvexSet, GeometryError, StrongConvexity};
+use crate::{ConvexSet, Enclosure, GeometryError, StrongConvexity};
 
 /// Bounded polytope in half-space form; vertices are enumerated at construction.
 #[derive(Debug, Clone, PartialEq)]
@@ -242,24 +242,24 @@ impl ConvexSet for Polytope {
             .collect();
         project_onto_cone(&gens, v, out);
     }
-    fn diameter(&self) -> Bounds {
+    fn diameter(&self) -> Enclosure {
         let mut d = 0.0f64;
         for (i, a) in self.vertices.iter().enumerate() {
             for b in &self.vertices[i + 1..] {
                 d = d.max(dist(a, b));
             }
         }
-        Bounds::exact(d)
+        Enclosure::exact(d)
     }
-    fn deviation_from_origin(&self) -> Bounds {
-        Bounds::exact(self.vertices.iter().map(|v| norm(v)).fold(0.0, f64::max))
+    fn deviation_from_origin(&self) -> Enclosure {
+        Enclosure::exact(self.vertices.iter().map(|v| norm(v)).fold(0.0, f64::max))
     }
     fn strong_convexity(&self) -> StrongConvexity {
         if self.dim() == 1 {
             // Half the length, the difference rounded upward.
             let hi = self.vertices.iter().map(|v| v[0]).fold(f64::NEG_INFINITY, f64::max);
             let lo = self.vertices.iter().map(|v| v[0]).fold(f64::INFINITY, f64::min);
-            StrongConvexity::Exact(0.5 * crate::strong_convexity::add_up(hi, -lo))
+            StrongConvexity::Exact(0.5 * rounding::add_up(hi, -lo))
         } else {
             StrongConvexity::Infinite
         }

@@ -1,5 +1,5 @@
 //! The closed set of parametric shapes a model file can name (`[theta] shape = "..."`).
-use crate::{Ball, BallIntersection, Bounds, ConvexSet, Ellipsoid, Interval, Polytope, StrongConvexity};
+use crate::{Ball, BallIntersection, ConvexSet, Ellipsoid, Enclosure, Interval, Polytope, StrongConvexity};
 
 /// One of the parametric shapes; dispatches statically to the concrete set.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,7 +32,7 @@ impl Shape {
     /// balls and ellipsoids, dual certificates for intersections of balls and polytopes.
     pub fn support_upper(&self, u: &[f64]) -> f64 {
         match self {
-            Shape::Interval(i) => super::upper::mul_up(u[0], if u[0] >= 0.0 { i.hi } else { i.lo }),
+            Shape::Interval(i) => rounding::mul_up(u[0], if u[0] >= 0.0 { i.hi } else { i.lo }),
             Shape::Ball(b) => super::upper::ball_support_upper(&b.centre, b.radius, u),
             Shape::Ellipsoid(e) => super::upper::ellipsoid_support_upper(e.centre(), e.matrix(), u),
             Shape::BallIntersection(bi) => bi.support_upper(u),
@@ -76,10 +76,10 @@ impl ConvexSet for Shape {
     fn project_normal_cone(&self, q: &[f64], v: &[f64], tol: f64, out: &mut [f64]) {
         dispatch!(self, s => s.project_normal_cone(q, v, tol, out))
     }
-    fn diameter(&self) -> Bounds {
+    fn diameter(&self) -> Enclosure {
         dispatch!(self, s => s.diameter())
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         dispatch!(self, s => s.deviation_from_origin())
     }
     fn strong_convexity(&self) -> StrongConvexity {

@@ -2,7 +2,7 @@
 //! (eqs. (Xinfsupp), (d)).
 use crate::curvature::planar_strong_convexity;
 use crate::linalg::{dot, norm};
-use crate::{Bounds, ConvexSet, StrongConvexity};
+use crate::{ConvexSet, Enclosure, StrongConvexity};
 use std::sync::Arc;
 
 /// Support function closure `u -> sigma_S(u)`.
@@ -160,14 +160,12 @@ impl ConvexSet for SupportSet {
     fn project(&self, x: &[f64], out: &mut [f64]) {
         project_via_support(self, x, out)
     }
-    fn deviation_from_origin(&self) -> Bounds {
+    fn deviation_from_origin(&self) -> Enclosure {
         crate::sphere_max(self.dim, |u| self.support(u), self.radius_bound, &Default::default())
     }
     fn strong_convexity(&self) -> StrongConvexity {
         match self.dim {
-            1 => StrongConvexity::Exact(
-                0.5 * crate::strong_convexity::add_up(self.support(&[1.0]), self.support(&[-1.0])),
-            ),
+            1 => StrongConvexity::Exact(0.5 * rounding::add_up(self.support(&[1.0]), self.support(&[-1.0]))),
             2 => planar_strong_convexity(|u| self.support(u)),
             _ => StrongConvexity::Unknown,
         }

@@ -10,35 +10,7 @@
 //! `{x : A x <= b}`, `sigma(u) <= b^T y + D(S,{0}) |u - A^T y|` for every `y >= 0` (Lagrangian
 //! duality). The maximiser only chooses a split (or `y`) that makes the bound tight.
 use crate::linalg::solve_small;
-use crate::strong_convexity::{gamma, sqrt_up, UNIT_ROUNDOFF};
-
-/// `x` moved up one ulp (the last rounding of a sum that is already an upper bound in exact
-/// arithmetic).
-#[inline]
-pub(crate) fn up(x: f64) -> f64 {
-    if x.is_finite() {
-        x.next_up()
-    } else {
-        x
-    }
-}
-
-/// `a b` rounded upward (exactness of the nearest product checked with `fma`).
-#[inline]
-pub fn mul_up(a: f64, b: f64) -> f64 {
-    let p = a * b;
-    if !p.is_finite() {
-        return p;
-    }
-    if p.abs() < 1e-290 {
-        return p + 1e-290;
-    }
-    if a.mul_add(b, -p) > 0.0 {
-        p.next_up()
-    } else {
-        p
-    }
-}
+use rounding::{gamma, sqrt_up, ulp_up, UNIT_ROUNDOFF};
 
 /// Upper bound of `sigma_{B_r(c)}(u) = c^T u + r |u|`.
 #[inline]
@@ -52,7 +24,7 @@ pub fn ball_support_upper(c: &[f64], r: f64, u: &[f64]) -> f64 {
         ss += u[i] * u[i];
     }
     let rn = r * sqrt_up(ss * (1.0 + 2.0 * gamma(p + 1)));
-    up(d + rn + 2.0 * gamma(p + 4) * (ad + rn) + 1e-300)
+    ulp_up(d + rn + 2.0 * gamma(p + 4) * (ad + rn) + 1e-300)
 }
 
 /// Upper bound of `sigma(u) = c^T u + sqrt(u^T M u)` (ellipsoid, `M` row-major `p x p`).
@@ -74,7 +46,7 @@ pub fn ellipsoid_support_upper(c: &[f64], m: &[f64], u: &[f64]) -> f64 {
         d += t;
         ad += t.abs();
     }
-    up(d + s + 2.0 * gamma(p + 4) * ad + 4.0 * UNIT_ROUNDOFF * s + 1e-300)
+    ulp_up(d + s + 2.0 * gamma(p + 4) * ad + 4.0 * UNIT_ROUNDOFF * s + 1e-300)
 }
 
 /// Split certificate for `cap_{i in J} B_{r_i}(c_i)` at a (computed) maximiser `s`: the
@@ -121,7 +93,7 @@ pub fn split_support_upper(centres: &[&[f64]], radii: &[f64], s: &[f64], u: &[f6
     total += b;
     total_abs += b.abs();
     let v = total + (cl + radii[k - 1] * 1.01) * e + 2.0 * gamma(k + 2) * total_abs;
-    v.is_finite().then(|| up(v))
+    v.is_finite().then(|| ulp_up(v))
 }
 
 /// Lagrangian certificate for `{x : A x <= b}` (rows `normals`, `offsets`) at a (computed)
@@ -140,7 +112,7 @@ pub fn polytope_support_upper(
     const MAXP: usize = 16;
     let p = u.len();
     let nu = sqrt_up(u.iter().map(|x| x * x).sum::<f64>() * (1.0 + 2.0 * gamma(p + 1)));
-    let fallback = up(dev * nu * (1.0 + 4.0 * UNIT_ROUNDOFF));
+    let fallback = ulp_up(dev * nu * (1.0 + 4.0 * UNIT_ROUNDOFF));
     if p > MAXP {
         return fallback;
     }
@@ -205,7 +177,7 @@ pub fn polytope_support_upper(
     let res = sqrt_up(res2 * (1.0 + 2.0 * gamma(p + 1)));
     let val = by + g * aby + dev * res * (1.0 + 4.0 * UNIT_ROUNDOFF);
     if val.is_finite() {
-        up(val).min(fallback)
+        ulp_up(val).min(fallback)
     } else {
         fallback
     }
@@ -231,7 +203,7 @@ pub fn split_support_upper_2d(ci: &[f64], ri: f64, cj: &[f64], rj: f64, s: &[f64
     let lip = (cj[0] * cj[0] + cj[1] * cj[1]).sqrt() * 1.01 + rj * 1.01;
     let (b1, b2) = (ball_support_upper(ci, ri, &ui), ball_support_upper(cj, rj, &uj));
     let v = b1 + b2 + lip * e * 1.01 + 2.0 * gamma(3) * (b1.abs() + b2.abs());
-    v.is_finite().then(|| up(v))
+    v.is_finite().then(|| ulp_up(v))
 }
 
 #[cfg(test)]
@@ -253,8 +225,6 @@ mod tests {
             let e = ellipsoid_support_upper(&c, &m, &u);
             assert!(e >= ex && e <= ex + 1e-14, "{e} {ex}");
         }
-        assert_eq!(mul_up(2.0, 3.0), 6.0);
-        assert!(mul_up(0.1, 3.0) >= 0.1 * 3.0);
     }
 
     /// The split certificate is valid for every split: with a deliberately wrong maximiser it

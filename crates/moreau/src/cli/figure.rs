@@ -114,7 +114,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                     vec![("trajectory-yz".into(), yz), ("trajectory-x".into(), x)]
                 }
                 Kind::Psi => {
-                    let r = bounds::theta::assemble(&sys, &bounds::theta::ThetaSettings::bound_only())?;
+                    let r = bounds::assemble(&sys, &bounds::ThetaSettings::bound_only())?;
                     eprintln!(
                         "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
                         r.theta,
@@ -130,7 +130,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                     vec![("fig-psi1".into(), figures::psi::from_report(&r))]
                 }
                 Kind::Tube => {
-                    let settings = bounds::theta::ThetaSettings::bound_only();
+                    let settings = bounds::ThetaSettings::bound_only();
                     let orbit = bounds::orbit::EtaOrbit::new(&sys, &settings.orbit)?;
                     let tube = bounds::tube::OutputTube::new(&sys, &settings.tube)?;
                     let z = figures::tube::periodic_z(&sys, 2000)?;

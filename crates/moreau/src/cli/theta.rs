@@ -3,7 +3,7 @@
 //! measured convergence exponent, path length per period and limsup |z'|.
 use anyhow::Context;
 use bounds::report::{fmt_value, render_table};
-use bounds::theta::{assemble, ThetaReport, ThetaSettings};
+use bounds::{assemble, ThetaReport, ThetaSettings};
 use geometry::ConvexSet;
 use std::path::PathBuf;
 use std::process::ExitCode;

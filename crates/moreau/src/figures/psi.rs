@@ -4,7 +4,7 @@
 //! levels ([`from_report`]).
 use super::canvas::{Element, Figure, BLUE, GREEN, GREY, ORANGE, PURPLE, RED};
 use crate::sweep::table::sig;
-use bounds::theta::{Psi, ThetaReport};
+use bounds::{Psi, ThetaReport};
 
 /// Fig. psi1 from the function and the two gammas (`theta` is read off the chord).
 pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {

@@ -1,4 +1,4 @@
-//! The evaluator of `moreau sweep`: [`bounds::theta::assemble`] at every point (theta of
+//! The evaluator of `moreau sweep`: [`bounds::assemble`] at every point (theta of
 //! eq. (theta) and its parts, the path bounds (path), (path1), (path2)), with the measured
 //! exponent and path length of simulated trajectories, their ratio and which bounds are
 //! verified.
@@ -8,7 +8,7 @@
 //! `transient_periods` (default `10`), `pairs` (default `2`), `seed` (default `11`).
 use super::eval::{Cell, Column, Evaluator, PointError};
 use super::SweepError;
-use bounds::theta::{assemble, ThetaSettings};
+use bounds::{assemble, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use model::System;
 use std::path::Path;

@@ -19,8 +19,8 @@ pub fn alpha(C: &DMatrix<f64>, E: &DMatrix<f64>) -> Alpha {
     let p = S.nrows();
     let eig = S.clone().symmetric_eigen();
     let est = eig.eigenvalues.iter().copied().fold(f64::INFINITY, f64::min);
-    let n = C.ncols() as f64;
-    let gam = (n + 2.0) * f64::EPSILON / (1.0 - (n + 2.0) * f64::EPSILON);
+    // (n + 2) eps / (1 - (n + 2) eps) = gamma_{2(n+2)}
+    let gam = rounding::gamma(2 * (C.ncols() + 2));
     let absprod = C.abs() * E.abs();
     let rounding = gam * absprod.iter().map(|x| x * x).sum::<f64>().sqrt();
     let scale = S.iter().map(|x| x * x).sum::<f64>().sqrt();

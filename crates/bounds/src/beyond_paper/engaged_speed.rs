@@ -17,10 +17,11 @@
 //! `v` in `Theta` for either sign); they are lower by `CE (hi - lo)` when `CE > 0`. The floors
 //! hold only while the backlash is engaged (`theta_engaged` decides where).
 use crate::error::BoundsError;
+use crate::tube::cf_rounding::{cf_support_error, PAD};
 use crate::tube::{Horizon, SemigroupData, TubeKernel, TubeSettings};
-use dynamics::linear::expm::frobenius_up;
 use geometry::{ConvexSet, Shape};
 use nalgebra::DMatrix;
+use rounding::{pad_down, pad_up};
 
 /// Offsets of the signed speed of `z` for `p = 1` (module docs), each an upper bound: the band of
 /// [`EngagedHistory`] at `tau = 0` ([`EngagedHistory::pinned`]).
@@ -40,34 +41,8 @@ pub struct EngagedSpeed {
 impl EngagedSpeed {
     /// `limsup |z'| <= ||eta_T'||_inf + max(ceil_up, ceil_down)` (at least `0`), from above.
     pub fn zdot_bound(&self, eta_dot_inf: f64) -> f64 {
-        up((eta_dot_inf + self.ceil_up.max(self.ceil_down)).max(0.0))
+        pad_up((eta_dot_inf + self.ceil_up.max(self.ceil_down)).max(0.0), PAD)
     }
-}
-
-/// Upper bound of `||C F_exact - fl(C F)||_F` for the computed `F` with `||F_exact - F||_2 <=
-/// f_radius` (the product's rounding `gamma_n ||C|| ||F||` and `||C|| f_radius`).
-pub fn cf_error(C: &DMatrix<f64>, F: &DMatrix<f64>, f_radius: f64) -> f64 {
-    let n = F.nrows() as f64;
-    let g = n * f64::EPSILON / (1.0 - n * f64::EPSILON);
-    up(frobenius_up(C) * (f_radius + g * frobenius_up(F)) * (1.0 + 1e-10))
-}
-
-/// Upper bound of the effect of `L = fl(C F)` (instead of `C F_exact`) on a support integral
-/// `int_0^inf sigma_Theta((L e^{sF_exact} E)^T v) ds`, `|v| = 1`: `D(Theta, {0}) ||dL|| ||E||
-/// int ||e^{s F_exact}||`, with `int ||e^{s F_exact}|| <= I + eps I^2 / (1 - eps I)` (`I` the
-/// proven integral for `F`, `eps = f_radius`). Infinite when `F` has no proven semigroup bound.
-pub fn cf_support_error(
-    C: &DMatrix<f64>,
-    F: &DMatrix<f64>,
-    E: &DMatrix<f64>,
-    f_radius: f64,
-    sg: &SemigroupData,
-    d_theta: f64,
-) -> f64 {
-    let Some(b) = sg.exp_norm() else { return f64::INFINITY };
-    let i = b.integral;
-    let i_exact = if f_radius * i < 0.5 { i + f_radius * i * i / (1.0 - f_radius * i) } else { f64::INFINITY };
-    up(d_theta * cf_error(C, F, f_radius) * frobenius_up(E) * i_exact * (1.0 + 1e-10))
 }
 
 /// The engaged history of the backlash for `p = 1` (beyond the paper; proofs-notes/theta-engaged.md,
@@ -86,7 +61,7 @@ pub fn cf_support_error(
 /// finite-horizon [`TubeKernel`]s (lower values: proven here because `sigma_Theta` of an
 /// interval, or of the point `{1}` for `I`, is one multiplication, within the kernel's
 /// allowance), those over `[0, inf)` from the caller's `sigma_{C F Xi_inf}` kernel (upper
-/// values), each widened by the effect of `||C F_exact - fl(C F)||` ([`cf_error`]).
+/// values), each widened by the effect of `||C F_exact - fl(C F)||` ([`crate::tube::cf_rounding::cf_error`]).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct EngagedHistory {
@@ -136,10 +111,10 @@ impl EngagedHistory {
         let (s_up, s_down) = (tube_CF.support_upper(&[1.0]), tube_CF.support_upper(&[-1.0]));
         let mut out = Self {
             dtau,
-            known_lo: vec![down(ce - ce_err)],
-            known_hi: vec![up(ce + ce_err)],
-            tail_up: vec![up(s_up + d_theta * l_err)],
-            tail_down: vec![up(s_down + d_theta * l_err)],
+            known_lo: vec![pad_down(ce - ce_err, PAD)],
+            known_hi: vec![pad_up(ce + ce_err, PAD)],
+            tail_up: vec![pad_up(s_up + d_theta * l_err, PAD)],
+            tail_down: vec![pad_up(s_down + d_theta * l_err, PAD)],
         };
         for j in 1..=steps {
             let tau = j as f64 * dtau;
@@ -148,10 +123,10 @@ impl EngagedHistory {
             let ki = TubeKernel::with_shared(&CF, F, E, &unit, 1.0, sg, h, tube)?;
             let (a_up, a_down) = (kt.support_bounds(&[1.0]).lower, kt.support_bounds(&[-1.0]).lower);
             let int = ki.support_bounds(&[1.0]);
-            out.tail_up.push(up(s_up - a_up + 2.0 * d_theta * l_err).max(0.0));
-            out.tail_down.push(up(s_down - a_down + 2.0 * d_theta * l_err).max(0.0));
-            out.known_lo.push(down(ce - ce_err + int.lower - l_err));
-            out.known_hi.push(up(ce + ce_err + int.upper + l_err));
+            out.tail_up.push(pad_up(s_up - a_up + 2.0 * d_theta * l_err, PAD).max(0.0));
+            out.tail_down.push(pad_up(s_down - a_down + 2.0 * d_theta * l_err, PAD).max(0.0));
+            out.known_lo.push(pad_down(ce - ce_err + int.lower - l_err, PAD));
+            out.known_hi.push(pad_up(ce + ce_err + int.upper + l_err, PAD));
         }
         let finite = [&out.known_lo, &out.known_hi, &out.tail_up, &out.tail_down]
             .iter()
@@ -178,25 +153,7 @@ impl EngagedHistory {
         } else {
             (w * self.known_hi[j], w * self.known_lo[j])
         };
-        (down(k_lo - self.tail_down[j]), up(k_hi + self.tail_up[j]))
-    }
-}
-
-/// Rounds down by a relative `4u` and an absolute `MIN_POSITIVE`.
-fn down(x: f64) -> f64 {
-    if x.is_finite() {
-        x - 4.0 * f64::EPSILON * x.abs() - f64::MIN_POSITIVE
-    } else {
-        x
-    }
-}
-
-/// Rounds up by a relative `4u` and an absolute `MIN_POSITIVE` (one sum of a few terms).
-fn up(x: f64) -> f64 {
-    if x.is_finite() {
-        x + 4.0 * f64::EPSILON * x.abs() + f64::MIN_POSITIVE
-    } else {
-        x
+        (pad_down(k_lo - self.tail_down[j], PAD), pad_up(k_hi + self.tail_up[j], PAD))
     }
 }
 

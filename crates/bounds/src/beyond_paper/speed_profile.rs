@@ -30,9 +30,13 @@
 //! holds from an earlier time `u >= l_c := (min_c sigma eta_T' - D) / R`. A cell then carries the
 //! chord of `psi` over `[l_c, g_c]` instead of `[0, g_c]`, and the path bound of an interval only
 //! has to be met by the speed above the floors. With every `l_c = 0` the bound is `theta_profile`.
-use crate::theta::psi::Psi;
-use crate::tube::{EngagedHistory, EngagedSpeed};
+use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
+use crate::exponent::psi::Psi;
 use geometry::linalg::dist;
+use rounding::scale_up;
+
+/// Relative margin of the enclosures here ([`scale_up`]): `1e-12`.
+const MARGIN: f64 = 1e-12;
 
 /// Time-resolved data of one period: cell speed bounds and the orbit at the cell boundaries.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,7 +71,7 @@ impl SpeedProfile {
     pub fn new(T: f64, eta: Vec<Vec<f64>>, eta_dot_cell: &[f64], d_ftheta: f64, d: f64, R: f64) -> Self {
         let cells = eta_dot_cell.len();
         assert_eq!(eta.len(), cells + 1, "one more boundary than cells");
-        let g = eta_dot_cell.iter().map(|e| up((e + d_ftheta) / R)).collect();
+        let g = eta_dot_cell.iter().map(|e| scale_up((e + d_ftheta) / R, MARGIN)).collect();
         Self {
             h: T / cells as f64,
             g,
@@ -89,7 +93,7 @@ impl SpeedProfile {
         assert!(deta_low.len() == self.cells() && deta_high.len() == self.cells(), "one enclosure per cell");
         for c in 0..self.cells() {
             let top = (deta_high[c] + es.ceil_up).max(-deta_low[c] + es.ceil_down).max(0.0);
-            self.g[c] = self.g[c].min(up(up(top) / self.R));
+            self.g[c] = self.g[c].min(scale_up(scale_up(top, MARGIN) / self.R, MARGIN));
         }
         self.engaged_offsets = Some((es.floor_up, es.floor_down));
         self
@@ -172,7 +176,7 @@ impl SpeedProfile {
             let (zl, zh) = (deta_low[c] + a, deta_high[c] + b);
             let (sl, sh) = if sigma > 0.0 { (zl, zh) } else { (-zh, -zl) };
             let (sl, sh) = (sl - 4.0 * f64::EPSILON * sl.abs(), sh + 4.0 * f64::EPSILON * sh.abs());
-            self.g[c] = self.g[c].min(up(sh.max(0.0) / self.R));
+            self.g[c] = self.g[c].min(scale_up(sh.max(0.0) / self.R, MARGIN));
             self.floor[c] = self.floor[c].max(sl / self.R * (1.0 - 1e-12)).min(self.g[c]);
         }
         self
@@ -292,15 +296,6 @@ impl SpeedProfile {
         }
         nodes.reverse();
         nodes
-    }
-}
-
-/// Rounds a positive finite value up by a relative `1e-12` (enclosure margins).
-fn up(x: f64) -> f64 {
-    if x.is_finite() {
-        x * (1.0 + 1e-12) + f64::MIN_POSITIVE
-    } else {
-        x
     }
 }
 

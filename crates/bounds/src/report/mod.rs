@@ -3,6 +3,12 @@
 //! and whether that bound is verified. Each is declared once ([`defs`]); the text table
 //! ([`render_table`]), the JSON keys (`ThetaReport::to_json`) and the sweep columns of
 //! `moreau sweep` derive from the declarations.
+//!
+//! The report of one model, [`ThetaReport`], and its JSON are in [`theta_report`].
+
+pub mod theta_report;
+
+pub use theta_report::{MeasuredSide, ThetaReport};
 
 /// How a reported number relates to the true quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

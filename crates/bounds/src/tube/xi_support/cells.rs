@@ -1,0 +1,282 @@
+//! The walk over the quadrature cells ([`TubeKernel::build`]): blocks of cells of equal width,
+//! `e^{mF}` propagated from centre to centre with its error, the cell matrices
+//! `K -+ r K'`, `K` and their error bounds, and the tiling of `[0, S]`
+//! (proofs-notes/tube-quadrature.md, "the quadrature matrices" and "the cells").
+use super::semigroup::SemigroupData;
+use super::{frob, Accum, ThetaSupport, TubeKernel};
+use geometry::Shape;
+use nalgebra::DMatrix;
+use rounding::{gamma, two_sum, UNIT_ROUNDOFF};
+
+/// Cells per block (one exponential step across each block boundary).
+const BLOCK: usize = 32;
+
+impl TubeKernel {
+    /// The cells of width `h(s) = h0 e^{grade s}` (capped at `h_cap`) in blocks of [`BLOCK`]
+    /// tiling `[0, s_max]`; `None` when more than `max_cells` would be needed.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn build(
+        sg: &SemigroupData,
+        L: &DMatrix<f64>,
+        LF: &DMatrix<f64>,
+        LF2: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        s_max: f64,
+        h0: f64,
+        grade: f64,
+        h_cap: f64,
+        d_theta: f64,
+        nF: f64,
+        nE: f64,
+        msup: f64,
+        r: usize,
+        p: usize,
+        max_cells: usize,
+    ) -> Option<(Self, Accum)> {
+        let mut walk = CellWalk::new(sg, L, LF, LF2, F, E, d_theta, nF, nE, msup);
+        let mut sb = 0.0;
+        let mut h_first = f64::NAN;
+        while sb < s_max {
+            let mut hb = (h0 * (grade * sb).exp()).min(h_cap).max(h0);
+            let mut count = BLOCK;
+            if sb + BLOCK as f64 * hb >= s_max {
+                count = (((s_max - sb) / hb).ceil() as usize).max(1);
+                hb = (s_max - sb) / count as f64;
+            }
+            if h_first.is_nan() {
+                h_first = hb;
+            }
+            if walk.half.len() + count > max_cells {
+                return None;
+            }
+            walk.block(hb, count);
+            sb += count as f64 * hb;
+            if count < BLOCK {
+                break;
+            }
+        }
+        Some(walk.finish(theta, s_max, h_first, r, p))
+    }
+}
+
+/// The state of the walk: the stored cell matrices and sums, `P ~ e^{tau F}` at the current
+/// cell centre `tau` (the exact sum of the float steps, kept as a double-double
+/// `(t_hi, t_lo)`), and the summed local errors `cum_loc`.
+struct CellWalk<'a> {
+    sg: &'a SemigroupData,
+    L: &'a DMatrix<f64>,
+    LF: &'a DMatrix<f64>,
+    LF2: &'a DMatrix<f64>,
+    E: &'a DMatrix<f64>,
+    d_theta: f64,
+    nF: f64,
+    nE: f64,
+    msup: f64,
+    /// `gamma_n` and the norms of `L`, `fl(L F)`, `fl(fl(L F) F)`.
+    gn: f64,
+    nL: f64,
+    nLF: f64,
+    nLF2: f64,
+    /// Errors of `fl(L F)` and `fl(fl(L F) F)` against `L F` and `L F^2`.
+    e_LF: f64,
+    e_LF2: f64,
+    minus: Vec<f64>,
+    mid: Vec<f64>,
+    plus: Vec<f64>,
+    half: Vec<f64>,
+    remainder: f64,
+    k_l1: f64,
+    acc: Accum,
+    P: Option<DMatrix<f64>>,
+    cum_loc: f64,
+    prev_rr: f64,
+    t_hi: f64,
+    t_lo: f64,
+    t_lo_abs: f64,
+    defects: f64,
+}
+
+impl<'a> CellWalk<'a> {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        sg: &'a SemigroupData,
+        L: &'a DMatrix<f64>,
+        LF: &'a DMatrix<f64>,
+        LF2: &'a DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &'a DMatrix<f64>,
+        d_theta: f64,
+        nF: f64,
+        nE: f64,
+        msup: f64,
+    ) -> Self {
+        let n = F.nrows();
+        let gn = gamma(n);
+        let nL = frob(L);
+        let nLF = frob(LF);
+        let nLF2 = frob(LF2);
+        // fl(L F) and fl(fl(L F) F) against L F and L F^2.
+        let e_LF = gn * nL * nF;
+        let e_LF2 = e_LF * nF + gn * nLF * nF;
+        Self {
+            sg,
+            L,
+            LF,
+            LF2,
+            E,
+            d_theta,
+            nF,
+            nE,
+            msup,
+            gn,
+            nL,
+            nLF,
+            nLF2,
+            e_LF,
+            e_LF2,
+            minus: Vec::new(),
+            mid: Vec::new(),
+            plus: Vec::new(),
+            half: Vec::new(),
+            remainder: 0.0,
+            k_l1: 0.0,
+            acc: Accum::default(),
+            P: None,
+            cum_loc: 0.0,
+            prev_rr: 0.0,
+            t_hi: 0.0,
+            t_lo: 0.0,
+            t_lo_abs: 0.0,
+            defects: 0.0,
+        }
+    }
+
+    /// The exact centre moves by `x`: `(t_hi, t_lo) += x` (TwoSum).
+    fn advance(&mut self, x: f64) {
+        let (s, e) = two_sum(self.t_hi, x);
+        self.t_hi = s;
+        self.t_lo += e;
+        self.t_lo_abs += e.abs();
+    }
+
+    /// One block of `count` cells of width `hb`.
+    fn block(&mut self, hb: f64, count: usize) {
+        let rr = 0.5 * hb;
+        let grow = (rr * self.nF).exp();
+        let (step, e_step) = self.sg.exp_step(hb);
+        let n_step = frob(&step);
+        self.first_centre(rr);
+        for j in 0..count {
+            self.cell(j, hb, rr, grow, &step, e_step, n_step);
+        }
+        self.prev_rr = rr;
+    }
+
+    /// `P` moves to the first centre of a block of half-width `rr` (from `0`, or across the
+    /// block boundary by `r_prev + rr`, whose TwoSum error is a tiling defect).
+    fn first_centre(&mut self, rr: f64) {
+        self.P = Some(match self.P.take() {
+            None => {
+                let (P0, e0) = self.sg.exp_step(rr);
+                self.cum_loc += e0;
+                self.advance(rr);
+                P0
+            }
+            Some(Pp) => {
+                let (g, e) = two_sum(self.prev_rr, rr);
+                self.defects += e.abs();
+                let (G, eG) = self.sg.exp_step(g);
+                self.cum_loc += frob(&Pp) * (eG + self.gn * frob(&G));
+                self.advance(g);
+                &Pp * &G
+            }
+        });
+    }
+
+    /// Cell `j` of a block (after one step of `hb` unless it is the first): its matrices
+    /// `K -+ rr K'`, `K`, their error bounds, the Taylor remainder and the norm sums.
+    #[allow(clippy::too_many_arguments)]
+    fn cell(&mut self, j: usize, hb: f64, rr: f64, grow: f64, step: &DMatrix<f64>, e_step: f64, n_step: f64) {
+        let (gn, nL, nLF, nLF2, e_LF, e_LF2) = (self.gn, self.nL, self.nLF, self.nLF2, self.e_LF, self.e_LF2);
+        let (nE, msup) = (self.nE, self.msup);
+        let mut Pc = self.P.take().unwrap();
+        if j > 0 {
+            self.cum_loc += frob(&Pc) * (e_step + gn * n_step);
+            Pc = &Pc * step;
+            self.advance(hb);
+        }
+        let nP = frob(&Pc);
+        let dP = msup * self.cum_loc * (1.0 + 1e-10);
+        let PE = &Pc * self.E;
+        let nPE = frob(&PE);
+        let e_PE = dP * nE + gn * nP * nE;
+        let K = self.L * &PE;
+        let nK = frob(&K);
+        let e_K = nL * e_PE + gn * nL * nPE;
+        let K1 = self.LF * &PE;
+        let nK1 = frob(&K1);
+        let e_K1 = nLF * e_PE + e_LF * (nPE + e_PE) + gn * nLF * nPE;
+        // M2 >= ||L F^2 e^{sF} E|| on the cell (1e-12: libm's exp within 1 ulp).
+        let M2 = (frob(&(self.LF2 * &Pc)) + gn * nLF2 * nP + nLF2 * dP + e_LF2 * (nP + dP)) * grow * nE * (1.0 + 1e-12);
+        let Km = &K - &K1 * rr;
+        let Kp = &K + &K1 * rr;
+        let e_pm = e_K + rr * e_K1 + 2.01 * UNIT_ROUNDOFF * (nK + rr * nK1);
+        let acc = &mut self.acc;
+        acc.norm_pm += rr * (frob(&Km) + frob(&Kp));
+        acc.norm_mid += 2.0 * rr * nK;
+        acc.err_pm += 2.0 * rr * e_pm;
+        acc.err_mid += 2.0 * rr * e_K;
+        // M is r x p; store M^T (p x r) row-major, i.e. M column-major.
+        self.minus.extend(Km.iter().copied());
+        self.mid.extend(K.iter().copied());
+        self.plus.extend(Kp.iter().copied());
+        self.half.push(rr);
+        self.remainder += self.d_theta * M2 * rr * rr * rr / 3.0;
+        self.k_l1 += 2.0 * rr * (nK + e_K + rr * (nK1 + e_K1) + 0.5 * rr * rr * M2);
+        self.P = Some(Pc);
+    }
+
+    /// The kernel: tiling defects and the distance of the last cell's end from `S`, and the
+    /// rounding of the sums of positive terms (relative `gamma_{cells+4}`).
+    fn finish(self, theta: &Shape, s_max: f64, h_first: f64, r: usize, p: usize) -> (TubeKernel, Accum) {
+        let mut acc = self.acc;
+        // Tiling: junction defects and the distance of the last cell's end from S.
+        let end_gap = if self.half.is_empty() {
+            s_max.abs()
+        } else {
+            let d0 = self.t_hi - s_max;
+            (d0 + self.t_lo + self.prev_rr).abs()
+                + 4.0 * UNIT_ROUNDOFF * (d0.abs() + self.t_lo.abs() + self.prev_rr + self.t_lo_abs)
+                + 4.0 * UNIT_ROUNDOFF * UNIT_ROUNDOFF * self.t_hi
+        };
+        acc.tiling = (self.defects + end_gap) * self.nL * self.msup * self.nE * (1.0 + 1e-10);
+        // The sums of positive terms above: relative gamma_{cells+4}.
+        let gs = 1.0 + 2.0 * gamma(self.half.len() + 4);
+        acc.norm_pm *= gs;
+        acc.norm_mid *= gs;
+        acc.err_pm *= gs;
+        acc.err_mid *= gs;
+        let h = if h_first.is_nan() { 0.0 } else { h_first };
+        let kernel = TubeKernel {
+            r,
+            p,
+            theta: ThetaSupport::new(theta),
+            minus: self.minus,
+            mid: self.mid,
+            plus: self.plus,
+            half: self.half,
+            remainder: self.remainder * gs * (1.0 + 1e-10),
+            tail: 0.0,
+            rounding_up: 0.0,
+            rounding_lo: 0.0,
+            k_l1: self.k_l1 * gs,
+            d_theta: self.d_theta,
+            zero_in_theta: true,
+            s_max,
+            h,
+        };
+        (kernel, acc)
+    }
+}

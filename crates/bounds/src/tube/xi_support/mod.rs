@@ -1,0 +1,292 @@
+//! Support functions of the tube cross-sections `L Xi(t)` and `L Xi_inf` (Lemma 2):
+//!
+//! ```text
+//! sigma_{L Xi(t)}(v)   = int_0^t   sigma_Theta(K(s)^T v) ds,   K(s) = L e^{sF} E      (Xsupp)
+//! sigma_{L Xi_inf}(v)  = int_0^inf sigma_Theta(K(s)^T v) ds                           (Xinfsupp)
+//! ```
+//! (`L = I_n` gives `Xi` itself, `L = C` the output tube `C Xi_inf` of eq. (d), `L = C F` the
+//! set `C F Xi_inf` of eq. (zinf)), enclosed rigorously up to floating-point rounding by a
+//! quadrature on graded cells (trapezoid from above, midpoint from below, Taylor remainders),
+//! the tail bound (DXX) and every floating-point term. The proof is in
+//! `proofs-notes/tube-quadrature.md`.
+//!
+//! Module map: this file builds a [`TubeKernel`] (truncation point, cell widths, the
+//! floating-point terms); [`semigroup`]: the proven bounds of `e^{sF}` and [`SemigroupData`];
+//! `cells`: the walk over the cells that stores the quadrature matrices; `evaluate`: the sums
+//! for a direction `v`; [`theta_support`]: `sigma_Theta` in the inner loop.
+mod cells;
+mod evaluate;
+pub mod semigroup;
+#[cfg(test)]
+mod tests;
+pub mod theta_support;
+
+pub use semigroup::{dxx_bound, exp_norm_bounds, exp_norm_integral, ExpNormBounds, SemigroupData};
+pub use theta_support::ThetaSupport;
+
+use crate::error::BoundsError;
+use dynamics::linear::expm::frobenius_up;
+use geometry::{ConvexSet, Shape};
+use nalgebra::DMatrix;
+use rounding::gamma;
+use semigroup::{exp_at, exp_sup_on};
+
+/// Settings of the tube quadrature.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TubeSettings {
+    /// Target absolute width (per unit `|v|`) of the enclosure of a support value, half for the
+    /// quadrature remainder and half for the tail. Default `1e-5`.
+    pub tol_abs: f64,
+    /// Maximum number of quadrature cells. Default `400_000`.
+    pub max_cells: usize,
+    /// Bound `eps >= ||F_exact - F||_2` on the rounding of the `F` handed in (e.g. the Frobenius
+    /// norm of `lmi::verify::f_enclosure_radius` for `F = fl(A + fl(E C))`); its effect on the
+    /// support values is added to the enclosure (proofs-notes/tube-quadrature.md). Default `0` (`F` exact).
+    pub f_radius: f64,
+}
+
+impl Default for TubeSettings {
+    fn default() -> Self {
+        Self { tol_abs: 1e-5, max_cells: 400_000, f_radius: 0.0 }
+    }
+}
+
+impl TubeSettings {
+    pub fn validate(&self) -> Result<(), BoundsError> {
+        if !(self.tol_abs > 0.0 && self.tol_abs.is_finite()) {
+            return Err(BoundsError::BadSetting {
+                name: "tube.tol_abs",
+                value: self.tol_abs,
+                reason: "must be positive and finite",
+            });
+        }
+        if !(self.f_radius >= 0.0 && self.f_radius.is_finite()) {
+            return Err(BoundsError::BadSetting {
+                name: "tube.f_radius",
+                value: self.f_radius,
+                reason: "must be finite and >= 0",
+            });
+        }
+        if self.max_cells < 16 {
+            return Err(BoundsError::BadSetting {
+                name: "tube.max_cells",
+                value: self.max_cells as f64,
+                reason: "must be at least 16",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The integration horizon: `Xi(t)` (eq. (Xsupp)) or `Xi_inf` (eq. (Xinfsupp)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Horizon {
+    Finite(f64),
+    Infinite,
+}
+
+/// Frobenius norm rounded upward (`dynamics::linear::expm::frobenius_up`).
+fn frob(M: &DMatrix<f64>) -> f64 {
+    frobenius_up(M)
+}
+
+/// Precomputed quadrature of `sigma_{L Xi}(v)` for any direction `v in R^r` (`r` = rows of `L`).
+/// Thread-safe (immutable after construction), cheap to evaluate for many directions.
+#[derive(Debug, Clone)]
+pub struct TubeKernel {
+    r: usize,
+    p: usize,
+    theta: ThetaSupport,
+    /// Per cell: `(K(m) - r K'(m))^T`, `K(m)^T`, `(K(m) + r K'(m))^T`, each `p x r`, row-major.
+    minus: Vec<f64>,
+    mid: Vec<f64>,
+    plus: Vec<f64>,
+    /// Half-width of each cell.
+    half: Vec<f64>,
+    /// Sum of the Taylor remainders per unit `|v|`.
+    remainder: f64,
+    /// Tail bound per unit `|v|` (0 for a finite horizon).
+    tail: f64,
+    /// Floating-point terms per unit `|v|` of the upper and lower sums (proofs-notes/tube-quadrature.md): matrix
+    /// errors, rounding of `M^T v` and of the sums, cell tiling, and the rounded `F`.
+    rounding_up: f64,
+    rounding_lo: f64,
+    /// Upper bound of `int ||K(s)|| ds` (for Lipschitz constants).
+    k_l1: f64,
+    d_theta: f64,
+    zero_in_theta: bool,
+    /// Truncation point `S` of the infinite integral (or the finite horizon).
+    pub s_max: f64,
+    /// Width of the first (smallest) cell; cells grow geometrically with `s`.
+    pub h: f64,
+}
+
+/// What [`TubeKernel::build`] accumulates besides the cells (per unit `|v|`, before `D_Theta`).
+#[derive(Debug, Clone, Copy, Default)]
+struct Accum {
+    /// `sum_j r_j (||K_j - r K'_j||_F + ||K_j + r K'_j||_F)` and `sum_j 2 r_j ||K_j||_F`.
+    norm_pm: f64,
+    norm_mid: f64,
+    /// The same with the bounds of the matrix errors.
+    err_pm: f64,
+    err_mid: f64,
+    /// Gaps and overlaps of the cells against `[0, S]` (length), times `||L|| M ||E||`.
+    tiling: f64,
+}
+
+impl TubeKernel {
+    /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
+    pub fn new(
+        L: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        horizon: Horizon,
+        settings: &TubeSettings,
+    ) -> Result<Self, BoundsError> {
+        settings.validate()?;
+        let d_theta = theta.deviation_from_origin().upper;
+        Self::with_shared(L, F, E, theta, d_theta, &SemigroupData::new(F), horizon, settings)
+    }
+
+    /// [`Self::new`] with the quantities shared between kernels computed once by the caller:
+    /// `d_theta` must be `theta.deviation_from_origin().upper` and `sg` must be
+    /// `SemigroupData::new(F)` (same `F`), else the enclosure is not proven.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_shared(
+        L: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        theta: &Shape,
+        d_theta: f64,
+        sg: &SemigroupData,
+        horizon: Horizon,
+        settings: &TubeSettings,
+    ) -> Result<Self, BoundsError> {
+        settings.validate()?;
+        // A `sg` of another F (misuse) is replaced by the right one: never a wrong enclosure.
+        let own;
+        let sg = if sg.f == *F {
+            sg
+        } else {
+            own = SemigroupData::new(F);
+            &own
+        };
+        let p = E.ncols();
+        let r = L.nrows();
+        let zero_in_theta = theta.contains(&vec![0.0; p], 0.0);
+        let nF = frob(F);
+        let nE = frob(E);
+        let nL = frob(L);
+        let LF = L * F;
+        let LF2 = &LF * F;
+        let tol = settings.tol_abs;
+        // Proven semigroup bounds: sup ||e^{sF}|| on the horizon, and int_0^inf when Hurwitz.
+        let (s_max, tail_unit, msup, i_inf) = match horizon {
+            Horizon::Finite(t) => {
+                if !(t >= 0.0 && t.is_finite()) {
+                    return Err(BoundsError::BadSetting {
+                        name: "horizon",
+                        value: t,
+                        reason: "must be finite and >= 0",
+                    });
+                }
+                let i_inf = sg.bounds.as_ref().ok().map(|b| b.integral);
+                (t, 0.0, exp_sup_on(F, t, &sg.bounds), i_inf)
+            }
+            Horizon::Infinite => {
+                let b = sg.bounds.clone()?;
+                let i_inf = b.integral;
+                let mu = sg.mu.clone()?;
+                let mut S = 8.0 / -mu;
+                let mut tail;
+                loop {
+                    // ||L e^{SF}||_F from above: the computed product, its rounding, and the error
+                    // of e^{SF}.
+                    let (X, eX) = exp_at(F, S, b.sup);
+                    let LX = L * &X;
+                    let nLX = frob(&LX) + gamma(F.nrows()) * nL * frob(&X) + nL * eX;
+                    tail = d_theta * nLX * nE * i_inf * (1.0 + 1e-10);
+                    if tail <= 0.5 * tol || S > 1e6 / -mu {
+                        break;
+                    }
+                    S *= 1.25;
+                }
+                (S, tail, b.sup, Some(i_inf))
+            }
+        };
+        // The rounded F (proofs-notes/tube-quadrature.md): int ||e^{s F_exact} - e^{sF}|| over the horizon.
+        let eps = settings.f_radius;
+        let f_term = if eps == 0.0 {
+            0.0
+        } else {
+            let via_integral = match i_inf {
+                Some(i) if eps * i < 0.5 => eps * i * i / (1.0 - eps * i),
+                _ => f64::INFINITY,
+            };
+            let via_gronwall = match horizon {
+                Horizon::Finite(t) => 0.5 * t * t * msup * msup * eps * (msup * eps * t).exp(),
+                Horizon::Infinite => f64::INFINITY,
+            };
+            d_theta * nL * nE * via_integral.min(via_gronwall) * (1.0 + 1e-6)
+        };
+        // Cell widths: graded as h(s) = h0 e^{grade s} (the remainder per cell decays like
+        // e^{mu s} h^3), capped at 1 / ||F||; h0 shrinks (remainder ~ h0^2) until the summed
+        // remainders are below tol / 2. The grading only affects efficiency, not rigour.
+        let grade = match horizon {
+            Horizon::Infinite => (-sg.mu.clone()?).max(0.0) / 3.0,
+            Horizon::Finite(_) => 0.0,
+        };
+        let h_cap = 1.0 / nF.max(1e-300);
+        let mut h0 = (0.05_f64).min(0.5 * h_cap);
+        loop {
+            let k = Self::build(
+                sg,
+                L,
+                &LF,
+                &LF2,
+                F,
+                E,
+                theta,
+                s_max,
+                h0,
+                grade,
+                h_cap,
+                d_theta,
+                nF,
+                nE,
+                msup,
+                r,
+                p,
+                settings.max_cells,
+            );
+            let Some((k, acc)) = k else {
+                return Err(BoundsError::QuadratureBudget {
+                    error_bound: f64::INFINITY,
+                    tol,
+                    nodes: settings.max_cells,
+                });
+            };
+            if k.remainder <= 0.5 * tol || k.cells() == 0 {
+                // Floating-point terms (proofs-notes/tube-quadrature.md), per unit |v|. D_Theta as a Lipschitz constant
+                // of sigma_Theta, enlarged by 1e-9 (numerical deviations of some shapes).
+                let lip = d_theta * (1.0 + 1e-9);
+                let n_terms = 2 * k.cells() + 8;
+                let gr = gamma(r) * 1.01;
+                let sums = gamma(n_terms) * 1.01 * lip;
+                let small = gamma(8) * (k.remainder + tail_unit);
+                let rounding_up =
+                    (lip * (acc.err_pm + gr * acc.norm_pm + acc.tiling) + sums * acc.norm_pm + f_term + small)
+                        * (1.0 + 1e-6);
+                // Lower sums evaluate sigma_Theta to nearest: allowance 1e-12 D_Theta |w|.
+                let rounding_lo = (lip * (acc.err_mid + (gr + 1e-12) * acc.norm_mid + acc.tiling)
+                    + sums * acc.norm_mid
+                    + f_term
+                    + small)
+                    * (1.0 + 1e-6);
+                return Ok(Self { tail: tail_unit, zero_in_theta, s_max, rounding_up, rounding_lo, ..k });
+            }
+            h0 /= (k.remainder / (0.4 * tol)).sqrt().max(1.5);
+        }
+    }
+}
