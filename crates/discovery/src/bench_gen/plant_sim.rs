@@ -1,4 +1,4 @@
-//! The generator's own simulator (independent of [`crate::simulate`]): explicit midpoint
+//! The generator's own simulator (independent of [`dynamics::extended`]): explicit midpoint
 //! (RK2) on a grid 20 times finer than the samples, forces and the play held over each fine
 //! step, Coulomb friction by a semi-implicit velocity update (stick when the friction-free
 //! velocity change cannot reverse the sign), the friction library likewise (the static level

@@ -225,9 +225,9 @@ mod tests {
         let w: Vec<f64> = good.recording.w.iter().map(|r| r[0]).collect();
         let y: Vec<f64> = good.recording.y.iter().map(|r| r[0]).collect();
         let rms = |sys: &System| {
-            let o = crate::simulate::ExtendedModel::new(sys, &[], H, 4)
+            let o = dynamics::extended::ExtendedModel::new(sys, &[], H, 4)
                 .unwrap()
-                .with_hold(crate::simulate::InputHold::Zoh)
+                .with_hold(dynamics::extended::InputHold::Zoh)
                 .simulate(&w, H, &[0.0, 0.0]);
             (o.y.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / y.len() as f64).sqrt()
         };

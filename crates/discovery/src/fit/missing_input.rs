@@ -12,7 +12,7 @@
 //! reported missing when it explains at least [`MISSING_SHARE`] and more than the best
 //! hypothesis by [`MISSING_MARGIN`]. Columns that are monotone (time stamps, sample
 //! counters) or constant are not inputs and are skipped.
-use crate::simulate::{ExtendedModel, InputHold};
+use dynamics::extended::{ExtendedModel, InputHold};
 use model::{Input, System};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
