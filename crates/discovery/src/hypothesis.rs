@@ -15,9 +15,9 @@
 use crate::physics::{self, Context, Site};
 use model::System;
 
-pub use crate::physics::cogging::{cogging_scan, COGGING_PERIODS};
-pub use crate::physics::friction::{notes as friction_notes, FRICTION_DECADES};
-pub use crate::physics::{Hypothesis, Kind, NominalRun, Scales, DECADES, LEVEL_LOG_SHIFT};
+pub use crate::physics::cogging::cogging_scan;
+pub use crate::physics::friction::notes as friction_notes;
+pub use crate::physics::{Hypothesis, Kind, NominalRun, Scales};
 
 /// Largest held-out SSE ratio of a generalisation against its simpler form
 /// ([`simpler_form`]): it must cut the simpler form's held-out error by 7 % (a new effect

@@ -17,7 +17,8 @@
 //! model composes them): [`crate::hypothesis`] asks every family, in the order of
 //! [`FAMILIES`], for its hypotheses at each [`Site`] of the model, and a [`Kind`] is named,
 //! described and converted by the family that claims it. Adding a law is one new file, its
-//! [`Kind`] variant and one line in [`FAMILIES`].
+//! [`Kind`] variant and one line in [`FAMILIES`] (and, for an effect the model file does not
+//! know yet, its variant and name in [`model::effects`]).
 //!
 //! Shared by the families: [`parameters`] (a hypothesis' parameter box, its unit and
 //! logarithmic coordinates, starts over decades) and [`scales`] (the recording's and the
