@@ -154,7 +154,7 @@ pub fn run_case_with(
                     if let Some(v) = rep
                         .effects
                         .iter()
-                        .find(|f| f.kind == "input_delay")
+                        .find(|f| f.kind == names::INPUT_DELAY)
                         .and_then(|f| f.other_hold.as_ref())
                         .filter(|o| matches!(t, Effect::InputDelay { .. }) && o.0 == truth_hold)
                         .map(|o| o.1[0].1)
