@@ -3,7 +3,8 @@
 //! parameters.
 use crate::bench_gen::{self, Conditions, Profile, CLASSES, FRICTION_CLASSES};
 use crate::diagnose::{diagnose, DiagnoseSettings};
-use model::effects::Effect;
+use crate::physics;
+use model::effects::{names, Effect};
 use serde::Serialize;
 
 /// Outcome of one case.
@@ -54,53 +55,22 @@ pub struct BenchResult {
     pub cases: Vec<CaseResult>,
 }
 
-/// Main parameter of an effect (the one the generator sets).
+/// Main parameter of an effect (the one the generator sets; declared by its family,
+/// [`physics::Family::main_parameter`]).
 pub fn main_param(e: &Effect) -> f64 {
-    match e {
-        Effect::Backlash { width, .. } => *width,
-        Effect::GapWidth { relative_change } => *relative_change,
-        Effect::CoulombFriction { level, .. } => *level,
-        Effect::ConstantForce { force, .. } => *force,
-        Effect::BacklashInertia { mass, damping } => mass / damping,
-        Effect::InputDelay { delay } => *delay,
-        Effect::InputSaturation { limit } => *limit,
-        Effect::SensorOffset { offset } => offset[0],
-        Effect::StribeckFriction { static_level, .. } => *static_level,
-        Effect::AsymmetricCoulomb { level_positive, .. } => *level_positive,
-        Effect::Cogging { amplitude, .. } => *amplitude,
-    }
+    physics::main_parameter(e).0
 }
 
 /// Name of the hypothesis parameter that is the main parameter (for its reported
 /// uncertainty); `None` where the main parameter is derived from several.
 fn main_param_name(e: &Effect) -> Option<&'static str> {
-    Some(match e {
-        Effect::Backlash { .. } => "width",
-        Effect::GapWidth { .. } => "relative_change",
-        Effect::CoulombFriction { .. } => "level",
-        Effect::ConstantForce { .. } => "force",
-        Effect::BacklashInertia { .. } => "mass",
-        Effect::InputDelay { .. } => "delay",
-        Effect::InputSaturation { .. } => "limit",
-        Effect::SensorOffset { .. } => "offset",
-        Effect::AsymmetricCoulomb { .. } => "level_positive",
-        Effect::StribeckFriction { .. } | Effect::Cogging { .. } => return None,
-    })
+    physics::main_parameter(e).1
 }
 
 /// Every identifiable parameter of a friction-library effect, `(name, value)` (the main
-/// parameter alone for the other effects).
+/// parameter alone for the other effects; see [`physics::Family::every_parameter`]).
 pub fn all_params(e: &Effect) -> Vec<(&'static str, f64)> {
-    match e {
-        Effect::StribeckFriction { level, static_level, stribeck_velocity, .. } => {
-            vec![("static_level", *static_level), ("level", *level), ("stribeck_velocity", *stribeck_velocity)]
-        }
-        Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
-            vec![("level_positive", *level_positive), ("level_negative", *level_negative)]
-        }
-        Effect::Cogging { amplitude, period, .. } => vec![("amplitude", *amplitude), ("period", *period)],
-        _ => vec![("main", main_param(e))],
-    }
+    physics::every_parameter(e).unwrap_or_else(|| vec![("main", main_param(e))])
 }
 
 /// Runs one case of the classic profile.
@@ -184,7 +154,7 @@ pub fn run_case_with(
                     if let Some(v) = rep
                         .effects
                         .iter()
-                        .find(|f| f.kind == "input_delay")
+                        .find(|f| f.kind == names::INPUT_DELAY)
                         .and_then(|f| f.other_hold.as_ref())
                         .filter(|o| matches!(t, Effect::InputDelay { .. }) && o.0 == truth_hold)
                         .map(|o| o.1[0].1)
@@ -193,11 +163,8 @@ pub fn run_case_with(
                     }
                     out.est_param = Some(ev);
                     out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
-                    if matches!(
-                        t,
-                        Effect::StribeckFriction { .. } | Effect::AsymmetricCoulomb { .. } | Effect::Cogging { .. }
-                    ) {
-                        out.param_errors = all_params(t)
+                    if let Some(truth_params) = physics::every_parameter(t) {
+                        out.param_errors = truth_params
                             .iter()
                             .zip(all_params(e))
                             .map(|((n, a), (_, b))| (n.to_string(), (b - a).abs() / a.abs().max(1e-300)))
@@ -254,7 +221,9 @@ pub fn class_set(name: &str) -> Option<Vec<&'static str>> {
     let all = bench_gen::all_classes();
     match name {
         "classic" => Some(CLASSES.to_vec()),
-        "friction" => Some(["none", "coulomb_friction"].iter().chain(FRICTION_CLASSES.iter()).copied().collect()),
+        "friction" => {
+            Some([bench_gen::NONE, names::COULOMB_FRICTION].iter().chain(FRICTION_CLASSES.iter()).copied().collect())
+        }
         "all" => Some(all),
         list => list.split(',').map(|c| all.iter().find(|a| **a == c.trim()).copied()).collect(),
     }

@@ -11,7 +11,8 @@
 //! 4. [`residual`]: whiteness and input cross-correlation tests of the nominal residual.
 //! 5. [`localise`]: residual energy per regime (reversals, contact, input extremes, high
 //!    acceleration) and the time windows where it concentrates.
-//! 6. [`hypothesis`] + [`fit`]: each effect of the physics library fitted by simulation-error
+//! 6. [`hypothesis`] + [`fit`]: each effect of the physics library ([`physics`], one file per
+//!    family) fitted by simulation-error
 //!    Levenberg-Marquardt with bounds and starts over decades (stuck fits flagged, never
 //!    evidence against their effect); [`select`]: BIC with a margin (plus the remaining
 //!    discretisation error's worth) and blocked cross-validation over contiguous folds
@@ -36,6 +37,7 @@ pub mod fit;
 pub mod hypothesis;
 pub mod localise;
 pub mod metrics;
+pub mod physics;
 pub mod play_width;
 pub mod recording;
 pub mod residual;

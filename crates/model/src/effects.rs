@@ -6,6 +6,22 @@ use crate::toml_access::{check_keys, describe, f64_at, key, opt_f64, str_at, vec
 use crate::ModelError;
 use toml::{Table, Value};
 
+/// The model-file name of each effect (`kind = "..."` in `[[effects]]`), declared once: the
+/// parser, the writer ([`Effect::kind`]) and the diagnosis' physics library all use these.
+pub mod names {
+    pub const BACKLASH: &str = "backlash";
+    pub const GAP_WIDTH: &str = "gap_width";
+    pub const COULOMB_FRICTION: &str = "coulomb_friction";
+    pub const CONSTANT_FORCE: &str = "constant_force";
+    pub const BACKLASH_INERTIA: &str = "backlash_inertia";
+    pub const INPUT_DELAY: &str = "input_delay";
+    pub const INPUT_SATURATION: &str = "input_saturation";
+    pub const SENSOR_OFFSET: &str = "sensor_offset";
+    pub const STRIBECK_FRICTION: &str = "stribeck_friction";
+    pub const ASYMMETRIC_COULOMB: &str = "asymmetric_coulomb";
+    pub const COGGING: &str = "cogging";
+}
+
 /// Where a backlash (play) effect sits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlayLocation {
@@ -54,17 +70,17 @@ impl Effect {
     /// The name used in model files and reports.
     pub fn kind(&self) -> &'static str {
         match self {
-            Effect::Backlash { .. } => "backlash",
-            Effect::GapWidth { .. } => "gap_width",
-            Effect::CoulombFriction { .. } => "coulomb_friction",
-            Effect::ConstantForce { .. } => "constant_force",
-            Effect::BacklashInertia { .. } => "backlash_inertia",
-            Effect::InputDelay { .. } => "input_delay",
-            Effect::InputSaturation { .. } => "input_saturation",
-            Effect::SensorOffset { .. } => "sensor_offset",
-            Effect::StribeckFriction { .. } => "stribeck_friction",
-            Effect::AsymmetricCoulomb { .. } => "asymmetric_coulomb",
-            Effect::Cogging { .. } => "cogging",
+            Effect::Backlash { .. } => names::BACKLASH,
+            Effect::GapWidth { .. } => names::GAP_WIDTH,
+            Effect::CoulombFriction { .. } => names::COULOMB_FRICTION,
+            Effect::ConstantForce { .. } => names::CONSTANT_FORCE,
+            Effect::BacklashInertia { .. } => names::BACKLASH_INERTIA,
+            Effect::InputDelay { .. } => names::INPUT_DELAY,
+            Effect::InputSaturation { .. } => names::INPUT_SATURATION,
+            Effect::SensorOffset { .. } => names::SENSOR_OFFSET,
+            Effect::StribeckFriction { .. } => names::STRIBECK_FRICTION,
+            Effect::AsymmetricCoulomb { .. } => names::ASYMMETRIC_COULOMB,
+            Effect::Cogging { .. } => names::COGGING,
         }
     }
 }
@@ -122,7 +138,7 @@ impl Effects {
             };
             let kind = str_at(t, &prefix, "kind")?;
             let e = match kind {
-                "backlash" => {
+                names::BACKLASH => {
                     check_keys(t, &prefix, "kind, width, location")?;
                     let location = match t.get("location").map(|l| l.as_str()) {
                         None | Some(Some("loop")) => PlayLocation::Loop,
@@ -131,7 +147,7 @@ impl Effects {
                     };
                     Effect::Backlash { width: nonneg(t, &prefix, "width")?, location }
                 }
-                "gap_width" => {
+                names::GAP_WIDTH => {
                     check_keys(t, &prefix, "kind, relative_change")?;
                     let r = f64_at(t, &prefix, "relative_change")?;
                     if r <= -1.0 {
@@ -139,23 +155,23 @@ impl Effects {
                     }
                     Effect::GapWidth { relative_change: r }
                 }
-                "coulomb_friction" => {
+                names::COULOMB_FRICTION => {
                     check_keys(t, &prefix, "kind, state, level")?;
                     Effect::CoulombFriction { state: state_index(t, &prefix, n)?, level: nonneg(t, &prefix, "level")? }
                 }
-                "constant_force" => {
+                names::CONSTANT_FORCE => {
                     check_keys(t, &prefix, "kind, state, force")?;
                     Effect::ConstantForce { state: state_index(t, &prefix, n)?, force: f64_at(t, &prefix, "force")? }
                 }
-                "backlash_inertia" => {
+                names::BACKLASH_INERTIA => {
                     check_keys(t, &prefix, "kind, mass, damping")?;
                     Effect::BacklashInertia { mass: nonneg(t, &prefix, "mass")?, damping: nonneg(t, &prefix, "damping")? }
                 }
-                "input_delay" => {
+                names::INPUT_DELAY => {
                     check_keys(t, &prefix, "kind, delay")?;
                     Effect::InputDelay { delay: nonneg(t, &prefix, "delay")? }
                 }
-                "input_saturation" => {
+                names::INPUT_SATURATION => {
                     check_keys(t, &prefix, "kind, limit")?;
                     let l = f64_at(t, &prefix, "limit")?;
                     if l <= 0.0 {
@@ -163,7 +179,7 @@ impl Effects {
                     }
                     Effect::InputSaturation { limit: l }
                 }
-                "sensor_offset" => {
+                names::SENSOR_OFFSET => {
                     check_keys(t, &prefix, "kind, offset")?;
                     let o = vec_at(t, &prefix, "offset")?;
                     if o.len() != p {
@@ -171,7 +187,7 @@ impl Effects {
                     }
                     Effect::SensorOffset { offset: o }
                 }
-                "stribeck_friction" => {
+                names::STRIBECK_FRICTION => {
                     check_keys(t, &prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
                     let state = state_index(t, &prefix, n)?;
                     let level = nonneg(t, &prefix, "level")?;
@@ -193,7 +209,7 @@ impl Effects {
                     };
                     Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous }
                 }
-                "asymmetric_coulomb" => {
+                names::ASYMMETRIC_COULOMB => {
                     check_keys(t, &prefix, "kind, state, level_positive, level_negative")?;
                     Effect::AsymmetricCoulomb {
                         state: state_index(t, &prefix, n)?,
@@ -201,7 +217,7 @@ impl Effects {
                         level_negative: nonneg(t, &prefix, "level_negative")?,
                     }
                 }
-                "cogging" => {
+                names::COGGING => {
                     check_keys(t, &prefix, "kind, state, position_state, amplitude, period, phase")?;
                     let state = state_index(t, &prefix, n)?;
                     let position_state = index_at(t, &prefix, "position_state", n)?;

@@ -30,7 +30,7 @@ pub mod plant_sim;
 pub mod servo_loop;
 
 use crate::recording::Recording;
-use model::effects::{Effect, PlayLocation};
+use model::effects::{names, Effect, PlayLocation};
 use model::{Input, SimDefaults, System};
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
@@ -39,22 +39,25 @@ use std::f64::consts::{PI, TAU};
 
 /// The classes of concealed effects.
 pub const CLASSES: [&str; 9] = [
-    "none",
-    "backlash",
-    "gap_width",
-    "coulomb_friction",
-    "constant_force",
-    "backlash_inertia",
-    "input_delay",
-    "input_saturation",
-    "sensor_offset",
+    NONE,
+    names::BACKLASH,
+    names::GAP_WIDTH,
+    names::COULOMB_FRICTION,
+    names::CONSTANT_FORCE,
+    names::BACKLASH_INERTIA,
+    names::INPUT_DELAY,
+    names::INPUT_SATURATION,
+    names::SENSOR_OFFSET,
 ];
+
+/// The class of cases without a concealed effect.
+pub const NONE: &str = "none";
 
 /// The classes of the friction library (issue 14): Stribeck friction with a static level,
 /// direction-dependent Coulomb levels and a cogging force. Kept apart from [`CLASSES`] so that
 /// the original benchmark keeps its classes (and its seeds their cases); [`all_classes`]
 /// lists both.
-pub const FRICTION_CLASSES: [&str; 3] = ["stribeck_friction", "asymmetric_coulomb", "cogging"];
+pub const FRICTION_CLASSES: [&str; 3] = [names::STRIBECK_FRICTION, names::ASYMMETRIC_COULOMB, names::COGGING];
 
 /// [`CLASSES`] followed by [`FRICTION_CLASSES`].
 pub fn all_classes() -> Vec<&'static str> {
@@ -277,32 +280,32 @@ fn random_signal(rng: &mut ChaCha8Rng, w0: f64, duration: f64) -> (Signal, &'sta
 /// directional level and the cogging amplitude; the cogging acts with position state 0).
 fn effect_at(class: &str, a: f64, sign: f64, wmax: f64, vel: usize, fr: &FrictionShape) -> Option<Effect> {
     Some(match class {
-        "stribeck_friction" => Effect::StribeckFriction {
+        names::STRIBECK_FRICTION => Effect::StribeckFriction {
             state: vel,
             level: a,
             static_level: a * fr.static_ratio,
             stribeck_velocity: fr.stribeck_frac * fr.v_rms,
             viscous: 0.0,
         },
-        "asymmetric_coulomb" => {
+        names::ASYMMETRIC_COULOMB => {
             let (up, down) = if fr.asym_up { (a, a * fr.asym_ratio) } else { (a * fr.asym_ratio, a) };
             Effect::AsymmetricCoulomb { state: vel, level_positive: up, level_negative: down }
         }
-        "cogging" => Effect::Cogging {
+        names::COGGING => Effect::Cogging {
             state: vel,
             position_state: 0,
             amplitude: a,
             period: fr.pos_range / fr.cog_periods,
             phase: fr.cog_phase,
         },
-        "backlash" => Effect::Backlash { width: a, location: PlayLocation::Loop },
-        "gap_width" => Effect::GapWidth { relative_change: a },
-        "coulomb_friction" => Effect::CoulombFriction { state: vel, level: a },
-        "constant_force" => Effect::ConstantForce { state: vel, force: sign * a },
-        "backlash_inertia" => Effect::BacklashInertia { mass: a, damping: 1.0 },
-        "input_delay" => Effect::InputDelay { delay: a },
-        "input_saturation" => Effect::InputSaturation { limit: wmax / (1.0 + a) },
-        "sensor_offset" => Effect::SensorOffset { offset: vec![sign * a] },
+        names::BACKLASH => Effect::Backlash { width: a, location: PlayLocation::Loop },
+        names::GAP_WIDTH => Effect::GapWidth { relative_change: a },
+        names::COULOMB_FRICTION => Effect::CoulombFriction { state: vel, level: a },
+        names::CONSTANT_FORCE => Effect::ConstantForce { state: vel, force: sign * a },
+        names::BACKLASH_INERTIA => Effect::BacklashInertia { mass: a, damping: 1.0 },
+        names::INPUT_DELAY => Effect::InputDelay { delay: a },
+        names::INPUT_SATURATION => Effect::InputSaturation { limit: wmax / (1.0 + a) },
+        names::SENSOR_OFFSET => Effect::SensorOffset { offset: vec![sign * a] },
         _ => return None,
     })
 }
@@ -312,6 +315,83 @@ fn fit_percent(a: &[f64], b: &[f64]) -> f64 {
     let num = a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt();
     let den = a.iter().map(|x| (x - mean).powi(2)).sum::<f64>().sqrt();
     100.0 * (1.0 - num / den)
+}
+
+impl FrictionShape {
+    /// The friction library's shape draws (a stream of their own, seeded from the case's
+    /// `mix`); the nominal run's scales are set after it.
+    fn draw(mix: u64) -> Self {
+        let mut rf = ChaCha8Rng::seed_from_u64(mix ^ 0xF41C_7100_0000_0002);
+        FrictionShape {
+            static_ratio: rf.random_range(1.8..3.0),
+            stribeck_frac: rf.random_range(0.05..0.25),
+            asym_ratio: rf.random_range(0.2..0.6),
+            asym_up: rf.random::<bool>(),
+            cog_periods: rf.random_range(3.0..10.0),
+            cog_phase: rf.random_range(0.0..TAU),
+            v_rms: 0.0,
+            pos_range: 0.0,
+        }
+    }
+}
+
+/// The digital profile's own draws (a second stream: the classic stream is untouched): the
+/// sample period, the natural frequency and damping that replace the plant's, and the AR(1)
+/// coefficient of the noise.
+fn digital_draws(mix: u64) -> (Option<f64>, Option<(f64, f64)>, f64) {
+    let mut rd = ChaCha8Rng::seed_from_u64(mix ^ 0xD161_7A1D_0000_0001);
+    let dt = (rd.random_range(1e-3f64.ln()..1e-2f64.ln())).exp();
+    let spp: f64 = rd.random_range(30.0..100.0);
+    let light = rd.random::<bool>();
+    let zeta = if light { rd.random_range(0.03..0.1) } else { rd.random_range(0.1..0.7) };
+    let rho = if rd.random::<bool>() { rd.random_range(0.5..0.9) } else { 0.0 };
+    (Some(dt), Some((TAU / (spp * dt), zeta)), rho)
+}
+
+/// `ns` samples of measurement noise of standard deviation `std`: white, or AR(1) with
+/// coefficient `rho > 0` and the same stationary variance.
+fn measurement_noise(rng: &mut ChaCha8Rng, ns: usize, std: f64, rho: f64) -> Vec<f64> {
+    let mut noise: Vec<f64> = (0..ns).map(|_| gauss(rng) * std).collect();
+    if rho > 0.0 {
+        // AR(1) with the same stationary variance: e_k = rho e_{k-1} + sqrt(1 - rho^2) v_k.
+        let c = (1.0 - rho * rho).sqrt();
+        let mut e = noise[0];
+        for v in noise.iter_mut().skip(1) {
+            e = rho * e + c * *v;
+            *v = e;
+        }
+    }
+    noise
+}
+
+/// The magnitude of the concealed effect of `class` at which the nominal model's fit
+/// (`fit_at(a)`) drops to `target`: grown until the fit drops below the target, then bisected
+/// (`backlash_inertia` capped at half a natural `period`).
+fn truth_magnitude(class: &str, fit_at: impl Fn(f64) -> f64, target: f64, period: f64, ystd: f64) -> f64 {
+    let mut hi = match class {
+        names::INPUT_DELAY => 0.02 * period,
+        names::BACKLASH_INERTIA => 0.02 * period,
+        names::GAP_WIDTH => 0.5,
+        names::INPUT_SATURATION => 0.05,
+        _ => 0.02 * ystd,
+    };
+    let mut lo = 0.0;
+    let mut guard = 0;
+    let cap = if class == names::BACKLASH_INERTIA { 0.5 * period } else { f64::INFINITY };
+    while fit_at(hi) > target && guard < 40 && hi < cap {
+        lo = hi;
+        hi *= 1.6;
+        guard += 1;
+    }
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if fit_at(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (0.5 * (lo + hi)).min(cap)
 }
 
 /// Generates case number `index` of `class` from `seed` (classic profile).
@@ -324,31 +404,9 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     let class_index = all_classes().iter().position(|c| *c == class).unwrap_or(0);
     let mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
-    // The friction library's shape draws (a third stream).
-    let mut rf = ChaCha8Rng::seed_from_u64(mix ^ 0xF41C_7100_0000_0002);
-    let mut fshape = FrictionShape {
-        static_ratio: rf.random_range(1.8..3.0),
-        stribeck_frac: rf.random_range(0.05..0.25),
-        asym_ratio: rf.random_range(0.2..0.6),
-        asym_up: rf.random::<bool>(),
-        cog_periods: rf.random_range(3.0..10.0),
-        cog_phase: rf.random_range(0.0..TAU),
-        v_rms: 0.0,
-        pos_range: 0.0,
-    };
-    // The digital profile's own draws (a second stream: the classic stream is untouched).
-    let mut rd = ChaCha8Rng::seed_from_u64(mix ^ 0xD161_7A1D_0000_0001);
+    let mut fshape = FrictionShape::draw(mix);
     let digital = profile == Profile::Digital;
-    let (dig_dt, over, noise_rho): (Option<f64>, Option<(f64, f64)>, f64) = if digital {
-        let dt = (rd.random_range(1e-3f64.ln()..1e-2f64.ln())).exp();
-        let spp: f64 = rd.random_range(30.0..100.0);
-        let light = rd.random::<bool>();
-        let zeta = if light { rd.random_range(0.03..0.1) } else { rd.random_range(0.1..0.7) };
-        let rho = if rd.random::<bool>() { rd.random_range(0.5..0.9) } else { 0.0 };
-        (Some(dt), Some((TAU / (spp * dt), zeta)), rho)
-    } else {
-        (None, None, 0.0)
-    };
+    let (dig_dt, over, noise_rho) = if digital { digital_draws(mix) } else { (None, None, 0.0) };
     let n = rng.random_range(2..=4);
     let plant = random_plant(&mut rng, n, over);
     let tau_slow = {
@@ -365,9 +423,9 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     let t: Vec<f64> = (0..ns).map(|k| k as f64 * dt).collect();
     let w: Vec<f64> = t.iter().map(|&tk| signal.eval(tk)).collect();
     let wmax = w.iter().map(|v| v.abs()).fold(0.0, f64::max);
-    let nominal_has_play = class != "backlash";
+    let nominal_has_play = class != names::BACKLASH;
     let mut plant = plant;
-    if class == "backlash_inertia" {
+    if class == names::BACKLASH_INERTIA {
         // Coasting is bounded by the gap: the effect needs a play wide enough to be seen, and
         // its time constant is capped at half a natural period (see the bisection below).
         plant.half_width = rng.random_range(0.15..0.3);
@@ -389,16 +447,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     fshape.pos_range = clean_nom.iter().copied().fold(f64::NEG_INFINITY, f64::max)
         - clean_nom.iter().copied().fold(f64::INFINITY, f64::min);
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
-    let mut noise: Vec<f64> = (0..ns).map(|_| gauss(&mut rng) * noise_std).collect();
-    if noise_rho > 0.0 {
-        // AR(1) with the same stationary variance: e_k = rho e_{k-1} + sqrt(1 - rho^2) v_k.
-        let c = (1.0 - noise_rho * noise_rho).sqrt();
-        let mut e = noise[0];
-        for v in noise.iter_mut().skip(1) {
-            e = noise_rho * e + c * *v;
-            *v = e;
-        }
-    }
+    let noise = measurement_noise(&mut rng, ns, noise_std, noise_rho);
     let measure = |eff: Option<&Effect>| -> Vec<f64> {
         plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns, zoh)
             .iter()
@@ -408,35 +457,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     };
     let fit_at =
         |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel, &fshape).as_ref()), &clean_nom);
-    let truth_a = if class == "none" {
-        0.0
-    } else {
-        // Grow until the fit drops below target, then bisect.
-        let mut hi = match class {
-            "input_delay" => 0.02 * period,
-            "backlash_inertia" => 0.02 * period,
-            "gap_width" => 0.5,
-            "input_saturation" => 0.05,
-            _ => 0.02 * ystd,
-        };
-        let mut lo = 0.0;
-        let mut guard = 0;
-        let cap = if class == "backlash_inertia" { 0.5 * period } else { f64::INFINITY };
-        while fit_at(hi) > target && guard < 40 && hi < cap {
-            lo = hi;
-            hi *= 1.6;
-            guard += 1;
-        }
-        for _ in 0..30 {
-            let mid = 0.5 * (lo + hi);
-            if fit_at(mid) > target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (0.5 * (lo + hi)).min(cap)
-    };
+    let truth_a = if class == NONE { 0.0 } else { truth_magnitude(class, fit_at, target, period, ystd) };
     let truth = effect_at(class, truth_a, sign, wmax, plant.vel, &fshape);
     let y = measure(truth.as_ref());
     let nominal_fit = fit_percent(&y, &clean_nom);

@@ -13,95 +13,14 @@
 //! output moves smoothly with the delay), first-order hold by its values at the sub-step
 //! points. Clamp and play act on the sub-step values. `fitted.toml` then carries the input as
 //! the plant sees it (the model-file format has no per-input effects).
-use crate::hypothesis::{Hypothesis, Kind, Scales, DECADES, LEVEL_LOG_SHIFT};
 use dynamics::extended::InputHold;
-use model::effects::{Effect, PlayLocation};
-use model::System;
-use serde::Serialize;
 
-/// An input effect that can act on one input.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum InputOp {
-    Play,
-    Saturation,
-    Delay,
-}
+/// The input effects on one input (declared in [`crate::physics::input_ops`]).
+pub use crate::physics::InputOp;
 
-impl InputOp {
-    /// Model-file name of the effect.
-    pub fn name(&self) -> &'static str {
-        match self {
-            InputOp::Play => "backlash",
-            InputOp::Saturation => "input_saturation",
-            InputOp::Delay => "input_delay",
-        }
-    }
-    /// Label with the input, e.g. `input_saturation(w2)`.
-    pub fn label(&self, input: usize) -> String {
-        match self {
-            InputOp::Play => format!("backlash(input w{})", input + 1),
-            _ => format!("{}(w{})", self.name(), input + 1),
-        }
-    }
-    pub fn description(&self, input: usize) -> String {
-        let j = input + 1;
-        match self {
-            InputOp::Play => format!("Play between input w{j} and the plant (the other inputs act directly): the plant only follows w{j} after it has reversed by the width of the play."),
-            InputOp::Saturation => format!("The actuator behind input w{j} cannot follow it beyond a limit (voltage or current saturation); the other inputs are not clipped."),
-            InputOp::Delay => format!("The plant sees input w{j} late (transport, communication or computation delay); the other inputs arrive on time."),
-        }
-    }
-    /// The same effect on every input (what a model file can state).
-    pub fn on_every_input(&self, v: f64) -> Effect {
-        match self {
-            InputOp::Play => Effect::Backlash { width: v.max(0.0), location: PlayLocation::Input },
-            InputOp::Saturation => Effect::InputSaturation { limit: v.max(1e-12) },
-            InputOp::Delay => Effect::InputDelay { delay: v.max(0.0) },
-        }
-    }
-}
-
-/// Per-input hypotheses for a model with `m > 1` inputs (none for `m = 1`): for each input,
-/// a play of width in `[0, range(w_j)/2]`, a saturation limit in `[0.2, 1] max |w_j|` and a
-/// delay in the bound of the global delay, with the global hypotheses' starts.
-pub fn candidates(sys: &System, s: &Scales, w: &[f64]) -> Vec<Hypothesis> {
-    let m = sys.m();
-    if m < 2 {
-        return vec![];
-    }
-    let n = w.len() / m;
-    let dmax = s.tau_slow.min(s.duration / 20.0).max(5.0 * s.dt);
-    let mut out = Vec::new();
-    for j in 0..m {
-        let absmax = (0..n).map(|k| w[k * m + j].abs()).fold(0.0, f64::max).max(1e-12);
-        let range = s.w_range.get(j).copied().unwrap_or(absmax).max(1e-12);
-        let level = |op: InputOp, hi: f64, name: &'static str| Hypothesis {
-            kind: Kind::InputOn { op, input: j },
-            lower: vec![0.0],
-            upper: vec![hi],
-            starts: DECADES.iter().map(|f| vec![unit_log(f * hi, 0.0, hi, LEVEL_LOG_SHIFT * hi)]).collect(),
-            names: vec![name],
-            log_shift: vec![Some(LEVEL_LOG_SHIFT * hi)],
-        };
-        out.push(level(InputOp::Play, 0.5 * range, "width"));
-        let (lo, hi) = (0.2 * absmax, absmax);
-        out.push(Hypothesis {
-            kind: Kind::InputOn { op: InputOp::Saturation, input: j },
-            lower: vec![lo],
-            upper: vec![hi],
-            starts: [0.52, 0.76, 0.96, 0.99, 0.999].iter().map(|f| vec![(f * absmax - lo) / (hi - lo)]).collect(),
-            names: vec!["limit"],
-            log_shift: vec![None],
-        });
-        out.push(level(InputOp::Delay, dmax, "delay"));
-    }
-    out
-}
-
-fn unit_log(theta: f64, lo: f64, hi: f64, c: f64) -> f64 {
-    (((theta + c) / (lo + c)).ln() / ((hi + c) / (lo + c)).ln()).clamp(0.0, 1.0)
-}
+/// The per-input hypotheses (the physics library at each input alone), as the diagnosis
+/// calls them from here.
+pub use crate::hypothesis::per_input_candidates as candidates;
 
 /// Value of input `j` of the held signal at time `t` (sample `k` at `k dt`; before the start
 /// the first sample, after the end the last).

@@ -10,7 +10,7 @@
 //! block of the solver (see [`crate::fit::nominal`]); without a refit the problem is as before.
 use crate::fit::input_effects::{self, InputOp};
 use crate::fit::nominal::Refit;
-use crate::hypothesis::{Hypothesis, Kind, Scales};
+use crate::physics::{Hypothesis, Kind, Scales};
 use dynamics::extended::{ExtendedModel, InputHold, SimOutput, StepMaps};
 use model::effects::Effect;
 use model::System;
