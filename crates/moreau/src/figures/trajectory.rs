@@ -1,8 +1,10 @@
 //! Trajectories: `y = C x` and `z` against time (and the states `x` in a second figure), from
 //! the catching-up scheme (eq. (zdot) discretised, NOTES.md) started at the model's `x0, z0`,
-//! or the extended-model simulator for a model with `[[effects]]`.
+//! or the extended-model simulator for a model with `[[effects]]`; and
+//! [`simulation_figure`], the plot `moreau simulate` writes beside `trajectory.csv`.
 use super::canvas::{palette, Element, Figure};
 use super::FigureError;
+use dynamics::trajectory::Trajectory;
 use model::System;
 
 /// Settings of the trajectory figure.
@@ -67,4 +69,23 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
         });
     }
     Ok((yz, xf))
+}
+
+/// The plot of `moreau simulate`: the inputs `w1..wm`, then `y_k` and `z_k` per output
+/// against `t`, titled with the model's name and `method` (how it was simulated).
+pub fn simulation_figure(sys: &System, tr: &Trajectory, method: &str) -> Figure {
+    let mut f = Figure::new(&format!("{} ({method})", sys.name), "t", "w, y, z");
+    f.size = (1000, 600);
+    let mut line = |label: String, y: Vec<f64>| {
+        let color = palette(f.elements.len());
+        f.elements.push(Element::Line { label, pts: tr.t.iter().copied().zip(y).collect(), color, dashed: false });
+    };
+    for j in 0..sys.m() {
+        line(format!("w{}", j + 1), (0..tr.len()).map(|i| tr.w_at(i)[j]).collect());
+    }
+    for j in 0..sys.p() {
+        line(format!("y{}", j + 1), (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect());
+        line(format!("z{}", j + 1), (0..tr.len()).map(|i| tr.z_at(i)[j]).collect());
+    }
+    f
 }
