@@ -11,6 +11,7 @@
 //! | `simulate` | [`simulate::simulate`] | [`simulate::Simulation`] (trajectory, method, step) |
 //! | `periodic` | [`periodic::periodic`] | [`periodic::PeriodicRun`] (regime, rate; JSON) |
 //! | `check` | [`check::plan`] then [`check::CheckPlan::run`] | [`check::CheckRun`] (reports, files; JSON) |
+//! | `convergence` | [`convergence::plan`] then [`convergence::ConvergencePlan::run`] | `dynamics::convergence::ConvergenceStudy` |
 //! | `diagnose` | [`diagnose::diagnose`] (+ [`diagnose::write_outputs`]) | [`diagnose::DiagnoseRun`] |
 //! | `sweep` | [`sweep::sweep`] | [`sweep::SweepRun`] (summary, files) |
 use anyhow::Context;
@@ -18,6 +19,7 @@ use model::System;
 use std::path::{Path, PathBuf};
 
 pub mod check;
+pub mod convergence;
 pub mod diagnose;
 pub mod periodic;
 pub mod simulate;

@@ -89,3 +89,33 @@ pub fn simulation_figure(sys: &System, tr: &Trajectory, method: &str) -> Figure 
     }
     f
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::figures::canvas;
+
+    #[test]
+    fn the_simulate_plot_renders_svg_and_png_with_text() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml");
+        let sys = model::load(std::path::Path::new(path)).unwrap();
+        let tr = dynamics::trajectory::simulate_model(&sys, 0.01, 300, 1).unwrap();
+        let f = simulation_figure(&sys, &tr, "catching-up, h = 1e-2");
+        let labels: Vec<&str> = f.elements.iter().map(|e| e.label_and_color().0).collect();
+        assert_eq!(labels, ["w1", "y1", "z1"]);
+        let svg = canvas::to_svg(&f).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("<text") && svg.contains("catching-up"));
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("a.png");
+        canvas::write_png(&f, &png).unwrap();
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+        // negative control: nothing finite to draw is an error, not an empty picture
+        let mut empty = f.clone();
+        for e in &mut empty.elements {
+            if let Element::Line { pts, .. } = e {
+                pts.iter_mut().for_each(|p| p.1 = f64::NAN);
+            }
+        }
+        assert!(canvas::to_svg(&empty).is_err());
+    }
+}
