@@ -1,8 +1,10 @@
 //! The extension module `moreau._native`: argument conversion and the GIL. Results travel as
 //! JSON text (the CLI's own objects, parsed by `json.loads` on the Python side) and as raw
 //! little-endian `float64` buffers (`numpy.frombuffer`); errors as `MoreauError` with the CLI's
-//! one-line message. The Python package `moreau` (python/python/moreau) is the public API.
-use crate::commands::{self as core, RecordingSource, SamplesSpec, Source, Stated};
+//! one-line message. Every command is the CLI's own function (`moreau::commands`); this module
+//! only converts. The Python package `moreau` (python/python/moreau) is the public API.
+use crate::system::{system_from_table, SamplesSpec};
+use moreau::commands::{self, one_line, Source, Stated};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -16,7 +18,7 @@ pyo3::create_exception!(
 );
 
 fn err(e: anyhow::Error) -> PyErr {
-    MoreauError::new_err(core::one_line(&e))
+    MoreauError::new_err(one_line(&e))
 }
 
 fn to_json(v: &serde_json::Value) -> PyResult<String> {
@@ -89,13 +91,13 @@ impl PySystem {
         let t = toml_table("", table)?;
         let stated = Stated::of_table(&t);
         let samples = samples.map(|(t, w, period, source)| SamplesSpec { t, w, period, source });
-        let inner = py.detach(move || core::system_from_table(t, samples)).map_err(err)?;
+        let inner = py.detach(move || system_from_table(t, samples)).map_err(err)?;
         Ok(Self { inner, stated })
     }
     /// Reads a model file (as `moreau validate FILE`).
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Self> {
-        let inner = core::load(&path).map_err(err)?;
+        let inner = commands::load(&path).map_err(err)?;
         let stated = std::fs::read_to_string(&path).map(|t| Stated::of_text(&t)).unwrap_or_default();
         Ok(Self { inner, stated })
     }
@@ -244,10 +246,41 @@ fn theta(
     stationary: bool,
     guidance: bool,
 ) -> PyResult<String> {
+    use commands::theta::{theta, ThetaOptions};
     let src = source(model)?;
-    let v =
-        py.detach(move || core::theta_json(&src, core::ThetaOptions { measure, stationary, guidance })).map_err(err)?;
+    let o = ThetaOptions { measure, stationary, guidance };
+    let v = py.detach(move || theta(&src, &o).and_then(|r| r.to_json())).map_err(err)?;
     to_json(&v)
+}
+
+/// A simulated trajectory as columns: `t` (N), and `w`, `x`, `y`, `z`, `q = z - y`, row-major
+/// N x m, N x n, N x p.
+struct SimOut {
+    n: usize,
+    m: usize,
+    p: usize,
+    t: Vec<f64>,
+    w: Vec<f64>,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    q: Vec<f64>,
+    method: String,
+    h: f64,
+}
+
+fn columns(s: &commands::simulate::Simulation) -> SimOut {
+    let (sys, tr) = (&s.sys, &s.trajectory);
+    let (n, m, p) = (sys.n(), sys.m(), sys.p());
+    let mut y = Vec::with_capacity(tr.len() * p);
+    let mut q = Vec::with_capacity(tr.len() * p);
+    for i in 0..tr.len() {
+        let yi = tr.y_at(&sys.C, i);
+        q.extend(tr.z_at(i).iter().zip(&yi).map(|(a, b)| a - b));
+        y.extend(yi);
+    }
+    let (t, w, x, z) = (tr.t.clone(), tr.w.clone(), tr.x.clone(), tr.z.clone());
+    SimOut { n, m, p, t, w, x, y, z, q, method: s.method.clone(), h: s.h }
 }
 
 /// `moreau simulate FILE`: (n, m, p, method, h, {t, w, x, y, z, q} as float64 bytes).
@@ -263,9 +296,10 @@ fn simulate<'py>(
     integrator: &str,
     max_rows: Option<usize>,
 ) -> PyResult<(usize, usize, usize, String, f64, Bound<'py, PyDict>)> {
-    let event = match integrator {
-        "catching-up" => false,
-        "event" => true,
+    use commands::simulate::{simulate, Integrator, SimulateOptions};
+    let integrator = match integrator {
+        "catching-up" => Integrator::CatchingUp,
+        "event" => Integrator::Event,
         other => {
             return Err(MoreauError::new_err(format!(
                 "invalid value '{other}' for '--integrator <INTEGRATOR>' [possible values: catching-up, event]"
@@ -273,8 +307,8 @@ fn simulate<'py>(
         }
     };
     let src = source(model)?;
-    let o = core::SimulateOptions { periods, dt, t_end, event, max_rows };
-    let r = py.detach(move || core::simulate(&src, &o)).map_err(err)?;
+    let o = SimulateOptions { periods, dt, t_end, integrator, max_rows };
+    let r = py.detach(move || simulate(&src, &o).map(|s| columns(&s))).map_err(err)?;
     let d = PyDict::new(py);
     for (k, v) in [("t", &r.t), ("w", &r.w), ("x", &r.x), ("y", &r.y), ("z", &r.z), ("q", &r.q)] {
         d.set_item(k, bytes(py, v))?;
@@ -292,8 +326,10 @@ fn periodic(
     periods: usize,
     pairs: usize,
 ) -> PyResult<String> {
+    use commands::periodic::{periodic, PeriodicOptions};
     let src = source(model)?;
-    let v = py.detach(move || core::periodic_json(&src, dt, periods, pairs)).map_err(err)?;
+    let o = PeriodicOptions { dt, periods, pairs };
+    let v = py.detach(move || periodic(&src, &o).map(|r| r.to_json())).map_err(err)?;
     to_json(&v)
 }
 
@@ -308,8 +344,12 @@ fn check(
     negative_control: bool,
     out: Option<PathBuf>,
 ) -> PyResult<(String, bool)> {
-    let o = core::CheckOptions { cases, seed, only, negative_control, out };
-    let (v, bad) = py.detach(move || core::check_json(&o)).map_err(err)?;
+    let o = commands::check::CheckOptions { cases, seed, only, negative_control, out };
+    let run = |o| -> anyhow::Result<_> {
+        let r = commands::check::plan(&o)?.run(&())?;
+        Ok((r.to_json(), r.failed()))
+    };
+    let (v, bad) = py.detach(move || run(o)).map_err(err)?;
     Ok((to_json(&v)?, bad))
 }
 
@@ -330,21 +370,36 @@ fn diagnose<'py>(
     estimate_x0: bool,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>, usize, Bound<'py, PyDict>)> {
+    use commands::diagnose::{diagnose, write_outputs, DiagnoseOptions, RecordingSource};
     let src = source(model)?;
     let rec = match (data, text) {
         (Some(p), None) => RecordingSource::File(p),
         (None, Some(text)) => RecordingSource::Text { text, source: source_name },
         _ => return Err(PyTypeError::new_err("give exactly one of data= (a path) and text= (CSV text)")),
     };
-    let o = core::DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, out };
-    let r = py.detach(move || core::diagnose(&src, &rec, &o)).map_err(err)?;
+    let Some(input_hold) = discovery::HoldChoice::parse(&input_hold) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
+        )));
+    };
+    let o = DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, ..Default::default() };
+    let run = move || -> anyhow::Result<discovery::Report> {
+        let r = diagnose(&src, &rec, &o)?.report;
+        if let Some(dir) = &out {
+            write_outputs(&r, dir)?;
+        }
+        Ok(r)
+    };
+    let r = py.detach(run).map_err(err)?;
+    let report = serde_json::to_value(&r).map_err(|e| err(e.into()))?;
+    let s = &r.series;
     let d = PyDict::new(py);
-    for (k, v) in [("t", &r.t), ("y", &r.y), ("yhat_nominal", &r.yhat_nominal), ("yhat_fitted", &r.yhat_fitted)] {
+    for (k, v) in [("t", &s.t), ("y", &s.y), ("yhat_nominal", &s.yhat_nominal), ("yhat_fitted", &s.yhat_fitted)] {
         d.set_item(k, bytes(py, v))?;
     }
     // the fitted model file states the initial state it was fitted with
-    let fitted = r.fitted.map(|inner| PySystem { inner, stated: Stated { x0: true, z0: true } });
-    Ok((to_json(&r.report)?, fitted, r.p, d))
+    let fitted = r.fitted_model.clone().map(|inner| PySystem { inner, stated: Stated { x0: true, z0: true } });
+    Ok((to_json(&report)?, fitted, s.p, d))
 }
 
 /// `moreau sweep SPEC --out DIR --quiet`: (JSON table, files written, exit status 0).
@@ -362,10 +417,33 @@ fn sweep(
     fresh: bool,
     retry_failed: bool,
 ) -> PyResult<(String, Vec<PathBuf>, bool)> {
-    let args =
-        moreau::cli::sweep::Args { spec, out, shard, threads, digits, overwrite, fresh, retry_failed, quiet: true };
-    let (v, files, ok) = py.detach(move || core::sweep(args)).map_err(err)?;
+    let o = commands::sweep::SweepOptions {
+        spec,
+        out,
+        shard,
+        threads,
+        digits,
+        overwrite,
+        fresh,
+        retry_failed,
+        progress: false,
+    };
+    let (v, files, ok) = py.detach(move || sweep_table(&o)).map_err(err)?;
     Ok((to_json(&v)?, files, ok))
+}
+
+/// Runs the sweep and reads back the JSON table it wrote (`sweep.json`, or the shard's) and
+/// the files of the table.
+fn sweep_table(o: &commands::sweep::SweepOptions) -> anyhow::Result<(serde_json::Value, Vec<PathBuf>, bool)> {
+    use anyhow::Context;
+    let run = commands::sweep::sweep(o)?;
+    let stem = moreau::sweep::run::stem(run.shard);
+    let json_path = o.out.join(format!("{stem}.json"));
+    let text = std::fs::read_to_string(&json_path).with_context(|| format!("cannot read {}", json_path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text).with_context(|| json_path.display().to_string())?;
+    let files =
+        ["csv", "json", "md", "tex"].iter().map(|e| o.out.join(format!("{stem}.{e}"))).filter(|p| p.exists()).collect();
+    Ok((v, files, run.summary.failed == 0))
 }
 
 /// The CLI's global `--allow-large`: lifts the soft work limits of every later call.

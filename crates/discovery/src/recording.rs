@@ -4,8 +4,28 @@
 //! residual follows it (an input missing from the model). Checked on reading (missing columns, non-finite values, non-increasing
 //! time, constant inputs) and put on a uniform time grid: irregular time stamps are resampled
 //! by linear interpolation at the median sampling interval.
+//!
+//! A file or text from outside goes through [`Recording::load`] or
+//! [`Recording::parse_checked`], which first run the file checks of [`checks`] (regular file
+//! of bounded size, no duplicate columns, time steps resolvable in double precision, no
+//! number near overflow), so every front end (the CLI, Python) refuses the same inputs with
+//! the same messages.
 use crate::DiscoveryError;
 use std::path::Path;
+use thiserror::Error;
+
+pub mod checks;
+
+pub use checks::{check_text, read_checked, CsvCheckError, TimeColumn};
+
+/// Why a recording was refused: by the file checks ([`checks`]) or by the reader.
+#[derive(Debug, Error)]
+pub enum RecordingError {
+    #[error(transparent)]
+    Check(#[from] CsvCheckError),
+    #[error(transparent)]
+    Read(#[from] DiscoveryError),
+}
 
 /// A recording on a uniform grid `t_k = t0 + k dt`.
 #[derive(Debug, Clone)]
@@ -71,14 +91,22 @@ impl Recording {
         self.t0 + self.dt * k as f64
     }
 
-    /// Reads a CSV file.
-    pub fn load(path: &Path) -> Result<Self, DiscoveryError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| DiscoveryError::Io { path: path.display().to_string(), reason: e.to_string() })?;
-        Self::parse_str(&text, &path.display().to_string())
+    /// Reads a CSV file after the file checks of [`checks::read_checked`] (as `recording` in
+    /// messages).
+    pub fn load(path: &Path) -> Result<Self, RecordingError> {
+        let text = read_checked(path, "recording", TimeColumn::Numeric("t"))?;
+        Ok(Self::parse_str(&text, &path.display().to_string())?)
     }
 
-    /// Parses CSV text; `source` names it in errors.
+    /// Parses CSV text after the checks of [`checks::check_text`]; `source` names it in
+    /// errors.
+    pub fn parse_checked(text: &str, source: &str) -> Result<Self, RecordingError> {
+        check_text(text, source, TimeColumn::Numeric("t"))?;
+        Ok(Self::parse_str(text, source)?)
+    }
+
+    /// Parses CSV text without the file checks (text made by the program itself); `source`
+    /// names it in errors.
     pub fn parse_str(text: &str, source: &str) -> Result<Self, DiscoveryError> {
         let path = source.to_string();
         let mut rdr = csv::ReaderBuilder::new()

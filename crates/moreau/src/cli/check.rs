@@ -7,11 +7,10 @@
 //!
 //! `--negative-control` runs the deliberately wrong variants instead: there every property
 //! must produce a counterexample, and the exit status is 1 if one of them does not.
-use anyhow::Context;
+use crate::commands::check::{self, CheckOptions, CheckProgress};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use theorems::{CampaignSettings, PropertyReport, Variant};
 
 #[derive(Debug, clap::Args)]
 #[command(after_help = "Examples:
@@ -48,38 +47,31 @@ fn fmt_slack(s: f64) -> String {
     }
 }
 
-pub fn report_json(r: &PropertyReport, file: Option<&PathBuf>) -> serde_json::Value {
-    serde_json::json!({
-        "name": r.name,
-        "label": r.label,
-        "title": r.title,
-        "variant": match r.variant { Variant::Claim => "claim", Variant::NegativeControl => "negative_control" },
-        "cases": r.cases,
-        "skipped": r.skipped,
-        "min_slack": if r.min_slack.is_finite() { serde_json::json!(r.min_slack) } else { serde_json::Value::Null },
-        "violations": r.violations,
-        "first_violation": r.first_violation,
-        "counterexample_file": file.map(|f| f.display().to_string()),
-        "counterexample": r.counterexample.as_ref().map(|c| c.summary.clone()),
-        "seconds": r.seconds,
-    })
+/// The progress bar of a campaign.
+struct Bar(ProgressBar);
+
+impl CheckProgress for Bar {
+    fn property(&self, name: &str) {
+        self.0.set_message(name.to_string());
+    }
+    fn cases(&self, done: u64) {
+        self.0.inc(done);
+    }
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    if a.cases == Some(0) {
-        anyhow::bail!("--cases must be at least 1, got 0");
-    }
-    if let Some(c) = a.cases {
-        crate::budget::cases(c)?;
-    }
-    let variant = if a.negative_control { Variant::NegativeControl } else { Variant::Claim };
-    let settings = CampaignSettings { cases: a.cases, seed: a.seed, only: a.only.clone(), variant };
-    let props = theorems::campaign::select(theorems::registry(), a.only.as_deref())?;
-    let total: u64 = props.iter().map(|p| a.cases.unwrap_or(p.info().default_cases)).sum();
+    let o = CheckOptions {
+        cases: a.cases,
+        seed: a.seed,
+        only: a.only.clone(),
+        negative_control: a.negative_control,
+        out: Some(a.out.clone()),
+    };
+    let plan = check::plan(&o)?;
     let bar = if a.json {
         ProgressBar::hidden()
     } else {
-        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+        ProgressBar::with_draw_target(Some(plan.total_cases()), ProgressDrawTarget::stderr())
     };
     bar.set_style(
         ProgressStyle::with_template(
@@ -87,43 +79,17 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let mut reports = Vec::new();
-    for p in &props {
-        bar.set_message(p.info().name.to_string());
-        let r = theorems::run_property(p.as_ref(), &settings, &|d| bar.inc(d))?;
-        reports.push(r);
-    }
-    bar.finish_and_clear();
-
-    // counterexample files
-    let mut files: Vec<Option<PathBuf>> = Vec::new();
-    for r in &reports {
-        match &r.counterexample {
-            Some(c) => {
-                let suffix = if a.negative_control { "-negative-control" } else { "" };
-                let path = a.out.join(format!("{}{}.{}", r.name, suffix, c.extension));
-                crate::output::write_atomic(&path, c.text.as_bytes())
-                    .with_context(|| format!("writing counterexample {}", path.display()))?;
-                files.push(Some(path));
-            }
-            None => files.push(None),
-        }
-    }
-
+    let bar = Bar(bar);
+    let run = plan.run(&bar)?;
+    bar.0.finish_and_clear();
     if a.json {
-        let v: Vec<serde_json::Value> = reports.iter().zip(&files).map(|(r, f)| report_json(r, f.as_ref())).collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(
-                &serde_json::json!({ "seed": a.seed, "variant": if a.negative_control { "negative_control" } else { "claim" }, "results": v })
-            )?
-        );
+        println!("{}", serde_json::to_string_pretty(&run.to_json())?);
     } else {
         println!(
             "{:<14} {:<10} {:>9} {:>8} {:>12} {:>10} {:>8}",
             "result", "label", "cases", "skipped", "min slack", "violations", "time"
         );
-        for r in &reports {
+        for r in &run.reports {
             println!(
                 "{:<14} {:<10} {:>9} {:>8} {:>12} {:>10} {:>7.2}s",
                 r.name,
@@ -135,7 +101,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                 r.seconds
             );
         }
-        for (r, f) in reports.iter().zip(&files) {
+        for (r, f) in run.reports.iter().zip(&run.files) {
             if let (Some(c), Some(f)) = (&r.counterexample, f) {
                 println!("{} {}: {} -> {}", r.name, r.label, c.summary, f.display());
             }
@@ -144,10 +110,5 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             println!("(negative controls: every property must show violations)");
         }
     }
-    let bad = if a.negative_control {
-        reports.iter().any(|r| r.violations == 0)
-    } else {
-        reports.iter().any(|r| r.violations > 0)
-    };
-    Ok(if bad { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(if run.failed() { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }

@@ -1,4 +1,6 @@
-//! The `moreau` command line: one module per subcommand.
+//! The `moreau` command line: one module per subcommand. Each parses its arguments, calls
+//! the command's function in [`crate::commands`] where it has one (validation, budgets and
+//! computation live there, shared with the Python package), and prints or writes the result.
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -87,7 +89,7 @@ pub fn main() -> ExitCode {
     crate::budget::set_allow_large(cli.allow_large);
     crate::output::install_interrupt_cleanup();
     let result = match cli.command {
-        Command::Theta(a) => crate::budget::theta_size_of_file("theta", &a.file).and_then(|_| theta::run(&a)),
+        Command::Theta(a) => theta::run(&a),
         Command::Validate(a) => validate::run(&a),
         Command::Import(a) => import::run(&a),
         Command::Check(a) => check::run(&a),
@@ -110,22 +112,4 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// The error and its causes on one line; a cause whose text an outer message already carries
-/// (thiserror variants that format their `source`) is not repeated.
-/// A context that the next cause repeats (`f.toml` then `f.toml: TOML syntax error ...` or
-/// `cannot read f.toml: ...`) is replaced by that cause, so the path is printed once; line breaks inside a
-/// message are folded.
-pub fn one_line(e: &anyhow::Error) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    for cause in e.chain() {
-        let text = cause.to_string().lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ");
-        if parts.iter().any(|p| p.contains(&text)) {
-            continue;
-        }
-        match parts.last_mut() {
-            Some(last) if text.contains(last.as_str()) => *last = text,
-            _ => parts.push(text),
-        }
-    }
-    parts.join(": ")
-}
+pub use crate::commands::one_line;

@@ -1,12 +1,8 @@
 //! `moreau periodic FILE [--dt H] [--periods N] [--json]`: the periodic regime (fixed point of
 //! the Poincare map), its residual and the (loc) check, the measured convergence exponent with
 //! its 95% interval, and the path length of z per period.
-use crate::budget::num;
-use anyhow::{bail, Context};
-use bounds::tube::localisation::{check_localisation, LocalisationSettings};
-use dynamics::periodic::linearised::{linearised_periodic, LinearisedSettings};
-use dynamics::periodic::poincare::{periodic_regime, PoincareSettings};
-use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
+use crate::commands::periodic::{periodic, PeriodicOptions, PeriodicRun};
+use crate::commands::Source;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -32,123 +28,66 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let sys = model::load(&a.file).with_context(|| a.file.display().to_string())?;
-    let dt = a.dt.unwrap_or(sys.sim.dt);
-    if !(dt > 0.0 && dt.is_finite()) {
-        bail!("--dt must be positive and finite, got {dt}");
-    }
-    if a.periods == 0 {
-        bail!("--periods must be at least 1, got 0");
-    }
-    let Some(T) = sys.period() else {
-        bail!(
-            "`{}` has a non-periodic input (`{}`): the periodic regime needs a T-periodic w",
-            a.file.display(),
-            sys.input.kind()
-        );
-    };
-    if a.pairs == 0 {
-        bail!("--pairs must be at least 1, got 0");
-    }
-    if a.dt.is_some() {
-        crate::budget::step(dt, &sys, None, "--dt")?;
-    }
-    // rate: `periods` periods of 2 trajectories per pair and a reference; Poincare iteration
-    // typically well under 100 periods
-    crate::budget::steps(
-        "periodic",
-        (T / dt).ceil() * (a.periods as f64 * (2 * a.pairs + 1) as f64 + 100.0),
-        &format!("{} periods, {} pairs, T = {}, dt = {}", a.periods, a.pairs, num(T), num(dt)),
-    )?;
-    if !sys.effects.list.is_empty() {
-        return run_with_effects(a, &sys, dt);
-    }
-    let reg = periodic_regime(&sys, &PoincareSettings { dt, ..Default::default() })?;
-    let lin = linearised_periodic(&sys, &LinearisedSettings::default())?;
-    let loc = check_localisation(&sys, lin.xi0(), &reg.x0, &reg.z0, &LocalisationSettings::default())?;
-    let transient = (a.periods / 6).max(1).min(10);
-    let rate = measure_rate(
-        &sys,
-        &RateSettings { dt, periods: a.periods, transient_periods: transient, pairs: a.pairs, ..Default::default() },
-        None,
-    )?;
+    let o = PeriodicOptions { dt: a.dt, periods: a.periods, pairs: a.pairs };
+    let run = periodic(&Source::File(a.file.clone()), &o)?;
     if a.json {
-        let v = serde_json::json!({
-            "name": sys.name, "period": reg.period, "h": reg.h,
-            "periodic_regime": reg, "xi_T0": lin.xi0(), "localisation": loc,
-            "rate": { "exponent": rate.exponent, "ci95": [rate.ci_low, rate.ci_high], "pairs": rate.pairs.iter().map(|p| serde_json::json!({"exponent": p.exponent, "ci95": [p.ci_low, p.ci_high], "renormalisations": p.renormalisations, "collapsed": p.collapsed})).collect::<Vec<_>>() },
-            "path_length_per_period": rate.path_length_per_period, "limsup_z_speed": rate.limsup_z_speed,
-            "osc_eta_T_lower": lin.osc_lower(), "eta_T_dot_inf_sampled": lin.deta_inf_sampled(),
-        });
-        println!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        let f = |v: &[f64]| v.iter().map(|x| format!("{x:.9}")).collect::<Vec<_>>().join(", ");
-        println!("{}", sys.name);
-        println!("  period T = {:.9}, step h = {:e} ({} steps per period)", reg.period, reg.h, reg.steps_per_period);
-        println!("  periodic regime: x(0) = [{}], z(0) = [{}]", f(&reg.x0), f(&reg.z0));
-        println!(
-            "    fixed-point iteration: {:?} after {} periods, residual |P(s) - s|_inf = {:.3e}",
-            reg.status, reg.iterations, reg.residual
-        );
-        println!(
-            "    (loc): {} (worst margin {:.3e} over {} directions, q in Theta: {})",
-            if loc.inside { "inside" } else { "OUTSIDE" },
-            loc.worst_margin,
-            loc.directions,
-            loc.q_in_theta
-        );
-        println!(
-            "  linearised: xi_T(0) = [{}], osc(eta_T) >= {:.6}, max sampled |eta_T'| = {:.6}",
-            f(lin.xi0()),
-            lin.osc_lower(),
-            lin.deta_inf_sampled()
-        );
-        println!(
-            "  measured exponent (1/2) limsup (1/t) ln V: {:.5}  95% CI [{:.5}, {:.5}]  ({} pairs, periods {}..{})",
-            rate.exponent,
-            rate.ci_low,
-            rate.ci_high,
-            rate.pairs.len(),
-            rate.transient_periods,
-            rate.periods
-        );
-        println!(
-            "  path length of z per period (min after transient): {:.6};  limsup |z'|: {:.6}",
-            rate.path_length_per_period, rate.limsup_z_speed
-        );
+        println!("{}", serde_json::to_string_pretty(&run.to_json())?);
+        return Ok(ExitCode::SUCCESS);
     }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// A model with `[[effects]]`: the regime reached by the extended-model simulator after
-/// `--periods` periods, with the residual between successive periods (no fixed-point claim, no
-/// (loc) check, no rate: those are results about the paper's class).
-fn run_with_effects(a: &Args, sys: &model::System, dt: f64) -> anyhow::Result<ExitCode> {
-    let kinds: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
-    let reg = dynamics::extended::regime_by_simulation(sys, dt, a.periods)?;
-    let last = reg.residuals.last().copied().unwrap_or(f64::NAN);
-    let note = format!(
-        "the model has effects outside the paper's class ({}): the regime below is where the extended-model simulator is after {} periods; uniqueness and the convergence rate are not established for it",
-        kinds.join(", "),
-        reg.periods
-    );
-    if a.json {
-        let v = serde_json::json!({
-            "name": sys.name, "period": reg.period, "h": reg.h, "effects": kinds,
-            "simulated_regime": reg, "last_period_residual": last, "note": note,
-        });
-        println!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        let f = |v: &[f64]| v.iter().map(|x| format!("{x:.9}")).collect::<Vec<_>>().join(", ");
-        println!("{}", sys.name);
-        println!("  period T = {:.9}, step h = {:e} ({} steps per period)", reg.period, reg.h, reg.steps_per_period);
-        println!("  note: {note}");
-        println!("  state after {} periods: x = [{}], z = [{}]", reg.periods, f(&reg.x0), f(&reg.z0));
-        println!("  change over the last period |s(NT) - s((N-1)T)|_inf = {last:.3e}");
-        println!(
-            "  path length of z over the last period: {:.6};  max |z'|: {:.6}",
-            reg.path_length_last_period, reg.max_z_speed_last_period
-        );
+    let f = |v: &[f64]| v.iter().map(|x| format!("{x:.9}")).collect::<Vec<_>>().join(", ");
+    match &run {
+        PeriodicRun::Paper { sys, regime: reg, linearised: lin, localisation: loc, rate } => {
+            println!("{}", sys.name);
+            println!(
+                "  period T = {:.9}, step h = {:e} ({} steps per period)",
+                reg.period, reg.h, reg.steps_per_period
+            );
+            println!("  periodic regime: x(0) = [{}], z(0) = [{}]", f(&reg.x0), f(&reg.z0));
+            println!(
+                "    fixed-point iteration: {:?} after {} periods, residual |P(s) - s|_inf = {:.3e}",
+                reg.status, reg.iterations, reg.residual
+            );
+            println!(
+                "    (loc): {} (worst margin {:.3e} over {} directions, q in Theta: {})",
+                if loc.inside { "inside" } else { "OUTSIDE" },
+                loc.worst_margin,
+                loc.directions,
+                loc.q_in_theta
+            );
+            println!(
+                "  linearised: xi_T(0) = [{}], osc(eta_T) >= {:.6}, max sampled |eta_T'| = {:.6}",
+                f(lin.xi0()),
+                lin.osc_lower(),
+                lin.deta_inf_sampled()
+            );
+            println!(
+                "  measured exponent (1/2) limsup (1/t) ln V: {:.5}  95% CI [{:.5}, {:.5}]  ({} pairs, periods {}..{})",
+                rate.exponent,
+                rate.ci_low,
+                rate.ci_high,
+                rate.pairs.len(),
+                rate.transient_periods,
+                rate.periods
+            );
+            println!(
+                "  path length of z per period (min after transient): {:.6};  limsup |z'|: {:.6}",
+                rate.path_length_per_period, rate.limsup_z_speed
+            );
+        }
+        PeriodicRun::Effects { sys, regime: reg, last_residual: last, note, .. } => {
+            println!("{}", sys.name);
+            println!(
+                "  period T = {:.9}, step h = {:e} ({} steps per period)",
+                reg.period, reg.h, reg.steps_per_period
+            );
+            println!("  note: {note}");
+            println!("  state after {} periods: x = [{}], z = [{}]", reg.periods, f(&reg.x0), f(&reg.z0));
+            println!("  change over the last period |s(NT) - s((N-1)T)|_inf = {last:.3e}");
+            println!(
+                "  path length of z over the last period: {:.6};  max |z'|: {:.6}",
+                reg.path_length_last_period, reg.max_z_speed_last_period
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -62,7 +62,8 @@ fn check_config(c: &robonine::StandConfig) -> anyhow::Result<()> {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let text = crate::csv_check::read_checked(&a.data, "log", crate::csv_check::TimeColumn::Iso8601("timestamp"))?;
+    let text =
+        discovery::recording::read_checked(&a.data, "log", discovery::recording::TimeColumn::Iso8601("timestamp"))?;
     let cfg_text = model::files::read_regular(&a.config, model::files::MAX_MODEL_BYTES)?;
     let cfg = robonine::StandConfig::from_json_str(&cfg_text).with_context(|| a.config.display().to_string())?;
     check_config(&cfg).with_context(|| a.config.display().to_string())?;

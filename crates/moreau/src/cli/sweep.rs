@@ -1,7 +1,5 @@
 //! `moreau sweep SPEC --out DIR [--shard K/N] [--threads N] [--digits D]`
-use crate::sweep::theta_eval::ThetaEvaluator;
-use crate::sweep::{RunOptions, Shard, SweepSpec};
-use anyhow::Context;
+use crate::commands::sweep::{sweep, SweepOptions, SweepRun};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -43,65 +41,22 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// Work of a sweep estimated before any point is evaluated: grid points, theta's problem size
-/// and, per point, the steps of the measured side (`[evaluate] dt, periods, pairs`) at the
-/// longest input period of the grid; `dt` against the shortest one.
-fn check_budget(spec: &SweepSpec, ev: &ThetaEvaluator) -> anyhow::Result<()> {
-    let points = spec.axes.iter().fold(1f64, |acc, a| acc * a.values.len() as f64);
-    crate::budget::check(
-        "sweep: grid points",
-        points,
-        crate::budget::MAX_SWEEP_POINTS as f64,
-        crate::sweep::spec::MAX_POINTS as f64,
-        "",
-    )?;
-    crate::budget::theta_size("sweep", spec.base.n(), spec.base.p())?;
-    let Some(rate) = &ev.settings.measure else { return Ok(()) };
-    let Some(base_T) = spec.base.period() else { return Ok(()) };
-    let omegas: Vec<f64> = spec
-        .axes
-        .iter()
-        .filter(|a| a.parameter == crate::sweep::axis::Parameter::InputOmega)
-        .flat_map(|a| a.values.iter().copied())
-        .collect();
-    let periods: Vec<f64> =
-        if omegas.is_empty() { vec![base_T] } else { omegas.iter().map(|w| std::f64::consts::TAU / w).collect() };
-    let t_min = periods.iter().copied().fold(f64::INFINITY, f64::min);
-    let t_max = periods.iter().copied().fold(0.0, f64::max);
-    model::check_step(rate.dt, Some(t_min), None, "evaluate.dt").with_context(|| spec.path.display().to_string())?;
-    crate::budget::steps(
-        "sweep: per point",
-        (t_max / rate.dt).ceil() * rate.periods as f64 * (2 * rate.pairs) as f64,
-        &format!(
-            "[evaluate] periods = {}, pairs = {}, dt = {}, T up to {}",
-            rate.periods,
-            rate.pairs,
-            crate::budget::num(rate.dt),
-            crate::budget::num(t_max)
-        ),
-    )
-}
-
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
-    let threads = a.threads.map(crate::budget::threads).transpose()?;
-    let spec = SweepSpec::load(&a.spec).with_context(|| a.spec.display().to_string())?;
-    let evaluator = ThetaEvaluator::from_table(&spec.evaluate, &spec.path)?;
-    check_budget(&spec, &evaluator)?;
-    let opts = RunOptions {
+    let o = SweepOptions {
+        spec: a.spec.clone(),
         out: a.out.clone(),
-        shard,
-        threads,
-        progress: !a.quiet,
+        shard: a.shard.clone(),
+        threads: a.threads,
+        digits: a.digits,
         overwrite: a.overwrite,
         fresh: a.fresh,
         retry_failed: a.retry_failed,
-        digits: a.digits,
+        progress: !a.quiet,
     };
-    let s = crate::sweep::run(&spec, &evaluator, &opts)?;
+    let SweepRun { name, summary: s, .. } = sweep(&o)?;
     eprintln!(
         "sweep `{}`: {} points in scope, {} resumed, {} computed, {} failed; spec hash {}",
-        spec.name, s.in_scope, s.resumed, s.computed, s.failed, s.result.spec_hash
+        name, s.in_scope, s.resumed, s.computed, s.failed, s.result.spec_hash
     );
     for f in &s.files {
         println!("{}", f.display());

@@ -1,9 +1,10 @@
 //! `moreau theta FILE [--json] [--out FILE]`: the paper's bound theta (eq. (theta)) with every
 //! intermediate quantity labelled by its equation and flagged verified / estimate, next to the
 //! measured convergence exponent, path length per period and limsup |z'|.
-use anyhow::Context;
+use crate::commands::theta::{theta, ThetaOptions};
+use crate::commands::Source;
 use bounds::report::{fmt_value, render_table};
-use bounds::{assemble, ThetaReport, ThetaSettings};
+use bounds::ThetaReport;
 use geometry::ConvexSet;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -137,34 +138,21 @@ pub fn explain(rep: &ThetaReport) -> String {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let sys = model::load(&a.file).with_context(|| a.file.display().to_string())?;
-    let mut settings = ThetaSettings::default();
-    if a.no_measure {
-        settings.measure = None;
-    }
-    if a.no_stationary {
-        settings.stationary = None;
-    }
-    let rep = assemble(&sys, &settings).with_context(|| a.file.display().to_string())?;
-    let guide = (!a.no_guidance && !rep.convergence_guaranteed && rep.effects.is_empty())
-        .then(|| crate::guidance::guidance(&sys, &rep, &Default::default()));
-    let mut obj = rep.to_json();
-    if let (Some(g), Some(m)) = (&guide, obj.as_object_mut()) {
-        m.insert("guidance".into(), serde_json::to_value(g)?);
-    }
-    let json = serde_json::to_string_pretty(&obj)?;
+    let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance: !a.no_guidance };
+    let run = theta(&Source::File(a.file.clone()), &o)?;
+    let json = serde_json::to_string_pretty(&run.to_json()?)?;
     if let Some(out) = &a.out {
         crate::output::write_atomic(out, json.as_bytes())?;
     }
     if a.json {
         println!("{json}");
     } else {
-        print!("{}", render(&rep, &sys.theta.describe()));
-        if let Some(g) = &guide {
+        print!("{}", render(&run.report, &run.sys.theta.describe()));
+        if let Some(g) = &run.guidance {
             print!("{}", g.render());
         }
         if a.explain {
-            print!("{}", explain(&rep));
+            print!("{}", explain(&run.report));
         }
     }
     Ok(ExitCode::SUCCESS)

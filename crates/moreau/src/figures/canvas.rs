@@ -1,5 +1,5 @@
 //! A small figure description (lines, dashed lines, bands, filled polygons, markers) and its
-//! rendering with plotters to SVG and PNG. Fonts: [`crate::plot::register_fonts`].
+//! rendering with plotters to SVG and PNG. Fonts: [`super::fonts`].
 use super::FigureError;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -421,13 +421,13 @@ where
 
 /// The figure as an SVG document.
 pub fn to_svg(f: &Figure) -> Result<String, FigureError> {
-    crate::plot::register_fonts();
+    super::fonts::register_fonts();
     let mut buf = String::new();
     {
         let root = SVGBackend::with_string(&mut buf, f.size).into_drawing_area();
         draw(root, f)?;
     }
-    Ok(crate::plot::embed_font(buf))
+    Ok(super::fonts::embed_font(buf))
 }
 
 /// `svg` (the figure's, from [`to_svg`]) parsed for rasterising or PDF conversion, with the
@@ -490,7 +490,7 @@ fn png_of(f: &Figure, tree: &svg2pdf::usvg::Tree, dpi: f64) -> Result<Vec<u8>, F
 
 /// Writes the figure as PNG to `path`.
 pub fn write_png(f: &Figure, path: &Path) -> Result<(), FigureError> {
-    crate::plot::register_fonts();
+    super::fonts::register_fonts();
     let root = BitMapBackend::new(path, f.size).into_drawing_area();
     draw(root, f)
 }

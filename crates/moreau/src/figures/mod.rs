@@ -4,11 +4,16 @@
 //!   limit `-lambda` and the chord whose value at `gamma_1` is `theta` (eq. (theta));
 //! - [`tube`]: Fig. loop, the orbit `eta_T` (eq. (etaT)), the tube `eta_T + C Xi_inf + Theta`
 //!   (eqs. (Xinfsupp), (d)) and the simulated periodic `z`;
-//! - [`trajectory`]: `y` and `z` (and the states) of a simulation against time;
-//! - [`sweep`]: theta and the measured rate against a swept parameter.
+//! - [`trajectory`]: `y` and `z` (and the states) of a simulation against time, and the plot
+//!   of `moreau simulate` ([`trajectory::simulation_figure`]);
+//! - [`sweep`]: theta and the measured rate against a swept parameter;
+//! - [`diagnosis`]: measured vs nominal vs fitted, residuals and zooms of `moreau diagnose`.
 //!
-//! Every figure is a [`canvas::Figure`] (data only) rendered by [`canvas::write_figure`].
+//! Every figure is a [`canvas::Figure`] (data only) rendered by [`canvas::write_figure`] (or
+//! [`canvas::to_svg`], [`canvas::write_png`]); [`fonts`] embeds the DejaVu font in all of them.
 pub mod canvas;
+pub mod diagnosis;
+pub mod fonts;
 pub mod pgf;
 pub mod psi;
 pub mod sweep;

@@ -1,8 +1,10 @@
 //! Trajectories: `y = C x` and `z` against time (and the states `x` in a second figure), from
 //! the catching-up scheme (eq. (zdot) discretised, NOTES.md) started at the model's `x0, z0`,
-//! or the extended-model simulator for a model with `[[effects]]`.
+//! or the extended-model simulator for a model with `[[effects]]`; and
+//! [`simulation_figure`], the plot `moreau simulate` writes beside `trajectory.csv`.
 use super::canvas::{palette, Element, Figure};
 use super::FigureError;
+use dynamics::trajectory::Trajectory;
 use model::System;
 
 /// Settings of the trajectory figure.
@@ -67,4 +69,53 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
         });
     }
     Ok((yz, xf))
+}
+
+/// The plot of `moreau simulate`: the inputs `w1..wm`, then `y_k` and `z_k` per output
+/// against `t`, titled with the model's name and `method` (how it was simulated).
+pub fn simulation_figure(sys: &System, tr: &Trajectory, method: &str) -> Figure {
+    let mut f = Figure::new(&format!("{} ({method})", sys.name), "t", "w, y, z");
+    f.size = (1000, 600);
+    let mut line = |label: String, y: Vec<f64>| {
+        let color = palette(f.elements.len());
+        f.elements.push(Element::Line { label, pts: tr.t.iter().copied().zip(y).collect(), color, dashed: false });
+    };
+    for j in 0..sys.m() {
+        line(format!("w{}", j + 1), (0..tr.len()).map(|i| tr.w_at(i)[j]).collect());
+    }
+    for j in 0..sys.p() {
+        line(format!("y{}", j + 1), (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect());
+        line(format!("z{}", j + 1), (0..tr.len()).map(|i| tr.z_at(i)[j]).collect());
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::figures::canvas;
+
+    #[test]
+    fn the_simulate_plot_renders_svg_and_png_with_text() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml");
+        let sys = model::load(std::path::Path::new(path)).unwrap();
+        let tr = dynamics::trajectory::simulate_model(&sys, 0.01, 300, 1).unwrap();
+        let f = simulation_figure(&sys, &tr, "catching-up, h = 1e-2");
+        let labels: Vec<&str> = f.elements.iter().map(|e| e.label_and_color().0).collect();
+        assert_eq!(labels, ["w1", "y1", "z1"]);
+        let svg = canvas::to_svg(&f).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("<text") && svg.contains("catching-up"));
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("a.png");
+        canvas::write_png(&f, &png).unwrap();
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+        // negative control: nothing finite to draw is an error, not an empty picture
+        let mut empty = f.clone();
+        for e in &mut empty.elements {
+            if let Element::Line { pts, .. } = e {
+                pts.iter_mut().for_each(|p| p.1 = f64::NAN);
+            }
+        }
+        assert!(canvas::to_svg(&empty).is_err());
+    }
 }

@@ -1,0 +1,115 @@
+//! `diagnose`: compare a nominal model with a recording, locate the mismatch, name the missing
+//! physics, refit and validate (crate `discovery`); [`write_outputs`] writes `report.md`,
+//! `report.json`, `fitted.toml` and the figures ([`crate::figures::diagnosis`]) into a
+//! directory, all together or not at all. The recording goes through the checked reader
+//! ([`discovery::Recording::load`], [`discovery::Recording::parse_checked`]).
+use super::{Source, Stated};
+use crate::figures::canvas;
+use crate::output::StagedDir;
+use anyhow::Context;
+use discovery::diagnose::Metric;
+use discovery::{DiagnoseSettings, HoldChoice, Recording, Report};
+use std::path::PathBuf;
+
+/// A recording: a CSV file or CSV text (built in Python from a DataFrame or an array;
+/// `source` names it in messages).
+pub enum RecordingSource {
+    File(PathBuf),
+    Text { text: String, source: String },
+}
+
+/// Options of `diagnose` (the CLI's `--estimation-fraction`, `--max-effects`,
+/// `--input-hold`, `--estimate-x0`, `--metric`, `--no-refit`).
+#[derive(Debug, Clone)]
+pub struct DiagnoseOptions {
+    /// Fraction of the record used for estimation (the rest validates). Default 0.7.
+    pub estimation_fraction: f64,
+    /// Greatest number of effects added by forward selection. Default 2.
+    pub max_effects: usize,
+    pub input_hold: HoldChoice,
+    /// Estimate the initial state even when the model states `[initial] x0`.
+    pub estimate_x0: bool,
+    pub metric: Metric,
+    /// Refit the nominal parameters the model file frees (`[fit] free`). Default true.
+    pub refit_nominal: bool,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        Self {
+            estimation_fraction: 0.7,
+            max_effects: 2,
+            input_hold: HoldChoice::Auto,
+            estimate_x0: false,
+            metric: Metric::Auto,
+            refit_nominal: true,
+        }
+    }
+}
+
+/// The result of `diagnose`: the report and the seconds the diagnosis itself took.
+pub struct DiagnoseRun {
+    pub report: Report,
+    pub seconds: f64,
+}
+
+/// Reads the model (with which initial values it states) and the recording, diagnoses.
+pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) -> anyhow::Result<DiagnoseRun> {
+    let (sys, stated) = match model_src {
+        Source::File(p) => {
+            let sys = model::load(p).with_context(|| format!("model {}", p.display()))?;
+            (sys, None)
+        }
+        Source::Built(s, stated) => ((**s).clone(), Some(*stated)),
+    };
+    let rec = match rec {
+        RecordingSource::File(p) => Recording::load(p)?,
+        RecordingSource::Text { text, source } => Recording::parse_checked(text, source)?,
+    };
+    let stated = match (stated, model_src) {
+        (Some(s), _) => s,
+        (None, Source::File(p)) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("model {}", p.display()))?;
+            Stated::of_text(&text)
+        }
+        (None, Source::Built(..)) => Stated::default(),
+    };
+    let settings = DiagnoseSettings {
+        estimation_fraction: o.estimation_fraction,
+        max_effects: o.max_effects,
+        input_hold: o.input_hold,
+        initial_state: stated.initial_state(&sys),
+        estimate_x0: o.estimate_x0,
+        metric: o.metric,
+        refit_nominal: o.refit_nominal,
+        ..Default::default()
+    };
+    let start = std::time::Instant::now();
+    let report = discovery::diagnose(&sys, &rec, &settings)?;
+    Ok(DiagnoseRun { report, seconds: start.elapsed().as_secs_f64() })
+}
+
+/// Writes every output of a report into `out` atomically.
+pub fn write_outputs(r: &Report, out: &std::path::Path) -> anyhow::Result<()> {
+    let figs = crate::figures::diagnosis::figures(r);
+    let st = StagedDir::new(out)?;
+    let mut captions = Vec::new();
+    for (name, fig) in &figs {
+        let svg = canvas::to_svg(fig).with_context(|| format!("figure {name}"))?;
+        std::fs::write(st.path(&format!("{name}.svg")), svg)?;
+        canvas::write_png(fig, &st.path(&format!("{name}.png"))).with_context(|| format!("figure {name}"))?;
+        captions.push((format!("{name}.svg"), fig.title.clone()));
+    }
+    let caps: Vec<(&str, &str)> = captions.iter().map(|(a, b)| (a.as_str(), b.as_str())).collect();
+    std::fs::write(st.path("report.md"), r.to_markdown(&caps))?;
+    std::fs::write(st.path("report.json"), serde_json::to_string_pretty(r)?)?;
+    if let Some(m) = &r.fitted_model {
+        let text = model::to_toml_string(m);
+        if let (model::Input::Samples { path, .. }, Some(csv)) = (&m.input, m.input.samples_csv()) {
+            std::fs::write(st.path(path), csv)?;
+        }
+        std::fs::write(st.path("fitted.toml"), text)?;
+        model::load(&st.path("fitted.toml")).context("the fitted model does not read back (internal error)")?;
+    }
+    st.commit()
+}

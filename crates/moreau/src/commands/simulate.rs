@@ -1,0 +1,136 @@
+//! `simulate`: the closed loop from the model's initial state by the catching-up scheme (the
+//! extended-model simulator for models with effects) or the event-driven reference. Budgets
+//! (all in [`simulate`]): the step against the input ([`crate::budget::step`]), the
+//! integration steps ([`crate::budget::steps`]) and the stored samples, `t, w, x, y, z` per
+//! kept row ([`crate::budget::samples`]).
+use super::Source;
+use crate::budget::num;
+use anyhow::bail;
+use dynamics::integrators::event_driven::{event_driven, EventDrivenSettings};
+use dynamics::trajectory::{simulate_model, Trajectory};
+use model::System;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Integrator {
+    /// Moreau's catching-up scheme with the exact linear step (any Theta); models with
+    /// `[[effects]]` run on the extended-model simulator.
+    #[default]
+    CatchingUp,
+    /// Event-driven reference (interval, ball, ellipsoid; zero or sine input).
+    Event,
+}
+
+/// Options of `simulate`: the CLI's `--periods`, `--dt`, `--integrator`, `--max-rows`, and
+/// `t_end` (Python only; the CLI takes the final time from `simulation.t_end` of the file).
+#[derive(Debug, Clone, Default)]
+pub struct SimulateOptions {
+    /// Input periods (periodic inputs; default: `simulation.periods`).
+    pub periods: Option<usize>,
+    /// Step (default: `simulation.dt`); for periodic inputs `T / ceil(T / dt)` is used.
+    pub dt: Option<f64>,
+    /// Final time instead of `periods` (any input).
+    pub t_end: Option<f64>,
+    pub integrator: Integrator,
+    /// Keep at most this many samples (every k-th step); `None` keeps every step.
+    pub max_rows: Option<usize>,
+}
+
+/// The result of `simulate`.
+pub struct Simulation {
+    pub sys: System,
+    pub trajectory: Trajectory,
+    /// How it was simulated (`catching-up, h = ...`, `event-driven, N events`, ...).
+    pub method: String,
+    /// The step used.
+    pub h: f64,
+}
+
+/// Validates the options, checks the budgets, simulates.
+pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation> {
+    let sys = src.system()?;
+    let dt = o.dt.unwrap_or(sys.sim.dt);
+    if !(dt > 0.0 && dt.is_finite()) {
+        bail!("--dt must be positive and finite, got {dt}");
+    }
+    if let Some(te) = o.t_end {
+        if !(te > 0.0 && te.is_finite()) {
+            bail!("t_end must be positive and finite, got {te}");
+        }
+        if o.periods.is_some() {
+            bail!("give t_end or periods, not both");
+        }
+    }
+    if o.dt.is_some() {
+        let t_end = o.t_end.or(sys.sim.t_end).filter(|_| sys.period().is_none() || o.t_end.is_some());
+        crate::budget::step(dt, &sys, t_end, "--dt")?;
+    }
+    let periods = o.periods.unwrap_or(sys.sim.periods);
+    if periods == 0 {
+        bail!("--periods must be at least 1, got 0");
+    }
+    if let Some(r) = o.max_rows.filter(|&r| r < 2) {
+        bail!("--max-rows must be at least 2, got {r}");
+    }
+    let (t_end, h) = match (sys.period(), o.t_end) {
+        (Some(T), None) => {
+            crate::budget::steps(
+                "simulate",
+                periods as f64 * (T / dt).ceil(),
+                &format!("{} periods of T = {} at dt = {}", num(periods as f64), num(T), num(dt)),
+            )?;
+            let (n, h) = dynamics::periodic::steps_per_period(T, dt)?;
+            (periods as f64 * n as f64 * h, h)
+        }
+        (Some(T), Some(te)) => {
+            let (_, h) = dynamics::periodic::steps_per_period(T, dt)?;
+            (te, h)
+        }
+        (None, te) => {
+            if o.periods.is_some() {
+                bail!(
+                    "--periods needs a periodic input; {} has input `{}` (set simulation.t_end instead)",
+                    src.label(),
+                    sys.input.kind()
+                );
+            }
+            (te.or(sys.sim.t_end).unwrap_or(100.0), dt)
+        }
+    };
+    crate::budget::steps("simulate", (t_end / h).round(), &format!("t_end = {} at dt = {}", num(t_end), num(h)))?;
+    let steps = (t_end / h).round().max(1.0) as usize;
+    let max_rows = o.max_rows.unwrap_or(steps + 1);
+    let rows = (steps as f64).min(max_rows as f64);
+    crate::budget::samples(
+        "simulate",
+        rows * (1 + sys.n() + sys.m() + 2 * sys.p()) as f64,
+        "numbers in trajectory.csv, --max-rows",
+    )?;
+    let every = steps.div_ceil(max_rows).max(1);
+    let effects: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
+    let (trajectory, method) = match o.integrator {
+        Integrator::CatchingUp if effects.is_empty() => {
+            (simulate_model(&sys, h, steps, every)?, format!("catching-up, h = {h:e}"))
+        }
+        Integrator::CatchingUp => (
+            simulate_model(&sys, h, steps, every)?,
+            format!("extended model with {}, h = {h:e}", effects.join(", ")),
+        ),
+        Integrator::Event if !effects.is_empty() => bail!(
+            "--integrator event simulates the paper's class only; {} has effects ({}): use --integrator catching-up (the extended-model simulator)",
+            src.label(),
+            effects.join(", ")
+        ),
+        Integrator::Event => {
+            let (tr, events) = event_driven(
+                &sys,
+                &EventDrivenSettings {
+                    dt_out: h * every as f64,
+                    t_end: (steps / every) as f64 * every as f64 * h,
+                    ..Default::default()
+                },
+            )?;
+            (tr, format!("event-driven, {events} events"))
+        }
+    };
+    Ok(Simulation { sys, trajectory, method, h })
+}

@@ -1,0 +1,71 @@
+//! `theta`: the paper's bound theta (eq. (theta)) of a model, its report and, when nothing is
+//! certified, the design guidance. Budget: theta's problem size ([`crate::budget::theta_size`]).
+use super::Source;
+use crate::guidance::Guidance;
+use anyhow::Context;
+use bounds::{assemble, ThetaReport, ThetaSettings};
+use model::System;
+
+/// Options of `theta` (the CLI's `--no-measure`, `--no-stationary`, `--no-guidance`).
+#[derive(Debug, Clone, Copy)]
+pub struct ThetaOptions {
+    /// Simulate the measured side (rate, path length, limsup |z'|).
+    pub measure: bool,
+    /// Decide the stationary set of Theorem 1.
+    pub stationary: bool,
+    /// Design guidance when nothing is certified (and the model has no effects).
+    pub guidance: bool,
+}
+
+impl Default for ThetaOptions {
+    fn default() -> Self {
+        Self { measure: true, stationary: true, guidance: true }
+    }
+}
+
+/// The result of `theta`: the system, its report and the guidance (when computed).
+pub struct ThetaRun {
+    pub sys: System,
+    pub report: ThetaReport,
+    pub guidance: Option<Guidance>,
+}
+
+impl ThetaRun {
+    /// The JSON object of `moreau theta --json`: the report, plus `guidance` when computed.
+    pub fn to_json(&self) -> anyhow::Result<serde_json::Value> {
+        let mut obj = self.report.to_json();
+        if let (Some(g), Some(m)) = (&self.guidance, obj.as_object_mut()) {
+            m.insert("guidance".into(), serde_json::to_value(g)?);
+        }
+        Ok(obj)
+    }
+}
+
+/// The problem-size budget of `theta`, then the model, then the bound (errors of a model file
+/// carry its path).
+pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
+    let sys = match src {
+        Source::File(p) => {
+            crate::budget::theta_size_of_file("theta", p)?;
+            super::load(p)?
+        }
+        Source::Built(s, _) => {
+            crate::budget::theta_size("theta", s.n(), s.p())?;
+            (**s).clone()
+        }
+    };
+    let mut settings = ThetaSettings::default();
+    if !o.measure {
+        settings.measure = None;
+    }
+    if !o.stationary {
+        settings.stationary = None;
+    }
+    let report = match src {
+        Source::File(p) => assemble(&sys, &settings).with_context(|| p.display().to_string())?,
+        Source::Built(..) => assemble(&sys, &settings)?,
+    };
+    let guidance = (o.guidance && !report.convergence_guaranteed && report.effects.is_empty())
+        .then(|| crate::guidance::guidance(&sys, &report, &Default::default()));
+    Ok(ThetaRun { sys, report, guidance })
+}

@@ -1,0 +1,297 @@
+//! The figures of a diagnosis report (`moreau diagnose`, output 1): measured against nominal
+//! and fitted, the residuals with their located windows shaded, and zooms into the top
+//! windows, each a stack of panels sharing the time axis.
+use super::canvas::{self, Element, Figure};
+use discovery::Report;
+use plotters::style::RGBColor;
+
+/// At most about `max` points of a series for figures of long records: per bucket its first,
+/// smallest and largest sample in time order, so spikes survive the thinning.
+fn thin(t: &[f64], v: &[f64], max: usize) -> Vec<(f64, f64)> {
+    let n = t.len().min(v.len());
+    let step = (3 * n / max.max(3)).max(1);
+    if step <= 3 {
+        return t.iter().zip(v).map(|(&a, &b)| (a, b)).collect();
+    }
+    let mut out = Vec::with_capacity(max + 3);
+    for lo in (0..n).step_by(step) {
+        let hi = (lo + step).min(n);
+        let (mut kmin, mut kmax) = (lo, lo);
+        for k in lo..hi {
+            if !v[k].is_finite() {
+                continue;
+            }
+            if v[k] < v[kmin] || !v[kmin].is_finite() {
+                kmin = k;
+            }
+            if v[k] > v[kmax] || !v[kmax].is_finite() {
+                kmax = k;
+            }
+        }
+        let mut ks = vec![lo, kmin, kmax];
+        ks.sort_unstable();
+        ks.dedup();
+        out.extend(ks.into_iter().map(|k| (t[k], v[k])));
+    }
+    out
+}
+
+/// The report's time series for output 1, as figures draw them.
+struct Curves {
+    t: Vec<f64>,
+    y: Vec<f64>,
+    nominal: Vec<f64>,
+    fitted: Vec<f64>,
+    v: Vec<f64>,
+    v_nominal: Vec<f64>,
+    v_fitted: Vec<f64>,
+}
+
+impl Curves {
+    fn of(r: &Report) -> Self {
+        let s = &r.series;
+        let p = s.p.max(1);
+        let col = |v: &[f64]| -> Vec<f64> { v.iter().step_by(p).copied().collect() };
+        let (y, nominal, fitted) = (col(&s.y), col(&s.yhat_nominal), col(&s.yhat_fitted));
+        // the derived velocity; its first and last 3 samples (where the filter is cut) left out
+        let vel = |a: &[f64]| {
+            let mut v = discovery::metrics::velocity(a, r.dt);
+            let n = v.len();
+            for k in (0..3.min(n)).chain(n.saturating_sub(3)..n) {
+                v[k] = f64::NAN;
+            }
+            v
+        };
+        Self { t: s.t.clone(), v: vel(&y), v_nominal: vel(&nominal), v_fitted: vel(&fitted), y, nominal, fitted }
+    }
+}
+
+fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x - y).collect()
+}
+
+/// Largest finite `|x|` over several series restricted to `[k0, k1)`.
+fn max_abs(series: &[&[f64]], k0: usize, k1: usize) -> f64 {
+    series
+        .iter()
+        .flat_map(|s| s[k0..k1.min(s.len())].iter())
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// A panel: the `(label, data, colour, dashed)` curves on `[k0, k1)` in `unit` (with an SI
+/// prefix or power of ten chosen for the data, [`discovery::metrics::axis_scale`]), the
+/// intervals `shade` translucent (first one labelled `shade_label`) and a dashed vertical
+/// line at `mark` (labelled).
+#[allow(clippy::too_many_arguments)]
+fn panel(
+    name: &str,
+    unit: &str,
+    t: &[f64],
+    k: (usize, usize),
+    curves: &[(&str, &[f64], RGBColor, bool)],
+    shade: &[(f64, f64)],
+    shade_label: &str,
+    mark: Option<(f64, &str)>,
+    max_points: usize,
+) -> Figure {
+    let (k0, k1) = k;
+    let data: Vec<&[f64]> = curves.iter().map(|c| c.1).collect();
+    let (div, u) = discovery::metrics::axis_scale(max_abs(&data, k0, k1), unit);
+    let label = if u.is_empty() { name.to_string() } else { format!("{name} ({u})") };
+    let mut f = Figure::new("", "t (s)", &label);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let scaled: Vec<Vec<f64>> = data.iter().map(|d| d[k0..k1].iter().map(|x| x / div).collect()).collect();
+    for v in scaled.iter().flatten().filter(|x| x.is_finite()) {
+        lo = lo.min(*v);
+        hi = hi.max(*v);
+    }
+    if lo > hi {
+        (lo, hi) = (-1.0, 1.0);
+    }
+    let (ta, tb) = (t[k0], t[k1 - 1]);
+    for (i, &(a, b)) in shade.iter().enumerate() {
+        let (a, b) = (a.max(ta), b.min(tb));
+        if a <= b {
+            f.elements.push(Element::Polygon {
+                label: if i == 0 { shade_label.into() } else { String::new() },
+                pts: vec![(a, lo), (b, lo), (b, hi), (a, hi)],
+                color: canvas::PURPLE,
+            });
+        }
+    }
+    if let Some((tm, l)) = mark.filter(|m| m.0 >= ta && m.0 <= tb) {
+        f.elements.push(Element::Line {
+            label: l.into(),
+            pts: vec![(tm, lo), (tm, hi)],
+            color: canvas::GREY,
+            dashed: true,
+        });
+    }
+    for ((label, _, color, dashed), v) in curves.iter().zip(&scaled) {
+        f.elements.push(Element::Line {
+            label: (*label).into(),
+            pts: thin(&t[k0..k1], v, max_points),
+            color: *color,
+            dashed: *dashed,
+        });
+    }
+    f
+}
+
+/// Okabe-Ito black for the recording.
+const MEASURED: RGBColor = RGBColor(0, 0, 0);
+
+/// The figures of a report (output 1), each measured against nominal (orange, dashed) and
+/// fitted (blue), located windows shaded, units from the model file's `[signals] y`:
+/// - `fit`: the record and the residual, validation start marked;
+/// - `residual`: the position and the derived velocity residual, each with its windows;
+/// - `zoom-1` .. `zoom-3`: the top located windows with context (record, residual, velocity
+///   residual).
+pub fn figures(r: &Report) -> Vec<(String, Figure)> {
+    let c = Curves::of(r);
+    let n = c.t.len();
+    if n < 2 {
+        return vec![];
+    }
+    let unit = r.units.first().cloned().unwrap_or_default();
+    let vunit = discovery::metrics::per_second(&unit);
+    let vunit = if unit.is_empty() { String::new() } else { vunit };
+    let en = diff(&c.y, &c.nominal);
+    let ef = diff(&c.y, &c.fitted);
+    let ven = diff(&c.v, &c.v_nominal);
+    let vef = diff(&c.v, &c.v_fitted);
+    let pw: Vec<(f64, f64)> = r.windows.iter().map(|w| (w.t_start, w.t_end)).collect();
+    let vw: Vec<(f64, f64)> = r.velocity_windows.iter().map(|w| (w.t_start, w.t_end)).collect();
+    let val = Some((r.validation_segment[0], "validation from here"));
+    let nominal_c = canvas::ORANGE;
+    let fitted_c = canvas::BLUE;
+    let sel = r.selected();
+    let fitted_label = format!("fitted ({sel})");
+    let all = (0, n);
+    let record = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
+        panel(
+            "y",
+            &unit,
+            &c.t,
+            k,
+            &[
+                ("measured", &c.y, MEASURED, false),
+                ("nominal", &c.nominal, nominal_c, true),
+                (&fitted_label, &c.fitted, fitted_c, false),
+            ],
+            shade,
+            "located window",
+            mark,
+            max,
+        )
+    };
+    let residual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
+        panel(
+            "residual y - yhat",
+            &unit,
+            &c.t,
+            k,
+            &[("nominal", &en, nominal_c, true), ("fitted", &ef, fitted_c, false)],
+            shade,
+            "located window",
+            mark,
+            max,
+        )
+    };
+    let vresidual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
+        panel(
+            "velocity residual",
+            &vunit,
+            &c.t,
+            k,
+            &[("nominal", &ven, nominal_c, true), ("fitted", &vef, fitted_c, false)],
+            shade,
+            "located window",
+            mark,
+            max,
+        )
+    };
+    let stack = |title: String, mut panels: Vec<Figure>, size: (u32, u32)| {
+        let mut top = panels.remove(0);
+        top.title = title;
+        top.size = size;
+        for p in &mut panels {
+            p.size = size;
+        }
+        // one legend column width for all panels, so their plot areas line up
+        let lw = std::iter::once(&top).chain(&panels).map(|p| p.legend_width()).max().unwrap_or(0);
+        let pad = |f: &mut Figure| {
+            // trailing spaces on the last label widen the legend column (capped at a third of
+            // the width, which `lw` respects)
+            while f.legend_width() < lw {
+                match f.elements.iter_mut().rev().find_map(|e| match e {
+                    Element::Line { label, .. } => Some(label),
+                    _ => None,
+                }) {
+                    Some(label) => label.push(' '),
+                    None => break,
+                }
+            }
+        };
+        pad(&mut top);
+        for p in &mut panels {
+            pad(p);
+        }
+        top.below = panels;
+        top
+    };
+    let mut out = vec![];
+    out.push((
+        "fit".to_string(),
+        stack(
+            format!("Measured vs nominal vs fitted (output 1): {sel}"),
+            vec![record(all, &pw, val, 4000), residual(all, &pw, val, 4000)],
+            (1200, 760),
+        ),
+    ));
+    out.push((
+        "residual".to_string(),
+        stack(
+            "Residuals (output 1), each with its located windows shaded".to_string(),
+            vec![residual(all, &pw, val, 4000), vresidual(all, &vw, val, 4000)],
+            (1200, 760),
+        ),
+    ));
+    // the top windows: position windows first, then velocity windows that overlap none
+    let mut zooms: Vec<(&discovery::localise::Window, &str)> = r.windows.iter().map(|w| (w, "position")).collect();
+    for w in &r.velocity_windows {
+        if !zooms.iter().any(|(z, _)| w.t_start <= z.t_end && z.t_start <= w.t_end) {
+            zooms.push((w, "velocity"));
+        }
+    }
+    let k_of = |t: f64| c.t.partition_point(|x| *x < t).min(n - 1);
+    for (i, (w, what)) in zooms.into_iter().take(3).enumerate() {
+        let width = (w.t_end - w.t_start).max(r.dt);
+        let pad = (0.75 * width).max(25.0 * r.dt);
+        let (k0, k1) = (k_of(w.t_start - pad), (k_of(w.t_end + pad) + 1).min(n));
+        if k1 < k0 + 2 {
+            continue;
+        }
+        let shade = [(w.t_start, w.t_end)];
+        let title = format!(
+            "Window {}: t = {:.3} - {:.3} s, {:.0} % of the {what} residual energy in {:.1} % of the time{}",
+            i + 1,
+            w.t_start,
+            w.t_end,
+            100.0 * w.share_energy,
+            100.0 * w.share_time,
+            if w.dominant_regime == "none" { String::new() } else { format!(" ({})", w.dominant_regime) }
+        );
+        let k = (k0, k1);
+        out.push((
+            format!("zoom-{}", i + 1),
+            stack(
+                title,
+                vec![record(k, &shade, val, 3000), residual(k, &shade, val, 3000), vresidual(k, &shade, val, 3000)],
+                (1100, 900),
+            ),
+        ));
+    }
+    out
+}
