@@ -31,8 +31,7 @@ fn every_example_loads_and_its_theta_holds_against_an_independent_measurement() 
         let sys = model::load(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         let name = f.file_name().unwrap().to_string_lossy().to_string();
         assert!(sys.mu() < 0.0, "{name}: F must be Hurwitz");
-        let r = bounds::assemble(&sys, &bounds::ThetaSettings::bound_only())
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let r = bounds::assemble(&sys, &bounds::ThetaSettings::bound_only()).unwrap_or_else(|e| panic!("{name}: {e}"));
         // geometry and driver agree on R (driver reports the safe upper value)
         let r_geom = sys.theta.strong_convexity().upper();
         assert!(r.R == r_geom || (r.R - r_geom).abs() <= 1e-12 * r_geom, "{name}: R {} vs {}", r.R, r_geom);

@@ -227,7 +227,7 @@ fn an_input_effect_on_one_of_two_inputs_gets_its_own_parameter() {
     let rec = Recording::parse_str(&csv, "two-inputs.csv").unwrap();
     let s = DiagnoseSettings {
         initial_state: Some(discovery::InitialState { x0: vec![0.0, 0.0], z0: None }),
-        input_hold: discovery::HoldChoice::Zoh,
+        input_hold: discovery::HoldChoice::Fixed(dynamics::extended::InputHold::Zoh),
         ..Default::default()
     };
     let r = diagnose(&sys, &rec, &s).unwrap();

@@ -112,7 +112,11 @@ fn auto_hold_follows_the_data_and_removes_the_spurious_delay() {
     assert_eq!(r.selected(), "none", "false alarm under the right hold: {}", r.verdict);
     // Negative control: forcing linear interpolation on the same recording "repairs" it with
     // an input delay of about half a sample (the failure of issue 13).
-    let sf = DiagnoseSettings { input_hold: HoldChoice::Foh, initial_state: Some(known), ..Default::default() };
+    let sf = DiagnoseSettings {
+        input_hold: HoldChoice::Fixed(InputHold::Foh),
+        initial_state: Some(known),
+        ..Default::default()
+    };
     let rf = diagnose(&case.nominal, &case.recording, &sf).unwrap();
     assert_eq!(rf.selected(), "input_delay", "{}", rf.verdict);
     let d = rf.effects[0].params[0].1;
@@ -231,7 +235,7 @@ fn an_effect_confined_to_one_fold_is_reported_not_testable() {
         let rec = Recording::from_samples("sat", &t, w.iter().map(|v| vec![*v]).collect(), y, None);
         let s = DiagnoseSettings {
             initial_state: Some(InitialState { x0: x0.clone(), z0: None }),
-            input_hold: HoldChoice::Foh,
+            input_hold: HoldChoice::Fixed(InputHold::Foh),
             max_effects: 1,
             ..Default::default()
         };

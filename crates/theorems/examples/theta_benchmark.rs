@@ -89,9 +89,8 @@ fn main() {
                 let ceiling = (rep.theta_verified && rep.theta < 0.0 && m.limsup_zdot > 0.0)
                     .then(|| {
                         let (g1, ginf) = (m.path_length_per_period / (rep.period * rep.R), m.limsup_zdot / rep.R);
-                        let psi = |l: f64, b: f64| {
-                            bounds::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf)
-                        };
+                        let psi =
+                            |l: f64, b: f64| bounds::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf);
                         let own = lmi::optimise_lambda(&sys.F(), &sys.E, &sys.C, psi, &settings.lambda).ok()?;
                         own.curve
                             .iter()

@@ -74,7 +74,7 @@ pub struct RestSet {
 fn open_loop(sys: &System, T: f64, K: usize, sub: usize) -> Result<Vec<DVector<f64>>, BoundsError> {
     let n = sys.n();
     let hs = T / (K * sub) as f64;
-    let map = SystemStepMap::new(&sys.A, &sys.B, &DMatrix::zeros(n, sys.p()), hs, InputHold::Linear)?;
+    let map = SystemStepMap::new(&sys.A, &sys.B, &DMatrix::zeros(n, sys.p()), hs, InputHold::Foh)?;
     let m = sys.m();
     let (mut w0, mut w1) = (vec![0.0; m], vec![0.0; m]);
     let mut x = sys.x0.clone();
@@ -187,7 +187,7 @@ pub fn confirm_at_rest(sys: &System, z: &[f64], dt: f64) -> Result<f64, BoundsEr
     s2.z0 = DVector::from_column_slice(z);
     let (N, h) = dynamics::periodic::steps_per_period(T, dt)?;
     let traj =
-        dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Linear }, N, 1)?;
+        dynamics::trajectory::simulate_catching_up(&s2, &CatchingUpSettings { dt: h, hold: InputHold::Foh }, N, 1)?;
     let mut drift = 0.0f64;
     for i in 0..traj.len() {
         drift = drift.max(geometry::linalg::dist(traj.z_at(i), z));

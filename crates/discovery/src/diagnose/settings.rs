@@ -5,6 +5,7 @@
 use crate::fit::FitSettings;
 use crate::select::{Plan, SelectSettings};
 use crate::{DiscoveryError, Recording};
+use dynamics::extended::InputHold;
 use model::System;
 use serde::Serialize;
 
@@ -177,17 +178,15 @@ impl DiagnoseSettings {
     }
 }
 
-/// How the input behaves between samples (`--input-hold`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[serde(rename_all = "snake_case")]
+/// The hold requested for the input between samples (`--input-hold`): decided from the data,
+/// or one of the simulator's holds ([`InputHold`], declared once in `dynamics`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HoldChoice {
     /// Decided from the data: the hold under which the nominal model fits better.
     #[default]
     Auto,
-    /// Zero-order hold: each sample held until the next (a digital controller's command).
-    Zoh,
-    /// First-order hold: linear interpolation between samples.
-    Foh,
+    /// This hold, as requested.
+    Fixed(InputHold),
 }
 
 impl HoldChoice {
@@ -195,10 +194,21 @@ impl HoldChoice {
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "auto" => Some(HoldChoice::Auto),
-            "zoh" => Some(HoldChoice::Zoh),
-            "foh" => Some(HoldChoice::Foh),
-            _ => None,
+            _ => [InputHold::Zoh, InputHold::Foh].into_iter().find(|h| h.name() == s).map(HoldChoice::Fixed),
         }
+    }
+    /// `auto`, `zoh` or `foh` (the `--input-hold` value).
+    pub fn name(&self) -> &'static str {
+        match self {
+            HoldChoice::Auto => "auto",
+            HoldChoice::Fixed(h) => h.name(),
+        }
+    }
+}
+
+impl Serialize for HoldChoice {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
     }
 }
 

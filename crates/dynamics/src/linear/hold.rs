@@ -17,13 +17,7 @@ pub enum InputHold {
     Zoh,
 }
 
-#[allow(non_upper_case_globals)]
 impl InputHold {
-    /// [`InputHold::Foh`] under the catching-up scheme's name (`w` linearly interpolated).
-    pub const Linear: InputHold = InputHold::Foh;
-    /// [`InputHold::Zoh`] under the catching-up scheme's name (`w` held).
-    pub const Held: InputHold = InputHold::Zoh;
-
     /// `"foh"` or `"zoh"` (reports).
     pub fn name(&self) -> &'static str {
         match self {
