@@ -367,3 +367,60 @@ fn an_interrupted_sweep_leaves_no_staging_and_no_lock_and_resumes() {
     // inside --out only the checkpoint, from which the next run resumes
     assert_only(&p.join("out"), &[".sweep.checkpoint.jsonl"]);
 }
+
+/// Issue 31 items 1, 2, 6: an output never replaces an input or a device, a symlink is followed
+/// (the link stays), and a closed standard output ends the run quietly.
+#[test]
+fn outputs_never_replace_inputs_devices_or_links() {
+    let d = workdir();
+    let p = d.path();
+    let model = worked();
+    // the model file as `--out` (also through a symlink): refused before any work, unchanged
+    std::os::unix::fs::symlink("w.toml", p.join("alias.json")).unwrap();
+    for out in ["w.toml", "alias.json"] {
+        let o = moreau_in(p, &["theta", "w.toml", "--no-measure", "--out", out]);
+        assert_refused(&o, &["refusing to overwrite", "w.toml"]);
+        assert_eq!(std::fs::read_to_string(p.join("w.toml")).unwrap(), model);
+    }
+    // import's input as its output
+    let ss = r#"{"A": [[-1.0]], "B": [[1.0]], "C": [[1.0]], "E": [[0.5]]}"#;
+    put(p, "ss.json", ss);
+    let o = moreau_in(p, &["import", "ss.json", "--out", "ss.json", "--interval", "0.1"]);
+    assert_refused(&o, &["refusing to overwrite", "ss.json"]);
+    assert_eq!(std::fs::read_to_string(p.join("ss.json")).unwrap(), ss);
+    // a character device is written through and stays a device
+    let o = moreau_in(p, &["theta", "w.toml", "--no-measure", "--out", "/dev/null"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::os::unix::fs::FileTypeExt::is_char_device(
+        &std::fs::symlink_metadata("/dev/null").unwrap().file_type()
+    ));
+    // a directory is refused by name
+    std::fs::create_dir(p.join("dir.json")).unwrap();
+    let o = moreau_in(p, &["theta", "w.toml", "--no-measure", "--out", "dir.json"]);
+    assert_refused(&o, &["dir.json", "is a directory"]);
+    // a symlink to another file: the file gets the report, the link stays
+    put(p, "real.json", "old");
+    std::os::unix::fs::symlink("real.json", p.join("link.json")).unwrap();
+    let o = moreau_in(p, &["theta", "w.toml", "--no-measure", "--out", "link.json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::symlink_metadata(p.join("link.json")).unwrap().file_type().is_symlink());
+    assert!(std::fs::read_to_string(p.join("real.json")).unwrap().contains("\"theta\""));
+    assert_only(p, &["w.toml", "alias.json", "ss.json", "dir.json", "real.json", "link.json"]);
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    let d = workdir();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_moreau"))
+        .args(["validate", "w.toml", "w.toml", "w.toml"])
+        .current_dir(d.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away, as `| head -c 0` would
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
+    assert_eq!(o.status.code(), Some(141), "128 + SIGPIPE; stderr: {err}");
+}

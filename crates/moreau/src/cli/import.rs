@@ -228,6 +228,8 @@ fn read(path: &Path) -> anyhow::Result<StateSpace> {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    crate::output::register_input(&a.file);
+    crate::output::refuse_input(&a.out)?;
     let ss = read(&a.file).with_context(|| a.file.display().to_string())?;
     let sys = build(ss, a).with_context(|| a.file.display().to_string())?;
     let text = model::to_toml_string(&sys);

@@ -88,6 +88,7 @@ pub fn main() -> ExitCode {
     };
     crate::budget::set_allow_large(cli.allow_large);
     crate::output::install_interrupt_cleanup();
+    crate::output::exit_quietly_on_broken_pipe();
     let result = match cli.command {
         Command::Theta(a) => theta::run(&a),
         Command::Validate(a) => validate::run(&a),

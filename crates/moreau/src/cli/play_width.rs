@@ -62,6 +62,8 @@ fn check_config(c: &robonine::StandConfig) -> anyhow::Result<()> {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    crate::output::register_input(&a.data);
+    crate::output::register_input(&a.config);
     let text =
         discovery::recording::read_checked(&a.data, "log", discovery::recording::TimeColumn::Iso8601("timestamp"))?;
     let cfg_text = model::files::read_regular(&a.config, model::files::MAX_MODEL_BYTES)?;

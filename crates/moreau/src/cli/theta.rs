@@ -139,6 +139,11 @@ pub fn explain(rep: &ThetaReport) -> String {
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance: !a.no_guidance };
+    // refused before the work, not after it
+    crate::output::register_input(&a.file);
+    if let Some(out) = &a.out {
+        crate::output::refuse_input(out)?;
+    }
     let run = theta(&Source::File(a.file.clone()), &o)?;
     let json = serde_json::to_string_pretty(&run.to_json()?)?;
     if let Some(out) = &a.out {

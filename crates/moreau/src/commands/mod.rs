@@ -85,6 +85,7 @@ impl Source {
 
 /// `model::load` with the path as context (as every command reads `FILE`).
 pub fn load(path: &Path) -> anyhow::Result<System> {
+    crate::output::register_input(path);
     model::load(path).with_context(|| path.display().to_string())
 }
 
