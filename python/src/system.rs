@@ -115,24 +115,9 @@ mod tests {
     use moreau::commands::one_line;
     use std::path::Path;
 
+    /// The worked example's model file as a table (what Python passes as a dict).
     fn worked_example() -> toml::Table {
-        r#"
-name = "worked example (NOTES.md), a = 1"
-[plant]
-A = [[0.0, 1.0], [-2.0, -0.6]]
-B = [[0.0], [1.0]]
-C = [[1.0, 0.0]]
-E = [[0.0], [1.0]]
-[theta]
-shape = "interval"
-half_width = 0.1
-[input]
-kind = "sine"
-amplitudes = [1.0]
-omega = 1.0
-"#
-        .parse()
-        .unwrap()
+        include_str!("../../examples/worked-example.toml").parse().unwrap()
     }
 
     #[test]

@@ -22,7 +22,10 @@ use dynamics::extended::InputHold;
 /// The hold (requested, or `auto` by the nominal fit), its report and the sub-steps under it.
 pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck) {
     let s = data.s;
-    let first_hold = if s.input_hold == HoldChoice::Fixed(InputHold::Zoh) { InputHold::Zoh } else { InputHold::Foh };
+    let first_hold = match s.input_hold {
+        HoldChoice::Fixed(h) => h,
+        HoldChoice::Auto => InputHold::Foh,
+    };
     let mut disc = data.converge_nominal(first_hold, data.k0);
     let (hold, hold_report) = match s.input_hold {
         HoldChoice::Fixed(_) => (
