@@ -31,7 +31,12 @@ pub fn refuse_input(path: &Path) -> Result<()> {
         return Ok(());
     }
     if let Ok(v) = INPUTS.lock() {
-        if let Some((_, _, input)) = v.iter().find(|(d, i, _)| *d == m.dev() && *i == m.ino()) {
+        // The input must still be the registered file: an inode number freed by a deleted
+        // input can be reused by an unrelated file.
+        let same = |d: u64, i: u64, input: &Path| {
+            d == m.dev() && i == m.ino() && std::fs::metadata(input).is_ok_and(|now| now.dev() == d && now.ino() == i)
+        };
+        if let Some((_, _, input)) = v.iter().find(|(d, i, input)| same(*d, *i, input)) {
             bail!(
                 "output {} is the input {} of this command: refusing to overwrite it (choose another output path)",
                 path.display(),
@@ -365,6 +370,15 @@ mod tests {
             assert!(err.contains("refusing to overwrite"), "{err}");
         }
         assert_eq!(std::fs::read_to_string(&input).unwrap(), "name = 'm'");
+        // a deleted input does not protect whatever file later reuses its inode number
+        let gone = root.path().join("gone.toml");
+        std::fs::write(&gone, "x").unwrap();
+        register_input(&gone);
+        std::fs::remove_file(&gone).unwrap();
+        let reused = root.path().join("reused.json");
+        for _ in 0..64 {
+            write_atomic(&reused, b"r").unwrap();
+        }
     }
 
     #[test]
