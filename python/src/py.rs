@@ -384,9 +384,10 @@ fn diagnose<'py>(
     };
     let o = DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, ..Default::default() };
     let run = move || -> anyhow::Result<discovery::Report> {
+        let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;
-        if let Some(dir) = &out {
-            write_outputs(&r, dir)?;
+        if let Some(st) = staged {
+            write_outputs(&r, st)?;
         }
         Ok(r)
     };

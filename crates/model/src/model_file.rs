@@ -295,12 +295,18 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
     })
 }
 
+/// Longest model `name` in bytes: it goes into plot titles, tables and reports.
+pub const MAX_NAME_BYTES: usize = 1000;
+
 fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
     let root: Table = text
         .parse::<Table>()
         .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
     check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects, fit, signals")?;
     let name = match root.get("name") {
+        Some(Value::String(s)) if s.len() > MAX_NAME_BYTES => {
+            return Err(ModelError::TooLong { key: "name".into(), bytes: s.len(), limit: MAX_NAME_BYTES })
+        }
         Some(Value::String(s)) => s.clone(),
         Some(other) => {
             return Err(ModelError::WrongType { key: "name".into(), expected: "a string", found: describe(other) })

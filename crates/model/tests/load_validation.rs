@@ -149,3 +149,19 @@ fn csv_inputs_reject_duplicates_overflow_unresolvable_times_and_short_periods() 
     let e = csv_model(d.path(), "t,w\n0,0\n1,1\n2,0\n", Some(1.0)).unwrap_err().to_string();
     assert!(e.contains("input.period") && e.contains("shorter than the data"), "{e}");
 }
+
+/// Issue 31 item 5: a 10 MB name (it goes into plot titles) and a 10 MB unknown key are
+/// refused in a short message; an ordinary name still loads.
+#[test]
+fn huge_names_and_keys_are_refused_in_a_short_message() {
+    let long = "n".repeat(10 << 20);
+    let e = err(&GOOD.replace("name = \"t\"", &format!("name = \"{long}\"")));
+    assert!(e.contains("key `name`") && e.contains("more than the limit of 1000 bytes"), "{}", &e[..e.len().min(300)]);
+    assert!(e.len() < 300, "{} bytes", e.len());
+    let e = err(&GOOD.replace("[plant]", &format!("[plant]\n{long} = 1")));
+    assert!(e.contains("unknown key") && e.contains("bytes in all"), "{}", &e[..e.len().min(300)]);
+    assert!(e.len() < 600, "{} bytes", e.len());
+    // negative control: a name of 1000 bytes is fine
+    let ok = GOOD.replace("name = \"t\"", &format!("name = \"{}\"", "n".repeat(1000)));
+    assert!(parse_str(&ok).is_ok());
+}

@@ -105,7 +105,7 @@ pub fn read_json(text: &str) -> anyhow::Result<StateSpace> {
                     serde_json::from_value(val.clone()).with_context(|| format!("`{k}` is not a table"))?;
                 ss.rest.insert(k.clone(), t);
             }
-            other => bail!("unknown key `{other}` (known: A, B, C, D, E, theta, input)"),
+            other => bail!("unknown key `{}` (known: A, B, C, D, E, theta, input)", model::error::clip(other)),
         }
     }
     Ok(ss)

@@ -69,7 +69,10 @@ impl Source {
     pub fn system(&self) -> anyhow::Result<System> {
         match self {
             Source::File(p) => load(p),
-            Source::Built(s, _) => Ok((**s).clone()),
+            Source::Built(s, _) => {
+                crate::budget::plant_entries(s)?;
+                Ok((**s).clone())
+            }
         }
     }
 
@@ -86,7 +89,9 @@ impl Source {
 /// `model::load` with the path as context (as every command reads `FILE`).
 pub fn load(path: &Path) -> anyhow::Result<System> {
     crate::output::register_input(path);
-    model::load(path).with_context(|| path.display().to_string())
+    let sys = model::load(path).with_context(|| path.display().to_string())?;
+    crate::budget::plant_entries(&sys).with_context(|| path.display().to_string())?;
+    Ok(sys)
 }
 
 /// The error and its causes on one line; a cause whose text an outer message already carries

@@ -10,17 +10,15 @@ pub enum SweepError {
     Toml { path: PathBuf, message: String },
     #[error("{source}")]
     File { source: model::ModelError },
-    #[error(
-        "{path} is in use by another sweep ({holder}; lock file {lock}): wait for it to finish or choose another --out"
-    )]
-    Locked { path: PathBuf, holder: String, lock: PathBuf },
+    #[error(transparent)]
+    Locked(#[from] crate::output::LockError),
     #[error("cannot merge: {path}: {reason}")]
     MergeGrid { path: PathBuf, reason: String },
     #[error("[evaluate] {key}: {reason}")]
     Evaluate { key: &'static str, reason: String },
     #[error("{path}: missing key `{key}`")]
     MissingKey { path: PathBuf, key: String },
-    #[error("{path}: unknown key `{key}` (allowed: {allowed})")]
+    #[error("{path}: unknown key `{}` (allowed: {allowed})", model::error::clip(key))]
     UnknownKey { path: PathBuf, key: String, allowed: &'static str },
     #[error("{path}: key `{key}` has the wrong type: expected {expected}")]
     WrongType { path: PathBuf, key: String, expected: &'static str },
