@@ -184,12 +184,28 @@ def worked() -> str:
     return W_TOML.read_text()
 
 
+def last_json(data: bytes):
+    """The JSON document `data` holds, or the one it ends with: an output written through
+    /dev/stdout follows the command's own report on the same stream. An exception if none."""
+    text = data.decode(errors="replace")
+    try:
+        return json.loads(text)
+    except Exception as e:  # noqa: BLE001
+        first = e
+    starts = [i + 1 for i, c in enumerate(text) if c == "\n" and text[i + 1 : i + 2] in ("{", "[")]
+    for i in starts:
+        try:
+            return json.loads(text[i:])
+        except Exception:  # noqa: BLE001
+            continue
+    return first
+
+
 def json_with(key: str):
     def check(data: bytes):
-        try:
-            v = json.loads(data.decode())
-        except Exception as e:  # noqa: BLE001
-            return f"not JSON ({str(e)[:80]})"
+        v = last_json(data)
+        if isinstance(v, Exception):
+            return f"not JSON ({str(v)[:80]})"
         if key and key not in json.dumps(v)[:10_000_000]:
             return f"JSON without `{key}`"
         return None
@@ -1583,7 +1599,9 @@ class Prober:
                 continue
             name = os.path.basename(p)
             rel = os.path.relpath(p, work)
-            hidden = name.startswith(".") or "tmp" in name.lower() or "staging" in name or name.endswith(".lock")
+            # `.moreau-outputs` is the manifest of a folder output (the files the run wrote)
+            hidden = (name.startswith(".") and name != ".moreau-outputs") or "tmp" in name.lower() \
+                or "staging" in name or name.endswith(".lock")
             if hidden:
                 leftovers.append(rel)
             elif rc != 0 and not any(within(p, a) for a in allow):

@@ -10,6 +10,7 @@
 //! and written atomically.
 use anyhow::{bail, Context};
 use geometry::{Ball, Interval, Shape};
+use model::error::clip;
 use model::{Input, System};
 use nalgebra::{DMatrix, DVector};
 use std::path::{Path, PathBuf};
@@ -72,13 +73,16 @@ fn matrix_from_json(name: &str, v: &serde_json::Value) -> anyhow::Result<DMatrix
                 serde_json::Value::Array(c) => c
                     .iter()
                     .enumerate()
-                    .map(|(j, x)| x.as_f64().with_context(|| format!("{name}[{i}][{j}] = {x} is not a number")))
+                    .map(|(j, x)| {
+                        x.as_f64()
+                            .with_context(|| format!("{name}[{i}][{j}] = {} is not a number", clip(&x.to_string())))
+                    })
                     .collect::<anyhow::Result<Vec<f64>>>(),
-                other => bail!("{name}[{i}] = {other} is not a list of numbers"),
+                other => bail!("{name}[{i}] = {} is not a list of numbers", clip(&other.to_string())),
             })
             .collect::<anyhow::Result<_>>()?,
         serde_json::Value::Number(x) => vec![vec![x.as_f64().unwrap_or(f64::NAN)]],
-        other => bail!("{name} = {other} is not a matrix (a list of rows)"),
+        other => bail!("{name} = {} is not a matrix (a list of rows)", clip(&other.to_string())),
     };
     let r = rows.len();
     let c = rows.first().map(Vec::len).unwrap_or(0);
@@ -105,15 +109,30 @@ pub fn read_json(text: &str) -> anyhow::Result<StateSpace> {
                     serde_json::from_value(val.clone()).with_context(|| format!("`{k}` is not a table"))?;
                 ss.rest.insert(k.clone(), t);
             }
-            other => bail!("unknown key `{}` (known: A, B, C, D, E, theta, input)", model::error::clip(other)),
+            other => bail!("unknown key `{}` (known: A, B, C, D, E, theta, input)", clip(other)),
         }
     }
     Ok(ss)
 }
 
+/// Parses a .mat file with `matfile`, whose parser panics on some damaged files (declared
+/// sizes whose product overflows): such a panic is reported as a damaged file, quietly.
+fn parse_mat(bytes: &[u8]) -> anyhow::Result<matfile::MatFile> {
+    const HOW: &str = "in MATLAB save with `save ss.mat A B C -v7` (v7.3/HDF5 files are not read)";
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let parsed = std::panic::catch_unwind(|| matfile::MatFile::parse(bytes));
+    std::panic::set_hook(hook);
+    match parsed {
+        Ok(Ok(mf)) => Ok(mf),
+        Ok(Err(e)) => bail!("not a readable MATLAB v5 .mat file ({e:?}); {HOW}"),
+        Err(_) => bail!("not a readable MATLAB v5 .mat file (damaged: its declared sizes do not fit its data); {HOW}"),
+    }
+}
+
 /// Reads a MATLAB v5 `.mat` file (real double or integer arrays A, B, C, optional D, E).
 pub fn read_mat(bytes: &[u8]) -> anyhow::Result<StateSpace> {
-    let mf = matfile::MatFile::parse(bytes).map_err(|e| anyhow::anyhow!("not a readable MATLAB v5 .mat file ({e:?}); in MATLAB save with `save ss.mat A B C -v7` (v7.3/HDF5 files are not read)"))?;
+    let mf = parse_mat(bytes)?;
     let get = |name: &str| -> anyhow::Result<Option<DMatrix<f64>>> {
         let Some(a) = mf.find_by_name(name) else { return Ok(None) };
         let size = a.size();
@@ -132,6 +151,9 @@ pub fn read_mat(bytes: &[u8]) -> anyhow::Result<StateSpace> {
             matfile::NumericData::Int64 { real, imag: None } => real.iter().map(|&x| x as f64).collect(),
             _ => bail!("{name} is not a real numeric array"),
         };
+        if size[0].checked_mul(size[1]) != Some(data.len()) {
+            bail!("{name} is declared {} x {} but holds {} values: the file is damaged", size[0], size[1], data.len());
+        }
         // MATLAB stores column-major
         Ok(Some(DMatrix::from_column_slice(size[0], size[1], &data)))
     };
