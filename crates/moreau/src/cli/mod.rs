@@ -1,7 +1,9 @@
 //! The `moreau` command line: one module per subcommand. Each parses its arguments, calls
 //! the command's function in [`crate::commands`] where it has one (validation, budgets and
 //! computation live there, shared with the Python package), and prints or writes the result.
+use anyhow::{bail, Context};
 use clap::{Parser, Subcommand};
+use std::path::Path;
 use std::process::ExitCode;
 
 pub mod check;
@@ -114,3 +116,40 @@ pub fn main() -> ExitCode {
 }
 
 pub use crate::commands::one_line;
+
+/// Refuses, before a long run, an output file that [`crate::output::write_atomic`] would
+/// refuse only after it: an input of the command ([`crate::output::refuse_input`], as `theta`
+/// does for `--out`), a directory, a block device or socket, or a file whose directory cannot
+/// be created or written (probed with an unnamed temporary file, gone when closed, where the
+/// writer will create its own). Character devices and FIFOs are written through and pass.
+pub fn check_output_early(path: &Path) -> anyhow::Result<()> {
+    crate::output::refuse_input(path)?;
+    let file = match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => {
+            bail!("output {} is a directory: refusing to replace it (give a file path)", path.display())
+        }
+        Ok(m) if m.is_file() => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+        Ok(m) => {
+            use std::os::unix::fs::FileTypeExt;
+            if m.file_type().is_char_device() || m.file_type().is_fifo() {
+                return Ok(());
+            }
+            bail!("output {} is not a regular file: refusing to replace it (give a file path)", path.display())
+        }
+        Err(_) => path.to_path_buf(),
+    };
+    // the nearest existing directory: the writer creates the missing ones below it
+    let mut dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    while std::fs::symlink_metadata(dir).is_err() {
+        match dir.parent().filter(|d| !d.as_os_str().is_empty()) {
+            Some(up) => dir = up,
+            None => break,
+        }
+    }
+    if !dir.is_dir() {
+        bail!("output {}: {} is not a directory", path.display(), dir.display());
+    }
+    tempfile::tempfile_in(dir)
+        .with_context(|| format!("output {}: cannot write into {}", path.display(), dir.display()))?;
+    Ok(())
+}
