@@ -34,7 +34,7 @@ pub fn plan(src: &Source, o: &ConvergenceOptions) -> anyhow::Result<ConvergenceP
     let sys = src.system()?;
     // an unstable loop diverges: every level's error grows with the horizon and a slope fitted
     // to them (errors of 1e15 gave "order 0.957") measures nothing
-    if let Some(top) = sys.eig_F().first().filter(|l| !(l.re < 0.0)) {
+    if let Some(top) = sys.eig_F().first().filter(|l| l.re >= 0.0) {
         let eig = if top.im == 0.0 {
             num(top.re)
         } else {
