@@ -32,6 +32,12 @@ def test_complex_arrays_are_refused_not_stripped_of_their_imaginary_part():
     # the native layer refuses a complex entry of a raw table too
     with pytest.raises(TypeError, match=r"key `plant\.A`: a complex number"):
         _native.System.from_table({"plant": {"A": [[1 + 2j]], "B": [[1.0]], "C": [[1.0]], "E": [[0.0]]}})
+    # a purely imaginary feedthrough D is not zero
+    class SS:
+        A, B, C, D = A, B, C, np.array([[1j]])
+
+    with pytest.raises(TypeError, match=r"`D` is complex"):
+        moreau.System.from_statespace(SS, E, moreau.Interval(0.1))
     # control: real arrays of any real dtype
     assert build(A=A.astype(np.float32)).n == 2
 

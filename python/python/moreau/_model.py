@@ -407,7 +407,7 @@ class System:
             if not hasattr(ss, k):
                 raise TypeError(f"from_statespace needs an object with attributes A, B, C (a state-space model); {type(ss).__name__} has no {k}")
         D = getattr(ss, "D", None)
-        if D is not None and np.size(D) and np.any(np.asarray(D, dtype=float) != 0):
+        if D is not None and np.size(D) and np.any(_real_array("D", D, "a matrix") != 0):
             raise MoreauError(
                 "the state-space model has a direct feedthrough D != 0; the loop of the paper has y = C x (D = 0)"
             )
