@@ -211,3 +211,52 @@ mod tests {
         assert!(threads(100_000).unwrap() >= 1);
     }
 }
+
+// ---- model size of a system built in memory (issue 31 item 8; added by helper Q) ----
+
+/// Numbers (matrix and vector entries) of a model built in memory (the Python package's
+/// `System`, `Polytope`, ...): as many as the largest model file the CLI reads holds
+/// ([`model::files::MAX_MODEL_BYTES`], 16 MiB) at 16 bytes a number. A 3000 x 3000 `A` (9e6
+/// numbers, gigabytes once converted) is refused before it is converted. No `--allow-large`
+/// lifts it, as none lifts the model-file limit.
+pub const MAX_MODEL_NUMBERS: u64 = model::files::MAX_MODEL_BYTES / 16;
+/// Numbers of an input given as sample arrays (`t` and `w`): as many as the largest input
+/// CSV ([`model::files::MAX_CSV_BYTES`], 512 MiB) holds at 16 bytes a number.
+pub const MAX_SAMPLE_NUMBERS: u64 = model::files::MAX_CSV_BYTES / 16;
+
+/// Refuses a model of more than [`MAX_MODEL_NUMBERS`] numbers (`detail`: which arrays).
+pub fn model_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    if numbers > MAX_MODEL_NUMBERS {
+        bail!(
+            "model: {numbers} numbers ({detail}) exceed the limit {MAX_MODEL_NUMBERS}, what the largest model file ({} MiB) holds at 16 bytes a number",
+            model::files::MAX_MODEL_BYTES >> 20
+        );
+    }
+    Ok(())
+}
+
+/// Refuses input samples of more than [`MAX_SAMPLE_NUMBERS`] numbers (`detail`: which arrays).
+pub fn sample_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    if numbers > MAX_SAMPLE_NUMBERS {
+        bail!(
+            "input samples: {numbers} numbers ({detail}) exceed the limit {MAX_SAMPLE_NUMBERS}, what the largest input CSV ({} MiB) holds at 16 bytes a number",
+            model::files::MAX_CSV_BYTES >> 20
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod model_size_tests {
+    use super::*;
+
+    #[test]
+    fn model_and_sample_numbers_name_value_and_limit() {
+        assert_eq!(MAX_MODEL_NUMBERS, 1_048_576);
+        assert!(model_numbers(MAX_MODEL_NUMBERS, "A").is_ok());
+        let e = model_numbers(9_000_000, "`plant.A` of shape (3000, 3000)").unwrap_err().to_string();
+        assert!(e.contains("9000000 numbers (`plant.A` of shape (3000, 3000))") && e.contains("limit 1048576"), "{e}");
+        assert!(sample_numbers(MAX_SAMPLE_NUMBERS, "t").is_ok());
+        assert!(sample_numbers(MAX_SAMPLE_NUMBERS + 1, "t").unwrap_err().to_string().contains("input samples"));
+    }
+}

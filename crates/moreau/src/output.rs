@@ -111,6 +111,29 @@ fn resolve_target(path: &Path) -> Result<Target> {
     bail!("output {}: more than {MAX_LINKS} levels of symlinks", path.display())
 }
 
+/// Refuses, before the work, an output file that [`write_atomic`] would refuse only after it:
+/// an input of the command, a directory, block device or socket (through links), or a file
+/// whose nearest existing directory cannot be written (probed with an unnamed temporary file,
+/// gone when closed). Character devices, FIFOs and descriptors are written through and pass.
+pub fn check_writable(path: &Path) -> Result<()> {
+    refuse_input(path)?;
+    let Target::File(file) = resolve_target(path)? else { return Ok(()) };
+    // the nearest existing directory: the writer creates the missing ones below it
+    let mut dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    while std::fs::symlink_metadata(dir).is_err() {
+        match dir.parent().filter(|d| !d.as_os_str().is_empty()) {
+            Some(up) => dir = up,
+            None => break,
+        }
+    }
+    if !dir.is_dir() {
+        bail!("output {}: {} is not a directory", path.display(), dir.display());
+    }
+    tempfile::tempfile_in(dir)
+        .with_context(|| format!("output {}: cannot write into {}", path.display(), dir.display()))?;
+    Ok(())
+}
+
 /// Writes `bytes` through this process's descriptor `fd` (standard output and error through
 /// their handles, so the output follows what the command printed before; any other by
 /// appending to what the path opens).

@@ -211,6 +211,8 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
         (Some(_), Some(_)) => bail!("the JSON has `input` and --sine was given: use one"),
     };
     let name = a.name.clone().unwrap_or_else(|| format!("imported from {}", a.file.display()));
+    let mut sim = model::SimDefaults::default();
+    sim.dt = step_for(&input, ss.rest.get("input"), sim.dt);
     let sys = System::builder()
         .name(name)
         .A(A)
@@ -221,6 +223,7 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
         .input(input)
         .x0(DVector::zeros(n))
         .z0(DVector::zeros(p))
+        .sim(sim)
         .build()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     if ss.rest.is_empty() {
@@ -232,7 +235,47 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
     for (k, v) in ss.rest {
         t.insert(k, v);
     }
-    model::parse_str(&toml::to_string(&t)?).map_err(|e| anyhow::anyhow!("{e}"))
+    // `csv` inputs are read relative to the state-space file, as a model file reads them
+    let dir = a.file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    model::model_file::parse_str_with(&toml::to_string(&t)?, &a.file.display().to_string(), dir)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// Steps per input period the imported model's `simulation.dt` gives at least (the default
+/// step is kept where it is finer): a fast input (`--omega 1e4`) with the default `1e-3`
+/// would give a model that `validate` refuses (fewer than `MIN_STEPS_PER_PERIOD` steps).
+const IMPORT_STEPS_PER_PERIOD: f64 = 100.0;
+
+/// The step for the imported model: `default`, or the input period over
+/// [`IMPORT_STEPS_PER_PERIOD`] where that is finer. The period comes from the flags' input
+/// or the JSON `input` table (`omega`, or a `csv` input's `period`).
+fn step_for(input: &Input, table: Option<&toml::Value>, default: f64) -> f64 {
+    let num =
+        |k: &str| table.and_then(|t| t.get(k)).and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)));
+    let period = input.period().or_else(|| {
+        num("omega")
+            .filter(|w| w.is_finite() && *w != 0.0)
+            .map(|w| std::f64::consts::TAU / w.abs())
+            .or_else(|| num("period"))
+    });
+    match period {
+        Some(T) if T.is_finite() && T > 0.0 => default.min(T / IMPORT_STEPS_PER_PERIOD),
+        _ => default,
+    }
+}
+
+/// A `csv` input as the written model must name it: a model file reads relative paths from
+/// its own directory, so the samples file is named by its file name when it sits beside the
+/// output, else by its absolute path.
+fn relocate_samples(sys: &mut System, out: &Path) {
+    let Input::Samples { path, .. } = &mut sys.input else { return };
+    let Ok(csv) = std::fs::canonicalize(&*path) else { return };
+    let out_dir = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let beside = std::fs::canonicalize(out_dir).is_ok_and(|d| csv.parent() == Some(d.as_path()));
+    *path = match (beside, csv.file_name()) {
+        (true, Some(name)) => name.to_string_lossy().into_owned(),
+        _ => csv.display().to_string(),
+    };
 }
 
 fn read(path: &Path) -> anyhow::Result<StateSpace> {
@@ -251,10 +294,24 @@ fn read(path: &Path) -> anyhow::Result<StateSpace> {
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     crate::output::register_input(&a.file);
-    crate::output::refuse_input(&a.out)?;
+    crate::output::check_writable(&a.out)?;
     let ss = read(&a.file).with_context(|| a.file.display().to_string())?;
-    let sys = build(ss, a).with_context(|| a.file.display().to_string())?;
+    let mut sys = build(ss, a).with_context(|| a.file.display().to_string())?;
+    relocate_samples(&mut sys, &a.out);
     let text = model::to_toml_string(&sys);
+    // the file must be one that `moreau validate` accepts where it is written
+    if text.len() as u64 > model::files::MAX_MODEL_BYTES {
+        bail!(
+            "{}: the model it gives is {} bytes, more than the {} a model file may have",
+            a.file.display(),
+            text.len(),
+            model::files::MAX_MODEL_BYTES
+        );
+    }
+    let out_dir = a.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    model::model_file::parse_str_with(&text, &a.out.display().to_string(), out_dir).with_context(|| {
+        format!("{}: the model it gives would not validate as {}", a.file.display(), a.out.display())
+    })?;
     crate::output::write_atomic(&a.out, text.as_bytes())?;
     println!(
         "wrote {}: n = {}, m = {}, p = {}, Theta = {}",

@@ -44,7 +44,7 @@ pub enum SweepError {
     NotFinite { name: String, value: f64 },
     #[error("axis `{name}`: value {value} gives an invalid model: {source}")]
     InvalidPoint { name: String, value: f64, source: model::ModelError },
-    #[error("the grid has {points} points, more than the limit {limit} (--allow-large raises it to 10^7)")]
+    #[error("the grid has {points} points, more than the limit {limit}{}", points_hint(*limit))]
     TooManyPoints { points: u128, limit: usize },
     #[error("bad shard `{text}`: expected K/N with 0 <= K < N (K counts from 0, e.g. $SLURM_ARRAY_TASK_ID)")]
     BadShard { text: String },
@@ -68,4 +68,14 @@ pub enum SweepError {
     ThreadPool { threads: usize, reason: String },
     #[error("cannot write {path}: {reason}")]
     Write { path: PathBuf, reason: String },
+}
+
+/// What lifts a grid-point limit: `--allow-large` the soft one, nothing the hard one (so the
+/// message never advises `--allow-large` when it was given).
+fn points_hint(limit: usize) -> String {
+    if limit < super::spec::MAX_POINTS {
+        format!("; pass --allow-large to raise it to {}", super::spec::MAX_POINTS)
+    } else {
+        " (the hard limit; --allow-large does not raise it)".to_string()
+    }
 }
