@@ -184,28 +184,12 @@ def worked() -> str:
     return W_TOML.read_text()
 
 
-def last_json(data: bytes):
-    """The JSON document `data` holds, or the one it ends with: an output written through
-    /dev/stdout follows the command's own report on the same stream. An exception if none."""
-    text = data.decode(errors="replace")
-    try:
-        return json.loads(text)
-    except Exception as e:  # noqa: BLE001
-        first = e
-    starts = [i + 1 for i, c in enumerate(text) if c == "\n" and text[i + 1 : i + 2] in ("{", "[")]
-    for i in starts:
-        try:
-            return json.loads(text[i:])
-        except Exception:  # noqa: BLE001
-            continue
-    return first
-
-
 def json_with(key: str):
     def check(data: bytes):
-        v = last_json(data)
-        if isinstance(v, Exception):
-            return f"not JSON ({str(v)[:80]})"
+        try:
+            v = json.loads(data.decode())
+        except Exception as e:  # noqa: BLE001
+            return f"not JSON ({str(e)[:80]})"
         if key and key not in json.dumps(v)[:10_000_000]:
             return f"JSON without `{key}`"
         return None
@@ -1696,11 +1680,21 @@ def key_line(lines: list) -> str:
 
 
 def last_json(data: bytes) -> bytes:
-    """The JSON object in a stream that may hold a readable report before it."""
+    """The JSON document in a stream that may hold a readable report before or after it (an
+    output written through /dev/stdout shares the stream with the command's report): the
+    first object or array that starts a line and parses whole."""
     text = data.decode(errors="replace")
-    i = text.find("\n{")
-    j = 0 if text.startswith("{") else (i + 1 if i >= 0 else -1)
-    return text[j:].encode() if j >= 0 else data
+    starts = ([0] if text[:1] in ("{", "[") else []) + [
+        i + 1 for i in range(len(text) - 1) if text[i] == "\n" and text[i + 1] in ("{", "[")
+    ]
+    dec = json.JSONDecoder()
+    for j in starts:
+        try:
+            _, end = dec.raw_decode(text, j)
+        except ValueError:
+            continue
+        return text[j:end].encode()
+    return data
 
 
 def replaced_what(e: dict, a: Optional[dict]) -> Optional[str]:
