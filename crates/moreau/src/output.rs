@@ -76,6 +76,10 @@ fn own_descriptor(p: &Path) -> Option<i32> {
 /// Follows symlinks from `path` (a dangling link names the file it would create) and
 /// classifies the result; refuses directories, block devices and sockets.
 fn resolve_target(path: &Path) -> Result<Target> {
+    use std::os::unix::ffi::OsStrExt;
+    if path.as_os_str().as_bytes().ends_with(b"/") {
+        bail!("output {} ends with '/', which names a directory: give a file path", path.display());
+    }
     let mut p = path.to_path_buf();
     for _ in 0..MAX_LINKS {
         if let Some(fd) = own_descriptor(&p) {
@@ -118,7 +122,23 @@ fn resolve_target(path: &Path) -> Result<Target> {
 pub fn check_writable(path: &Path) -> Result<()> {
     refuse_input(path)?;
     let Target::File(file) = resolve_target(path)? else { return Ok(()) };
-    // the nearest existing directory: the writer creates the missing ones below it
+    probe_nearest_directory(path, &file)
+}
+
+/// [`check_writable`] for an output folder ([`StagedDir`]): refuses a path that names
+/// something other than a directory, and a folder whose nearest existing ancestor cannot be
+/// written, before the work.
+pub fn check_directory_writable(out: &Path) -> Result<()> {
+    refuse_non_directory(out)?;
+    if out.is_dir() {
+        return probe_nearest_directory(out, &out.join("probe"));
+    }
+    probe_nearest_directory(out, out)
+}
+
+/// Probes the nearest existing directory above `file` (the writer creates the missing ones
+/// below it) with an unnamed temporary file, gone when closed; `path` names the output.
+fn probe_nearest_directory(path: &Path, file: &Path) -> Result<()> {
     let mut dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     while std::fs::symlink_metadata(dir).is_err() {
         match dir.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -753,6 +773,29 @@ mod tests {
         for _ in 0..64 {
             write_atomic(&reused, b"r").unwrap();
         }
+    }
+
+    #[test]
+    fn outputs_are_checked_before_the_work() {
+        let root = tempfile::tempdir().unwrap();
+        let file = root.path().join("notes.txt");
+        std::fs::write(&file, "x").unwrap();
+        let slash = format!("{}/new.json/", root.path().display());
+        for (path, why) in [
+            (slash.as_str(), "ends with '/'"),
+            (root.path().to_str().unwrap(), "is a directory"),
+            (&format!("{}/x.json", file.display()), "is not a directory"),
+        ] {
+            let err = check_writable(Path::new(path)).unwrap_err().to_string();
+            assert!(err.contains(why), "{path}: {err}");
+        }
+        let err = check_directory_writable(&file).unwrap_err().to_string();
+        assert!(err.contains("is not a directory"), "{err}");
+        // negative controls: a new file, a new nested folder, /dev/null
+        check_writable(&root.path().join("a/b/new.json")).unwrap();
+        check_writable(Path::new("/dev/null")).unwrap();
+        check_directory_writable(&root.path().join("new/folder")).unwrap();
+        check_directory_writable(root.path()).unwrap();
     }
 
     #[test]
