@@ -139,12 +139,10 @@ pub fn check_directory_writable(out: &Path) -> Result<()> {
 /// Probes the nearest existing directory above `file` (the writer creates the missing ones
 /// below it) with an unnamed temporary file, gone when closed; `path` names the output.
 fn probe_nearest_directory(path: &Path, file: &Path) -> Result<()> {
-    let mut dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    while std::fs::symlink_metadata(dir).is_err() {
-        match dir.parent().filter(|d| !d.as_os_str().is_empty()) {
-            Some(up) => dir = up,
-            None => break,
-        }
+    let here = Path::new(".");
+    let mut dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(here);
+    while dir != here && std::fs::symlink_metadata(dir).is_err() {
+        dir = dir.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(here);
     }
     if !dir.is_dir() {
         bail!("output {}: {} is not a directory", path.display(), dir.display());
@@ -791,8 +789,10 @@ mod tests {
         }
         let err = check_directory_writable(&file).unwrap_err().to_string();
         assert!(err.contains("is not a directory"), "{err}");
-        // negative controls: a new file, a new nested folder, /dev/null
+        // negative controls: a new file, a new nested folder (relative too), /dev/null
         check_writable(&root.path().join("a/b/new.json")).unwrap();
+        check_writable(Path::new("no-such-dir/below/new.json")).unwrap();
+        check_directory_writable(Path::new("no-such-dir/below/out")).unwrap();
         check_writable(Path::new("/dev/null")).unwrap();
         check_directory_writable(&root.path().join("new/folder")).unwrap();
         check_directory_writable(root.path()).unwrap();
