@@ -164,6 +164,7 @@ fn huge_names_and_keys_are_refused_in_a_short_message() {
     // negative control: a name of 1000 bytes is fine
     let ok = GOOD.replace("name = \"t\"", &format!("name = \"{}\"", "n".repeat(1000)));
     assert!(parse_str(&ok).is_ok());
+}
 
 /// Issue 31 item 7: a header `t,wfoo` was read as `t,w`, and a stated period far longer than
 /// the data (`period = 1e12` for 6.28 s of samples) was accepted. Both refused, naming what

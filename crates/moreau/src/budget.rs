@@ -208,6 +208,11 @@ mod tests {
         assert!(cases(1_000_000_000_000).is_err());
         assert!(theta_size("theta", 200, 1).unwrap_err().to_string().contains("n = 200"));
         assert!(threads(0).is_err());
+        // recordings: rows counted before parsing (header and blank lines not counted)
+        let rows = |k: usize| format!("t,w,y\n{}\n", "0,0,0\n".repeat(k));
+        assert!(recording_rows("r.csv", &rows(1_000_000)).is_ok());
+        let e = recording_rows("r.csv", &rows(1_000_001)).unwrap_err().to_string();
+        assert!(e.contains("rows: 1000001") && e.contains("--allow-large"), "{e}");
         assert!(threads(100_000).unwrap() >= 1);
     }
 }
