@@ -7,8 +7,11 @@
 //!   with the binary built for this test, in a temporary folder per page where `examples/` and
 //!   `data/` are the repository's and each block headed `toml file=NAME` (any language) has
 //!   been written as `NAME`. A command exits 0, or, with `# expect: fails` on its line, fails
-//!   with one `error:` line. A block after `<!-- not run: REASON -->` is skipped. A misspelt
-//!   flag and a wrongly expected failure are reported (controls).
+//!   with one `error:` line. A block after `<!-- not run: REASON -->` is skipped. A plain
+//!   block that starts with `$ moreau ...` is a sample of the output: the command is run and
+//!   each line of the sample other than `...` must be a line of what it prints. A misspelt
+//!   flag, a wrongly expected failure and a sample line the command does not print are
+//!   reported (controls).
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Component, Path, PathBuf};
 use std::process::Command;
@@ -264,6 +267,8 @@ enum Item {
     File { name: String, body: String },
     /// A `moreau ...` line of an `sh` block (continuations joined).
     Command { line: usize, text: String, expect_fail: bool },
+    /// A plain block starting with `$ moreau ...`: the command and the lines it must print.
+    Sample { line: usize, text: String, expected: Vec<String> },
 }
 
 /// The files and commands of a guide page in order; blocks after `<!-- not run: ... -->`
@@ -322,6 +327,13 @@ fn guide_items(text: &str) -> Result<Vec<Item>, String> {
                 }
                 items.push(Item::File { name, body: text });
             }
+            if lang.is_empty() {
+                if let Some(cmd) = body.first().and_then(|(_, l)| l.trim().strip_prefix("$ moreau ")) {
+                    let expected =
+                        body[1..].iter().map(|(_, l)| l.trim_end().to_string()).filter(|l| l.trim() != "...").collect();
+                    items.push(Item::Sample { line: body[0].0, text: format!("moreau {cmd}"), expected });
+                }
+            }
             if lang == "sh" {
                 let mut k = 0;
                 while k < body.len() {
@@ -373,6 +385,24 @@ fn run_page(page: &str, items: &[Item]) -> Vec<String> {
                 }
                 std::fs::write(p, body).unwrap();
             }
+            Item::Sample { line, text, expected } => {
+                let out = Command::new("bash")
+                    .args(["-c", text])
+                    .current_dir(work)
+                    .env("PATH", &path)
+                    .env("OPENBLAS_NUM_THREADS", "1")
+                    .output()
+                    .expect("bash runs");
+                let stdout = String::from_utf8_lossy(&out.stdout);
+                let printed: Vec<&str> = stdout.lines().map(str::trim_end).collect();
+                let at = format!("{page}:{line}: sample of `{text}`");
+                if !out.status.success() {
+                    failures.push(format!("{at}: the command failed ({})", out.status));
+                }
+                for want in expected.iter().filter(|w| !printed.contains(&w.as_str())) {
+                    failures.push(format!("{at}: the command does not print the line {want:?}"));
+                }
+            }
             Item::Command { line, text, expect_fail } => {
                 let out = Command::new("bash")
                     .args(["-c", text])
@@ -422,7 +452,7 @@ fn every_command_of_the_guide_runs() {
     let mut commands = 0;
     for (page, text) in &pages {
         let items = guide_items(text).unwrap_or_else(|e| panic!("{page}: {e}"));
-        commands += items.iter().filter(|i| matches!(i, Item::Command { .. })).count();
+        commands += items.iter().filter(|i| matches!(i, Item::Command { .. } | Item::Sample { .. })).count();
         failures.extend(run_page(page, &items));
     }
     assert!(commands >= 40, "only {commands} commands found in the guide: the extraction is broken");
@@ -435,7 +465,8 @@ fn the_guide_extraction_and_runner_report_what_they_should() {
                 ```toml file=m.toml\nname = \"x\"\n```\n\n\
                 ```sh\n$ moreau validate m.toml   # comment\nmoreau theta m.toml \\\n    --json\nls\n```\n\n\
                 <!-- not run: a reason\n  on two lines -->\n```sh\nmoreau check --cases 1000000000\n```\n\n\
-                ```sh\nmoreau validate x.toml # expect: fails\n```\n";
+                ```sh\nmoreau validate x.toml # expect: fails\n```\n\
+                ```\n$ moreau validate m.toml\n...\n  n = 2\n```\n";
     let items = guide_items(page).unwrap();
     assert_eq!(
         items,
@@ -444,6 +475,7 @@ fn the_guide_extraction_and_runner_report_what_they_should() {
             Item::Command { line: 8, text: "moreau validate m.toml   # comment".into(), expect_fail: false },
             Item::Command { line: 9, text: "moreau theta m.toml --json".into(), expect_fail: false },
             Item::Command { line: 21, text: "moreau validate x.toml # expect: fails".into(), expect_fail: true },
+            Item::Sample { line: 24, text: "moreau validate m.toml".into(), expected: vec!["  n = 2".into()] },
         ]
     );
     assert!(guide_items("<!-- not run: -->\n```sh\nmoreau x\n```\n").is_err(), "a marker needs a reason");
@@ -463,9 +495,15 @@ fn the_guide_extraction_and_runner_report_what_they_should() {
             cmd(2, "moreau validate examples/worked-example.toml # expect: fails", true),
             cmd(3, "moreau validate examples/worked-example.toml", false),
             cmd(4, "moreau validate examples/missing.toml # expect: fails", true),
+            Item::Sample {
+                line: 5,
+                text: "moreau validate examples/worked-example.toml".into(),
+                expected: vec!["  n = 2, m = 1, p = 1".into(), "  n = 3, m = 1, p = 1".into()],
+            },
         ],
     );
-    assert_eq!(failures.len(), 2, "{failures:#?}");
+    assert_eq!(failures.len(), 3, "{failures:#?}");
+    assert!(failures[2].contains("control.md:5") && failures[2].contains("n = 3"), "{failures:#?}");
     assert!(failures[0].contains("control.md:1") && failures[0].contains("--jsn"), "{failures:#?}");
     assert!(failures[1].contains("control.md:2") && failures[1].contains("should fail"), "{failures:#?}");
 }
