@@ -328,7 +328,11 @@ fn guide_items(text: &str) -> Result<Vec<Item>, String> {
                 items.push(Item::File { name, body: text });
             }
             if lang.is_empty() {
-                if let Some(cmd) = body.first().and_then(|(_, l)| l.trim().strip_prefix("$ moreau ")) {
+                let first = body.first().map_or("", |(_, l)| l.trim());
+                // the README writes the command as `cargo run --release -- ...`
+                if let Some(cmd) =
+                    first.strip_prefix("$ moreau ").or_else(|| first.strip_prefix("$ cargo run --release -- "))
+                {
                     let expected =
                         body[1..].iter().map(|(_, l)| l.trim_end().to_string()).filter(|l| l.trim() != "...").collect();
                     items.push(Item::Sample { line: body[0].0, text: format!("moreau {cmd}"), expected });
@@ -455,6 +459,12 @@ fn every_command_of_the_guide_runs() {
         commands += items.iter().filter(|i| matches!(i, Item::Command { .. } | Item::Sample { .. })).count();
         failures.extend(run_page(page, &items));
     }
+    // the README's output sample (its cargo commands themselves are CI's, not run here)
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let samples: Vec<Item> =
+        guide_items(&readme).unwrap().into_iter().filter(|i| matches!(i, Item::Sample { .. })).collect();
+    assert!(!samples.is_empty(), "README.md shows what `moreau theta` prints");
+    failures.extend(run_page("README.md", &samples));
     assert!(commands >= 40, "only {commands} commands found in the guide: the extraction is broken");
     assert!(failures.is_empty(), "commands of the guide that do not behave:\n{}", failures.join("\n"));
 }
