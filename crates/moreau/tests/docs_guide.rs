@@ -188,6 +188,28 @@ fn broken_links(pages: &[(PathBuf, String)], lookup: &dyn Fn(&Path) -> Target) -
     errors
 }
 
+/// Table rows whose code spans hold an unescaped `|`: GitHub splits the cell there.
+fn broken_table_rows(page: &Path, text: &str) -> Vec<String> {
+    let mut errors = Vec::new();
+    for (no, line) in prose_lines(text) {
+        if !line.trim_start().starts_with('|') {
+            continue;
+        }
+        let mut in_code = false;
+        let mut prev = ' ';
+        for c in line.chars() {
+            if c == '`' {
+                in_code = !in_code;
+            } else if c == '|' && in_code && prev != '\\' {
+                errors.push(format!("{}:{no}: `|` inside a code span of a table row: write `\\|`", page.display()));
+                break;
+            }
+            prev = c;
+        }
+    }
+    errors
+}
+
 fn markdown_pages() -> Vec<(PathBuf, String)> {
     let root = root();
     let mut files = vec![PathBuf::from("README.md"), PathBuf::from("BENCHMARKS.md")];
@@ -231,8 +253,11 @@ fn every_relative_link_of_readme_benchmarks_and_docs_resolves() {
     let links: usize =
         pages.iter().map(|(_, t)| prose_lines(t).iter().map(|(_, l)| link_targets(l).len()).sum::<usize>()).sum();
     assert!(links >= 60, "only {links} links found: the extraction is broken");
-    let errors = broken_links(&pages, &lookup);
-    assert!(errors.is_empty(), "broken links:\n{}", errors.join("\n"));
+    let mut errors = broken_links(&pages, &lookup);
+    for (page, text) in &pages {
+        errors.extend(broken_table_rows(page, text));
+    }
+    assert!(errors.is_empty(), "broken links or tables:\n{}", errors.join("\n"));
 }
 
 #[test]
@@ -257,6 +282,9 @@ fn a_broken_link_or_anchor_is_reported() {
         "what-moreau-theta-says-and-what-the-numbers-mean"
     );
     assert_eq!(slug("`[input]`: w(t)"), "input-wt");
+    let table = "| a | `\\|x\\|` |\n| b | `|x|` |\n`|x|` outside a table\n";
+    let rows = broken_table_rows(Path::new("t.md"), table);
+    assert!(rows.len() == 1 && rows[0].starts_with("t.md:2:"), "{rows:#?}");
 }
 
 // ---------------------------------------------------------------- commands of the guide
