@@ -2,7 +2,7 @@
 # Regenerates docs/figures: one PNG (plotters) and one PDF (the pgfplots code compiled with
 # pdflatex on a 14 cm x 11 cm page) of each figure kind of `moreau figure`. Needs pdflatex and
 # pgfplots (Debian: texlive-latex-base texlive-pictures). The bam-xl330-* PNGs come from
-# `moreau diagnose` (README) and are left alone.
+# `moreau diagnose` (docs/guide/diagnose.md) and are left alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet -p moreau
