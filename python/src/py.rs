@@ -136,7 +136,7 @@ impl PySystem {
     }
     /// The model file of this system.
     fn to_toml(&self) -> String {
-        model::to_toml_string(&self.inner)
+        model::model_file::to_toml_string_stating(&self.inner, self.stated)
     }
     #[getter]
     fn name(&self) -> String {

@@ -20,8 +20,10 @@ def worked(**kw):
 
 
 def test_system_from_arrays_is_the_worked_example_file():
-    sys = worked(name="worked example (NOTES.md), a = 1")
+    sys = worked(name="worked example (NOTES.md), a = 1", x0=[0.0, 0.0], z0=[0.0])
     assert sys.to_toml() == moreau.load(WORKED).to_toml()
+    # an initial state that was not given is not written (it would then count as known)
+    assert "[initial]" not in worked(name="worked example (NOTES.md), a = 1").to_toml()
     assert (sys.n, sys.m, sys.p) == (2, 1, 1)
     assert sys.period == pytest.approx(2 * np.pi)
     assert sys.mu == pytest.approx(-0.3)

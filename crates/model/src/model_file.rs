@@ -420,6 +420,36 @@ fn shape_table(s: &Shape) -> Option<Table> {
 /// Writes a system as a model file (round-trips through [`parse_str`]; a `csv` input keeps
 /// its file path as given).
 pub fn to_toml_string(s: &System) -> String {
+    to_toml_string_stating(s, StatedInitial { x0: true, z0: true })
+}
+
+/// Which initial values a model file states (`[initial] x0`, `z0`): `diagnose` takes a stated
+/// `x0` as known instead of estimating it, so a system whose `x0` was never given must not
+/// gain one by being written and read back.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StatedInitial {
+    pub x0: bool,
+    pub z0: bool,
+}
+
+impl StatedInitial {
+    /// From model-file text (nothing stated when the text is no TOML table).
+    pub fn of_text(text: &str) -> Self {
+        let Ok(root) = text.parse::<Table>() else { return Self::default() };
+        Self::of_table(&root)
+    }
+
+    /// From the tables of a model file.
+    pub fn of_table(root: &Table) -> Self {
+        let init = root.get("initial").and_then(|v| v.as_table());
+        let has = |k: &str| init.is_some_and(|t| t.contains_key(k));
+        Self { x0: has("x0"), z0: has("z0") }
+    }
+}
+
+/// [`to_toml_string`] writing `[initial] x0` and `z0` only where `stated` says so (an unstated
+/// one reads back as the same default: `x0 = 0`, `z0` from `x0`).
+pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     let mut root = Table::new();
     root.insert("name".into(), Value::String(s.name.clone()));
     let mut plant = Table::new();
@@ -449,9 +479,15 @@ pub fn to_toml_string(s: &System) -> String {
     }
     root.insert("input".into(), Value::Table(inp));
     let mut init = Table::new();
-    init.insert("x0".into(), vec_value(s.x0.as_slice()));
-    init.insert("z0".into(), vec_value(s.z0.as_slice()));
-    root.insert("initial".into(), Value::Table(init));
+    if stated.x0 {
+        init.insert("x0".into(), vec_value(s.x0.as_slice()));
+    }
+    if stated.z0 {
+        init.insert("z0".into(), vec_value(s.z0.as_slice()));
+    }
+    if !init.is_empty() {
+        root.insert("initial".into(), Value::Table(init));
+    }
     let mut sim = Table::new();
     sim.insert("dt".into(), Value::Float(s.sim.dt));
     sim.insert("periods".into(), Value::Integer(s.sim.periods as i64));

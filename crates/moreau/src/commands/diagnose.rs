@@ -87,7 +87,7 @@ pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) 
         estimation_fraction: o.estimation_fraction,
         max_effects: o.max_effects,
         input_hold: o.input_hold,
-        initial_state: stated.initial_state(&sys),
+        initial_state: super::initial_state(stated, &sys),
         estimate_x0: o.estimate_x0,
         metric: o.metric,
         refit_nominal: o.refit_nominal,

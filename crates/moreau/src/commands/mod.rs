@@ -33,35 +33,15 @@ pub enum Source {
     Built(Box<System>, Stated),
 }
 
-/// Which initial values a model states (`[initial] x0`, `z0`): `diagnose` takes a stated
-/// `x0` as known instead of estimating it.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Stated {
-    pub x0: bool,
-    pub z0: bool,
-}
+/// Which initial values a model states (declared in the model crate, where it is written).
+pub use model::model_file::StatedInitial as Stated;
 
-impl Stated {
-    /// From model-file text (nothing stated when the text is no TOML table).
-    pub fn of_text(text: &str) -> Self {
-        let Ok(root) = toml::from_str::<toml::Table>(text) else { return Self::default() };
-        Self::of_table(&root)
-    }
-
-    /// From the tables of a model file.
-    pub fn of_table(root: &toml::Table) -> Self {
-        let init = root.get("initial").and_then(|v| v.as_table());
-        let has = |k: &str| init.is_some_and(|t| t.contains_key(k));
-        Self { x0: has("x0"), z0: has("z0") }
-    }
-
-    /// The initial state `diagnose` gets: the model's `x0` (and `z0`) where stated.
-    pub fn initial_state(self, sys: &System) -> Option<discovery::InitialState> {
-        self.x0.then(|| discovery::InitialState {
-            x0: sys.x0.iter().copied().collect(),
-            z0: self.z0.then(|| sys.z0.iter().copied().collect()),
-        })
-    }
+/// The initial state `diagnose` gets: the model's `x0` (and `z0`) where `stated`.
+pub fn initial_state(stated: Stated, sys: &System) -> Option<discovery::InitialState> {
+    stated.x0.then(|| discovery::InitialState {
+        x0: sys.x0.iter().copied().collect(),
+        z0: stated.z0.then(|| sys.z0.iter().copied().collect()),
+    })
 }
 
 impl Source {
