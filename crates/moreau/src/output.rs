@@ -24,6 +24,14 @@ pub fn register_input(path: &Path) {
     }
 }
 
+/// Forgets every registered input: for a process that runs many commands one after another
+/// (the fuzz targets of `crate::fuzzing`); a command-line run never needs it.
+pub fn forget_inputs() {
+    if let Ok(mut v) = INPUTS.lock() {
+        v.clear();
+    }
+}
+
 /// Refuses an output target that is (or resolves to, through links) an input of the command.
 pub fn refuse_input(path: &Path) -> Result<()> {
     let Ok(m) = std::fs::metadata(path) else { return Ok(()) };
@@ -59,7 +67,8 @@ enum Target {
 /// classifies the result; refuses directories, block devices and sockets.
 fn resolve_target(path: &Path) -> Result<Target> {
     let mut p = path.to_path_buf();
-    for _ in 0..MAX_LINKS {
+    // MAX_LINKS links, then the file they lead to
+    for _ in 0..=MAX_LINKS {
         let Ok(m) = std::fs::symlink_metadata(&p) else { return Ok(Target::File(p)) };
         let t = m.file_type();
         if t.is_symlink() {
