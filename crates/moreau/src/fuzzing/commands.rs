@@ -17,7 +17,7 @@ const SIM_ROWS: usize = 50;
 
 /// The bytes as `model.toml` in a fresh temporary directory (kept alive by the returned guard).
 fn model_file(data: &[u8]) -> Option<(tempfile::TempDir, PathBuf)> {
-    let dir = tempfile::tempdir().ok()?;
+    let dir = super::scratch().ok()?;
     let p = dir.path().join("model.toml");
     std::fs::write(&p, data).ok()?;
     Some((dir, p))

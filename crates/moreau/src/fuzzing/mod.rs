@@ -60,3 +60,15 @@ fn split_two(text: &str) -> (&str, &str) {
     }
     (text, "")
 }
+
+/// A fresh temporary directory, in memory (`/dev/shm`) where there is one: a directory on
+/// disk costs about 1 ms to make and remove here, 5x the parse it serves.
+fn scratch() -> std::io::Result<tempfile::TempDir> {
+    let shm = std::path::Path::new("/dev/shm");
+    if shm.is_dir() {
+        if let Ok(d) = tempfile::tempdir_in(shm) {
+            return Ok(d);
+        }
+    }
+    tempfile::tempdir()
+}

@@ -113,7 +113,7 @@ pub fn write_output(data: &[u8]) {
     let (name, content) = rest.split_at(len.min(rest.len()));
     let content = &content[..content.len().min(MAX_CONTENT)];
     let kind = Kind::of(k, depth);
-    let Ok(root) = tempfile::tempdir() else { return };
+    let Ok(root) = super::scratch() else { return };
     let (fx, d) = (root.path().join("fx"), root.path().join("d"));
     if std::fs::create_dir(&fx).is_err() || std::fs::create_dir(&d).is_err() {
         return;

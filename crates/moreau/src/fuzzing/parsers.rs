@@ -19,7 +19,7 @@ pub fn sweep_spec(data: &[u8]) {
 
 /// An input CSV (`[input] kind = "csv"`), read from a temporary file as the model reader does.
 pub fn input_csv(data: &[u8]) {
-    let Ok(dir) = tempfile::tempdir() else { return };
+    let Ok(dir) = super::scratch() else { return };
     let p = dir.path().join("w.csv");
     if std::fs::write(&p, data).is_err() {
         return;
