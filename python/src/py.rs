@@ -7,7 +7,7 @@ use crate::system::{system_from_table, SamplesSpec};
 use moreau::commands::{self, one_line, Source, Stated};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyBytes, PyComplex, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use std::path::PathBuf;
 
 pyo3::create_exception!(
@@ -33,38 +33,62 @@ pub struct PySystem {
     stated: Stated,
 }
 
+/// Counts the numbers of a model's tables as they are converted and refuses more than
+/// [`moreau::budget::MAX_MODEL_NUMBERS`] before the rest is converted.
+struct NumberBudget(u64);
+
+impl NumberBudget {
+    fn take(&mut self, key: &str) -> PyResult<()> {
+        self.0 += 1;
+        if self.0 > moreau::budget::MAX_MODEL_NUMBERS {
+            moreau::budget::model_numbers(self.0, &format!("the model's tables, counted up to `{key}`"))
+                .map_err(err)?;
+        }
+        Ok(())
+    }
+}
+
 /// A Python value of a model-file table as a TOML value (numbers, strings, booleans, lists,
-/// dicts).
-fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+/// dicts). A complex number is refused (its imaginary part would be dropped).
+fn toml_value(key: &str, v: &Bound<'_, PyAny>, budget: &mut NumberBudget) -> PyResult<toml::Value> {
     if v.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(v.extract()?));
     }
     if v.is_instance_of::<PyFloat>() {
+        budget.take(key)?;
         return Ok(toml::Value::Float(v.extract()?));
     }
     if v.is_instance_of::<PyInt>() {
+        budget.take(key)?;
         return Ok(toml::Value::Integer(v.extract()?));
     }
     if v.is_instance_of::<PyString>() {
         return Ok(toml::Value::String(v.extract()?));
     }
     if let Ok(d) = v.cast::<PyDict>() {
-        return Ok(toml::Value::Table(toml_table(key, d)?));
+        return Ok(toml::Value::Table(toml_table(key, d, budget)?));
     }
     if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
         let mut a = Vec::new();
         for x in v.try_iter()? {
-            a.push(toml_value(key, &x?)?);
+            a.push(toml_value(key, &x?, budget)?);
         }
         return Ok(toml::Value::Array(a));
     }
+    if v.is_instance_of::<PyComplex>() {
+        return Err(PyTypeError::new_err(format!(
+            "key `{key}`: a complex number ({}) cannot be used in a model: the entries are real (its imaginary part would be dropped)",
+            v.repr()?
+        )));
+    }
     if let Ok(x) = v.extract::<f64>() {
+        budget.take(key)?;
         return Ok(toml::Value::Float(x));
     }
     Err(PyTypeError::new_err(format!("key `{key}`: cannot use a value of type {} in a model", v.get_type().name()?)))
 }
 
-fn toml_table(prefix: &str, d: &Bound<'_, PyDict>) -> PyResult<toml::Table> {
+fn toml_table(prefix: &str, d: &Bound<'_, PyDict>, budget: &mut NumberBudget) -> PyResult<toml::Table> {
     let mut t = toml::Table::new();
     for (k, v) in d.iter() {
         let k: String = k.extract()?;
@@ -72,7 +96,7 @@ fn toml_table(prefix: &str, d: &Bound<'_, PyDict>) -> PyResult<toml::Table> {
             continue;
         }
         let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
-        t.insert(k, toml_value(&key, &v)?);
+        t.insert(k, toml_value(&key, &v, budget)?);
     }
     Ok(t)
 }
@@ -88,8 +112,12 @@ impl PySystem {
     #[staticmethod]
     #[pyo3(signature = (table, samples=None))]
     fn from_table(py: Python<'_>, table: &Bound<'_, PyDict>, samples: Option<SamplesArg>) -> PyResult<Self> {
-        let t = toml_table("", table)?;
+        let t = toml_table("", table, &mut NumberBudget(0))?;
         let stated = Stated::of_table(&t);
+        if let Some((t, w, _, source)) = &samples {
+            let numbers = t.len() as u64 + w.iter().map(|r| r.len() as u64).sum::<u64>();
+            moreau::budget::sample_numbers(numbers, &format!("t and w of {source}")).map_err(err)?;
+        }
         let samples = samples.map(|(t, w, period, source)| SamplesSpec { t, w, period, source });
         let inner = py.detach(move || system_from_table(t, samples)).map_err(err)?;
         Ok(Self { inner, stated })
@@ -384,9 +412,10 @@ fn diagnose<'py>(
     };
     let o = DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, ..Default::default() };
     let run = move || -> anyhow::Result<discovery::Report> {
+        let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;
-        if let Some(dir) = &out {
-            write_outputs(&r, dir)?;
+        if let Some(st) = staged {
+            write_outputs(&r, st)?;
         }
         Ok(r)
     };
@@ -457,6 +486,20 @@ fn allow_large() -> bool {
     moreau::budget::allow_large()
 }
 
+/// The model-size budget of the CLI (`moreau::budget::model_numbers`) for an array of
+/// `numbers` entries (`detail`: which), checked by the Python package before it converts the
+/// array.
+#[pyfunction]
+fn check_model_numbers(numbers: u64, detail: &str) -> PyResult<()> {
+    moreau::budget::model_numbers(numbers, detail).map_err(err)
+}
+
+/// The budget of input samples given as arrays (`moreau::budget::sample_numbers`).
+#[pyfunction]
+fn check_sample_numbers(numbers: u64, detail: &str) -> PyResult<()> {
+    moreau::budget::sample_numbers(numbers, detail).map_err(err)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MoreauError", m.py().get_type::<MoreauError>())?;
@@ -470,5 +513,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(set_allow_large, m)?)?;
     m.add_function(wrap_pyfunction!(allow_large, m)?)?;
+    m.add_function(wrap_pyfunction!(check_model_numbers, m)?)?;
+    m.add_function(wrap_pyfunction!(check_sample_numbers, m)?)?;
+    m.add("MAX_MODEL_NUMBERS", moreau::budget::MAX_MODEL_NUMBERS)?;
+    m.add("MAX_SAMPLE_NUMBERS", moreau::budget::MAX_SAMPLE_NUMBERS)?;
     Ok(())
 }

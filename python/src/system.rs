@@ -59,22 +59,7 @@ fn samples_input(s: SamplesSpec) -> Result<Input, ModelError> {
         }
     }
     if let Some(per) = s.period {
-        if per.is_nan() || per <= 0.0 || per.is_infinite() {
-            return Err(ModelError::OutOfRange { key: "input.period".into(), value: per, reason: "must be positive" });
-        }
-        let span = s.t[s.t.len() - 1] - s.t[0];
-        if per < span * (1.0 - 1e-12) {
-            return Err(ModelError::Invalid {
-                key: "input.period".into(),
-                value: per,
-                reason: format!(
-                    "shorter than the data in `{}` (samples span {span} from t = {} to t = {}): the rest would be cut silently",
-                    s.source,
-                    s.t[0],
-                    s.t[s.t.len() - 1]
-                ),
-            });
-        }
+        model::input::check_period(per, &s.t, &s.source)?;
     }
     Ok(Input::Samples { path: s.source, t: s.t, w: s.w, period: s.period })
 }

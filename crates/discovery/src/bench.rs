@@ -225,7 +225,17 @@ pub fn class_set(name: &str) -> Option<Vec<&'static str>> {
             Some([bench_gen::NONE, names::COULOMB_FRICTION].iter().chain(FRICTION_CLASSES.iter()).copied().collect())
         }
         "all" => Some(all),
-        list => list.split(',').map(|c| all.iter().find(|a| **a == c.trim()).copied()).collect(),
+        list => {
+            // each class once, in the order first named (`none,none,...` is one class)
+            let mut set: Vec<&'static str> = Vec::new();
+            for c in list.split(',') {
+                let class = all.iter().find(|a| **a == c.trim()).copied()?;
+                if !set.contains(&class) {
+                    set.push(class);
+                }
+            }
+            Some(set)
+        }
     }
 }
 
@@ -374,5 +384,20 @@ impl BenchResult {
         s += &format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / total.max(1) as f64);
         let _ = k;
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_class_named_twice_runs_once() {
+        let many = vec!["none"; 10_000].join(",");
+        assert_eq!(class_set(&many).unwrap(), [bench_gen::NONE]);
+        let two = format!("{},none, {}", bench_gen::NONE, names::COULOMB_FRICTION);
+        assert_eq!(class_set(&two).unwrap(), [bench_gen::NONE, names::COULOMB_FRICTION]);
+        // negative control: an unknown name still refuses the list
+        assert!(class_set("none,no-such-class").is_none());
     }
 }

@@ -203,8 +203,10 @@ pub mod robonine {
     /// Degrees per encoder count (4096 counts per revolution).
     pub const COUNT_DEG: f64 = 360.0 / 4096.0;
 
-    /// One puller servo of the stand.
+    /// One puller servo of the stand (unknown keys are refused: a misspelt key would
+    /// otherwise be ignored silently).
     #[derive(Debug, Clone, serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
     pub struct Puller {
         pub motor_id: u32,
         #[serde(default)]
@@ -215,12 +217,30 @@ pub mod robonine {
         pub stretched_tolerance: f64,
     }
 
-    /// The upstream analysis configuration (`analysis_config_*.json`).
+    /// The upstream analysis configuration (`analysis_config_*.json`). Unknown keys are
+    /// refused. `home_tolerance`, `home_motor_ids`, `require_home_position_match` and
+    /// `min_segment_samples` are settings of the upstream script: they are read and
+    /// range-checked so that a config is taken as written or refused, but the labelling here
+    /// does not use them (it needs the DUT's target exactly at `home_position`; the segment
+    /// length is [`PlayWidthSettings::min_segment_samples`], `--min-segment-samples`).
     #[derive(Debug, Clone, serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
     pub struct StandConfig {
         pub home_position: f64,
         pub report_motor_ids: Vec<u32>,
         pub actuated_motors: Vec<Puller>,
+        /// Upstream: tolerance of the DUT's position around home (counts, >= 0).
+        #[serde(default)]
+        pub home_tolerance: Option<f64>,
+        /// Upstream: servos that must be at home.
+        #[serde(default)]
+        pub home_motor_ids: Option<Vec<u32>>,
+        /// Upstream: whether the home position must match.
+        #[serde(default)]
+        pub require_home_position_match: Option<bool>,
+        /// Upstream: shortest steady segment (samples, >= 1).
+        #[serde(default)]
+        pub min_segment_samples: Option<usize>,
     }
 
     impl StandConfig {
@@ -237,6 +257,14 @@ pub mod robonine {
             }
             if c.report_motor_ids.is_empty() {
                 return Err(PlayWidthError::BadConfig { reason: "report_motor_ids is empty".into() });
+            }
+            if let Some(h) = c.home_tolerance.filter(|h| !(h.is_finite() && *h >= 0.0)) {
+                return Err(PlayWidthError::BadConfig {
+                    reason: format!("home_tolerance {h} must be a non-negative number (counts)"),
+                });
+            }
+            if c.min_segment_samples == Some(0) {
+                return Err(PlayWidthError::BadConfig { reason: "min_segment_samples 0 must be at least 1".into() });
             }
             Ok(c)
         }
@@ -514,5 +542,26 @@ mod tests {
         assert_eq!(r[0].unloaded.cycle_differences.len(), 4);
         let e = robonine::analyse("timestamp,pos (5)\n", "x.csv", &cfg, &PlayWidthSettings::default()).unwrap_err();
         assert!(e.to_string().contains("target pos (5)"), "{e}");
+    }
+
+    /// Issue 31 item 7: `home_tolerance = -5`, `min_segment_samples = 0` and unknown keys
+    /// were accepted. Each is refused naming the key and the value; the upstream file as
+    /// shipped is accepted (control).
+    #[test]
+    fn stand_configs_refuse_bad_ranges_and_unknown_keys() {
+        let good = include_str!("../../../data/robonine-backlash/analysis_config_m5.json");
+        robonine::StandConfig::from_json_str(good).unwrap();
+        for (from, to, needles) in [
+            ("\"home_tolerance\": 5", "\"home_tolerance\": -5", vec!["home_tolerance -5"]),
+            ("\"min_segment_samples\": 10", "\"min_segment_samples\": 0", vec!["min_segment_samples 0"]),
+            ("\"home_tolerance\": 5", "\"home_tolerence\": 5", vec!["unknown field `home_tolerence`"]),
+            ("\"label\": \"M3\"", "\"lable\": \"M3\"", vec!["unknown field `lable`"]),
+        ] {
+            assert!(good.contains(from), "{from}");
+            let e = robonine::StandConfig::from_json_str(&good.replacen(from, to, 1)).unwrap_err().to_string();
+            for n in needles {
+                assert!(e.contains(n), "expected `{n}` in: {e}");
+            }
+        }
     }
 }

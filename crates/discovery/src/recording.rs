@@ -61,14 +61,16 @@ fn col_names(prefix: &str, header: &[String]) -> Vec<usize> {
     if let Some(i) = header.iter().position(|h| h == prefix) {
         return vec![i];
     }
-    let mut out = Vec::new();
-    for k in 1.. {
-        match header.iter().position(|h| *h == format!("{prefix}{k}")) {
-            Some(i) => out.push(i),
-            None => break,
-        }
-    }
-    out
+    // `prefix1, prefix2, ...` up to the first missing number (one pass over the header)
+    let numbered: std::collections::HashMap<usize, usize> = header
+        .iter()
+        .enumerate()
+        .filter_map(|(i, h)| {
+            let k = h.strip_prefix(prefix)?;
+            (k.bytes().all(|b| b.is_ascii_digit()) && !k.starts_with('0')).then(|| k.parse().ok().map(|k| (k, i)))?
+        })
+        .collect();
+    (1..).map_while(|k| numbered.get(&k).copied()).collect()
 }
 
 impl Recording {
@@ -286,6 +288,18 @@ impl Recording {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbered_columns_are_found_in_one_pass() {
+        let h = |cols: &[&str]| cols.iter().map(|c| c.to_string()).collect::<Vec<_>>();
+        assert_eq!(col_names("y", &h(&["t", "y2", "w", "y1", "y3"])), [3, 1, 4]);
+        assert_eq!(col_names("y", &h(&["t", "y1", "y3"])), [1], "numbering stops at the first gap");
+        assert_eq!(col_names("y", &h(&["t", "y", "y1"])), [1], "a bare name wins");
+        assert!(col_names("y", &h(&["t", "y01", "yy1"])).is_empty(), "no leading zeros, no other prefixes");
+        // a header of 100000 numbered columns (quadratic before)
+        let wide: Vec<String> = (1..=100_000).map(|k| format!("w{k}")).collect();
+        assert_eq!(col_names("w", &wide).len(), 100_000);
+    }
 
     fn csv(rows: usize, f: impl Fn(usize) -> String) -> String {
         let mut s = "t,w,y\n".to_string();

@@ -17,7 +17,7 @@ pub enum DynamicsError {
     ResonantPeriod { sigma_min: f64 },
     #[error("the event-driven integrator supports Theta = interval (p = 1), ball or ellipsoid; got {shape}")]
     UnsupportedShape { shape: String },
-    #[error("the event-driven integrator needs an input of kind zero, sine, square or csv; got {kind}")]
+    #[error("the event-driven integrator needs an input of kind zero or sine (the exosystem); got {kind}")]
     UnsupportedInput { kind: &'static str },
     #[error("event location failed at t = {t}: {what}")]
     EventLocation { t: f64, what: &'static str },

@@ -28,4 +28,6 @@ pub enum GeometryError {
     EmptyPolytope,
     #[error("polytope normal {index} is zero")]
     ZeroNormal { index: usize },
+    #[error("polytope has an empty interior (zero volume): its width across half-space {index} is {width:e}, against a diameter {diameter:e}; Theta must be a full-dimensional set (use shape = \"point\" for {{0}})")]
+    DegeneratePolytope { index: usize, width: f64, diameter: f64 },
 }

@@ -176,6 +176,35 @@ fn polytope_projection_vertices_and_infinite_r() {
     assert!(Polytope::new(vec![vec![1.0, 0.0], vec![0.0, 1.0], vec![-1.0, -1.0]], vec![1.0, 1.0, -5.0]).is_err());
 }
 
+/// Issue 31 item 7: a polytope with an empty interior was accepted. Refused, naming the row
+/// across which it has no width; a thin but full-dimensional one stays accepted (control).
+#[test]
+fn degenerate_polytopes_are_refused_with_the_reason() {
+    use geometry::GeometryError;
+    // the segment {0} x [-1, 1]: all vertices on a line in R^2
+    let e = Polytope::from_box(&[0.0, -1.0], &[0.0, 1.0]).unwrap_err();
+    assert!(matches!(e, GeometryError::DegeneratePolytope { index: 0, .. }), "{e:?}");
+    assert!(e.to_string().contains("empty interior"), "{e}");
+    // a single point (the origin), by three half-planes
+    let e = Polytope::new(vec![vec![1.0, 0.0], vec![0.0, 1.0], vec![-1.0, -1.0]], vec![0.0, 0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, GeometryError::DegeneratePolytope { diameter, .. } if diameter == 0.0), "{e:?}");
+    // a flat triangle in R^3 (z = 0 implied by z <= 0 and -z <= 0)
+    let e = Polytope::new(
+        vec![
+            vec![1.0, 0.0, 0.0],
+            vec![0.0, 1.0, 0.0],
+            vec![-1.0, -1.0, 0.0],
+            vec![0.0, 0.0, 1.0],
+            vec![0.0, 0.0, -1.0],
+        ],
+        vec![1.0, 1.0, 1.0, 0.0, 0.0],
+    )
+    .unwrap_err();
+    assert!(matches!(e, GeometryError::DegeneratePolytope { .. }), "{e:?}");
+    // control: thin (width 1e-6 against diameter 2) but full-dimensional
+    assert!(Polytope::from_box(&[-1e-6, -1.0], &[0.0, 1.0]).is_ok());
+}
+
 #[test]
 fn linear_image_and_minkowski_sum_via_support_functions() {
     let b = Ball::centred(2, 1.0).unwrap();

@@ -101,8 +101,9 @@ impl Input {
         out
     }
 
-    /// Reads samples from a CSV file with header `t,w` or `t,w1,...,wm`. Rejects missing or
-    /// non-numeric cells, NaN/inf, and time stamps that do not increase strictly.
+    /// Reads samples from a CSV file with header exactly `t,w` (or `t,w1`) or `t,w1,...,wm`.
+    /// Rejects other headers, missing or non-numeric cells, NaN/inf, and time stamps that do
+    /// not increase strictly. A stated `period` is checked by the caller ([`check_period`]).
     pub fn from_csv(path: &Path, period: Option<f64>) -> Result<Self, ModelError> {
         let ps = path.display().to_string();
         let text = crate::files::read_regular(path, crate::files::MAX_CSV_BYTES)?;
@@ -119,6 +120,20 @@ impl Input {
             return Err(ModelError::Csv {
                 path: ps,
                 reason: format!("duplicate column `{dup}` (column {}) in header `{}`", j + 1, names.join(",")),
+            });
+        }
+        // the columns are taken by position: a header that names them otherwise (`t,wfoo`,
+        // `t,w2,w1`) would be read as something it does not say
+        let m = names.len() - 1;
+        let numbered: Vec<String> = (1..=m).map(|j| format!("w{j}")).collect();
+        if names[1..] != numbered[..] && !(m == 1 && names[1] == "w") {
+            let expected = if m == 1 { "`t,w` or `t,w1`".to_string() } else { format!("`t,{}`", numbered.join(",")) };
+            return Err(ModelError::Csv {
+                path: ps,
+                reason: format!(
+                    "header `{}` does not name its {m} input column(s) as expected: {expected}",
+                    names.join(",")
+                ),
             });
         }
         let mut t = Vec::new();
@@ -180,6 +195,48 @@ impl Input {
         }
         Ok(Input::Samples { path: path.display().to_string(), t, w, period })
     }
+}
+
+/// `x` to 7 significant digits, for messages (`6.279999999999999` -> `6.28`).
+fn short(x: f64) -> String {
+    crate::error::fmt_num(format!("{x:.6e}").parse().unwrap_or(x))
+}
+
+/// Checks the stated `period` of sampled data `t` (from `source`, for messages): positive and
+/// finite, not shorter than the data (the rest would be cut silently) and not longer than the
+/// data plus their largest sample step (beyond the last sample the input holds its last value,
+/// so the data would not cover the period: `period = 1e12` for 6.28 s of data).
+pub fn check_period(period: f64, t: &[f64], source: &str) -> Result<(), ModelError> {
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(ModelError::OutOfRange { key: "input.period".into(), value: period, reason: "must be positive" });
+    }
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return Ok(()) };
+    let span = t1 - t0;
+    if period < span * (1.0 - 1e-12) {
+        return Err(ModelError::Invalid {
+            key: "input.period".into(),
+            value: period,
+            reason: format!(
+                "shorter than the data in `{source}` (samples span {span} from t = {t0} to t = {t1}): the rest would be cut silently"
+            ),
+        });
+    }
+    let step = t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    if period > (span + step) * (1.0 + 1e-12) {
+        return Err(ModelError::Invalid {
+            key: "input.period".into(),
+            value: period,
+            reason: format!(
+                "longer than the data in `{source}` cover: the samples span {} from t = {} to t = {} (largest step {}), so a period above {} would hold the last sample for the rest of each period",
+                short(span),
+                short(t0),
+                short(t1),
+                short(step),
+                short(span + step)
+            ),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -276,18 +276,7 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
             }
             let input = Input::from_csv(&dir.join(file), period)?;
             if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
-                let span = t[t.len() - 1] - t[0];
-                if per < span * (1.0 - 1e-12) {
-                    return Err(ModelError::Invalid {
-                        key: "input.period".into(),
-                        value: per,
-                        reason: format!(
-                            "shorter than the data in `{file}` (samples span {span} from t = {} to t = {}): the rest would be cut silently",
-                            t[0],
-                            t[t.len() - 1]
-                        ),
-                    });
-                }
+                crate::input::check_period(per, t, &file)?;
             }
             input
         }
@@ -295,12 +284,20 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
     })
 }
 
-fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
+/// Longest model `name` in bytes: it goes into plot titles, tables and reports.
+pub const MAX_NAME_BYTES: usize = 1000;
+
+/// Parses model-file text as [`load`] reads a file named `origin` in directory `dir` (`csv`
+/// inputs resolved relative to `dir`): what a file with this text there would give.
+pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
     let root: Table = text
         .parse::<Table>()
         .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
     check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects, fit, signals")?;
     let name = match root.get("name") {
+        Some(Value::String(s)) if s.len() > MAX_NAME_BYTES => {
+            return Err(ModelError::TooLong { key: "name".into(), bytes: s.len(), limit: MAX_NAME_BYTES })
+        }
         Some(Value::String(s)) => s.clone(),
         Some(other) => {
             return Err(ModelError::WrongType { key: "name".into(), expected: "a string", found: describe(other) })

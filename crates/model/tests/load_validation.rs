@@ -149,3 +149,44 @@ fn csv_inputs_reject_duplicates_overflow_unresolvable_times_and_short_periods() 
     let e = csv_model(d.path(), "t,w\n0,0\n1,1\n2,0\n", Some(1.0)).unwrap_err().to_string();
     assert!(e.contains("input.period") && e.contains("shorter than the data"), "{e}");
 }
+
+/// Issue 31 item 5: a 10 MB name (it goes into plot titles) and a 10 MB unknown key are
+/// refused in a short message; an ordinary name still loads.
+#[test]
+fn huge_names_and_keys_are_refused_in_a_short_message() {
+    let long = "n".repeat(10 << 20);
+    let e = err(&GOOD.replace("name = \"t\"", &format!("name = \"{long}\"")));
+    assert!(e.contains("key `name`") && e.contains("more than the limit of 1000 bytes"), "{}", &e[..e.len().min(300)]);
+    assert!(e.len() < 300, "{} bytes", e.len());
+    let e = err(&GOOD.replace("[plant]", &format!("[plant]\n{long} = 1")));
+    assert!(e.contains("unknown key") && e.contains("bytes in all"), "{}", &e[..e.len().min(300)]);
+    assert!(e.len() < 600, "{} bytes", e.len());
+    // negative control: a name of 1000 bytes is fine
+    let ok = GOOD.replace("name = \"t\"", &format!("name = \"{}\"", "n".repeat(1000)));
+    assert!(parse_str(&ok).is_ok());
+
+/// Issue 31 item 7: a header `t,wfoo` was read as `t,w`, and a stated period far longer than
+/// the data (`period = 1e12` for 6.28 s of samples) was accepted. Both refused, naming what
+/// was found and what is expected; the exact headers and a period of one sample step beyond
+/// the data stay accepted (controls).
+#[test]
+fn csv_inputs_need_the_exact_header_and_a_period_the_data_cover() {
+    let d = tempfile::tempdir().unwrap();
+    let e = csv_model(d.path(), "t,wfoo\n0,0\n1,1\n", None).unwrap_err().to_string();
+    assert!(e.contains("header `t,wfoo`") && e.contains("`t,w` or `t,w1`"), "{e}");
+    let e = csv_model(d.path(), "t,w2,w1\n0,0,0\n1,1,1\n", None).unwrap_err().to_string();
+    assert!(e.contains("header `t,w2,w1`") && e.contains("`t,w1,w2`"), "{e}");
+    csv_model(d.path(), "t,w\n0,0\n1,1\n", None).unwrap();
+    csv_model(d.path(), "t,w1\n0,0\n1,1\n", None).unwrap();
+    // 6.28 s of data sampled every 0.0628 s
+    let samples: String = (0..=100).map(|k| format!("{},{}\n", k as f64 * 0.0628, (k as f64 * 0.0628).sin())).collect();
+    let csv = format!("t,w\n{samples}");
+    let e = csv_model(d.path(), &csv, Some(1e12)).unwrap_err().to_string();
+    assert!(
+        e.contains("input.period") && e.contains("1000000000000") && e.contains("span 6.28 from t = 0 to t = 6.28"),
+        "{e}"
+    );
+    csv_model(d.path(), &csv, Some(6.28)).unwrap();
+    csv_model(d.path(), &csv, Some(6.28 + 0.0628)).unwrap();
+    assert!(csv_model(d.path(), &csv, Some(6.5)).is_err());
+}

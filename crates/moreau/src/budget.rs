@@ -12,6 +12,8 @@
 //! | sweep grid points | [`MAX_SWEEP_POINTS`] = 1e6 | `sweep::spec::MAX_POINTS` = 1e7 |
 //! | `discover-bench` cases per class | [`MAX_BENCH_CASES`] = 1000 | 1e6 |
 //! | convergence ladder levels | - | [`MAX_LEVELS`] = 40 |
+//! | rows of a recording (`diagnose`) | [`MAX_RECORDING_ROWS`] = 1e6 | [`HARD_MAX_RECORDING_ROWS`] = 5e7 |
+//! | magnitude of a plant entry (`theta`, `simulate`, ...) | [`MAX_PLANT_ENTRY`] = 1e12 | `model::MAX_MAGNITUDE` = 1e100 |
 //! | `theta` state dimension n / backlash dimension p | [`THETA_MAX_N`] / [`THETA_MAX_P`] | - |
 //! | worker threads | the machine's available parallelism (capped with a note) | |
 use anyhow::bail;
@@ -44,6 +46,17 @@ pub const THETA_MAX_N: usize = 12;
 /// Largest backlash dimension p for `theta` without `--allow-large`: the certified maxima over
 /// the unit sphere of R^p grow exponentially with p.
 pub const THETA_MAX_P: usize = 4;
+
+/// Rows of a recording `diagnose` reads without `--allow-large` (each hypothesis simulates
+/// and differentiates the whole recording; 1e7 rows took 3.8 GB before it was stopped).
+pub const MAX_RECORDING_ROWS: f64 = 1e6;
+/// Rows of a recording beyond which nothing runs.
+pub const HARD_MAX_RECORDING_ROWS: f64 = 5e7;
+
+/// Largest magnitude of a plant entry (A, B, C, E) without `--allow-large`: beyond it the
+/// plant's time scales span more than double precision resolves beside the input period
+/// (1e60 made the matrix exponential lose the slow modes and, before it was guarded, hang).
+pub const MAX_PLANT_ENTRY: f64 = 1e12;
 
 static ALLOW_LARGE: AtomicBool = AtomicBool::new(false);
 
@@ -98,6 +111,37 @@ pub fn samples(command: &str, samples: f64, detail: &str) -> anyhow::Result<()> 
 /// Cases per property of `moreau check`.
 pub fn cases(cases: u64) -> anyhow::Result<()> {
     check("check: --cases", cases as f64, MAX_CASES as f64, HARD_MAX_CASES as f64, "per property")
+}
+
+/// Rows of a recording (data lines of its CSV text, counted before it is parsed).
+pub fn recording_rows(source: &str, text: &str) -> anyhow::Result<()> {
+    let lines = text.lines().filter(|l| !l.trim().is_empty()).count();
+    let rows = lines.saturating_sub(1) as f64;
+    check(&format!("diagnose: recording {source}: rows"), rows, MAX_RECORDING_ROWS, HARD_MAX_RECORDING_ROWS, "")
+}
+
+/// Magnitudes of the plant's entries against [`MAX_PLANT_ENTRY`]; the message names the
+/// largest entry.
+pub fn plant_entries(sys: &model::System) -> anyhow::Result<()> {
+    let mut largest = (0.0f64, "A", 0, 0);
+    for (name, m) in [("A", &sys.A), ("B", &sys.B), ("C", &sys.C), ("E", &sys.E)] {
+        for i in 0..m.nrows() {
+            for j in 0..m.ncols() {
+                if m[(i, j)].abs() > largest.0 {
+                    largest = (m[(i, j)].abs(), name, i, j);
+                }
+            }
+        }
+    }
+    let (value, name, i, j) = largest;
+    let what = format!("plant entry {name}[{i}][{j}]: magnitude");
+    check(
+        &what,
+        value,
+        MAX_PLANT_ENTRY,
+        model::MAX_MAGNITUDE,
+        "time scales this far apart are not resolved in double precision; rescale the units",
+    )
 }
 
 /// Problem size of `theta` (state dimension `n`, backlash dimension `p`).
@@ -165,5 +209,54 @@ mod tests {
         assert!(theta_size("theta", 200, 1).unwrap_err().to_string().contains("n = 200"));
         assert!(threads(0).is_err());
         assert!(threads(100_000).unwrap() >= 1);
+    }
+}
+
+// ---- model size of a system built in memory (issue 31 item 8; added by helper Q) ----
+
+/// Numbers (matrix and vector entries) of a model built in memory (the Python package's
+/// `System`, `Polytope`, ...): as many as the largest model file the CLI reads holds
+/// ([`model::files::MAX_MODEL_BYTES`], 16 MiB) at 16 bytes a number. A 3000 x 3000 `A` (9e6
+/// numbers, gigabytes once converted) is refused before it is converted. No `--allow-large`
+/// lifts it, as none lifts the model-file limit.
+pub const MAX_MODEL_NUMBERS: u64 = model::files::MAX_MODEL_BYTES / 16;
+/// Numbers of an input given as sample arrays (`t` and `w`): as many as the largest input
+/// CSV ([`model::files::MAX_CSV_BYTES`], 512 MiB) holds at 16 bytes a number.
+pub const MAX_SAMPLE_NUMBERS: u64 = model::files::MAX_CSV_BYTES / 16;
+
+/// Refuses a model of more than [`MAX_MODEL_NUMBERS`] numbers (`detail`: which arrays).
+pub fn model_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    if numbers > MAX_MODEL_NUMBERS {
+        bail!(
+            "model: {numbers} numbers ({detail}) exceed the limit {MAX_MODEL_NUMBERS}, what the largest model file ({} MiB) holds at 16 bytes a number",
+            model::files::MAX_MODEL_BYTES >> 20
+        );
+    }
+    Ok(())
+}
+
+/// Refuses input samples of more than [`MAX_SAMPLE_NUMBERS`] numbers (`detail`: which arrays).
+pub fn sample_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    if numbers > MAX_SAMPLE_NUMBERS {
+        bail!(
+            "input samples: {numbers} numbers ({detail}) exceed the limit {MAX_SAMPLE_NUMBERS}, what the largest input CSV ({} MiB) holds at 16 bytes a number",
+            model::files::MAX_CSV_BYTES >> 20
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod model_size_tests {
+    use super::*;
+
+    #[test]
+    fn model_and_sample_numbers_name_value_and_limit() {
+        assert_eq!(MAX_MODEL_NUMBERS, 1_048_576);
+        assert!(model_numbers(MAX_MODEL_NUMBERS, "A").is_ok());
+        let e = model_numbers(9_000_000, "`plant.A` of shape (3000, 3000)").unwrap_err().to_string();
+        assert!(e.contains("9000000 numbers (`plant.A` of shape (3000, 3000))") && e.contains("limit 1048576"), "{e}");
+        assert!(sample_numbers(MAX_SAMPLE_NUMBERS, "t").is_ok());
+        assert!(sample_numbers(MAX_SAMPLE_NUMBERS + 1, "t").unwrap_err().to_string().contains("input samples"));
     }
 }

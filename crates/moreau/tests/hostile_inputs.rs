@@ -424,3 +424,187 @@ fn a_closed_stdout_ends_quietly() {
     assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
     assert_eq!(o.status.code(), Some(141), "128 + SIGPIPE; stderr: {err}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 31 item 7: inputs that were silently accepted or answered with contradictory messages.
+// Each case below was accepted (or misleading) before its fix.
+
+/// The worked example with `from` replaced by `to` (the replacement must happen).
+fn worked_with(from: &str, to: &str) -> String {
+    let w = worked();
+    assert!(w.contains(from), "{from}");
+    w.replacen(from, to, 1)
+}
+
+/// `convergence` on a non-Hurwitz loop printed a "fitted order 0.957" from errors of 9e15;
+/// on a csv input it said "needs ... zero, sine, square or csv; got csv".
+#[test]
+fn convergence_refuses_unstable_loops_and_names_the_inputs_it_takes() {
+    let d = workdir();
+    let p = d.path();
+    put(p, "u.toml", &worked_with("[-2.0, -0.6]", "[-2.0, 0.6]"));
+    let o = moreau_in(p, &["convergence", "u.toml", "--levels", "2", "--periods", "1"]);
+    assert_refused(&o, &["u.toml", "not Hurwitz", "eigenvalue 0.3 + 0.953939i", "real part 0.3"]);
+    assert!(o.stdout.is_empty(), "no table, no fitted order");
+    put(p, "w.csv", "t,w\n0,0\n1,1\n2,0\n");
+    put(
+        p,
+        "c.toml",
+        &worked_with("kind = \"sine\"\namplitudes = [1.0]\nomega = 1.0", "kind = \"csv\"\nfile = \"w.csv\""),
+    );
+    let o = moreau_in(p, &["convergence", "c.toml"]);
+    assert_refused(&o, &["c.toml", "needs an input of kind zero or sine", "input is `csv`"]);
+    // the same text from the integrator itself (simulate --integrator event)
+    let o = moreau_in(p, &["simulate", "c.toml", "--integrator", "event", "--out", "sim"]);
+    assert_refused(&o, &["zero or sine", "got csv"]);
+    // control: the stable worked example still gives its table
+    let o = moreau_in(p, &["convergence", "w.toml", "--levels", "2", "--periods", "1"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("fitted order"));
+}
+
+/// A CSV input stated `period = 1e12` for 6.28 s of data (accepted by `theta`), a header
+/// `t,wfoo` was read as `t,w`, and a polytope with an empty interior was accepted.
+#[test]
+fn csv_periods_headers_and_degenerate_polytopes_are_refused() {
+    let d = workdir();
+    let p = d.path();
+    let samples: String = (0..=100).map(|k| format!("{},{}\n", k as f64 * 0.0628, (k as f64 * 0.0628).sin())).collect();
+    put(p, "w.csv", &format!("t,w\n{samples}"));
+    let csv_input = |period: &str| {
+        worked_with(
+            "kind = \"sine\"\namplitudes = [1.0]\nomega = 1.0",
+            &format!("kind = \"csv\"\nfile = \"w.csv\"\n{period}"),
+        )
+    };
+    put(p, "m.toml", &csv_input("period = 1e12"));
+    let o = moreau_in(p, &["theta", "m.toml", "--no-measure"]);
+    assert_refused(&o, &["m.toml", "input.period", "1000000000000", "span 6.28"]);
+    put(p, "w2.csv", &format!("t,wfoo\n{samples}"));
+    put(p, "h.toml", &csv_input("").replace("w.csv", "w2.csv"));
+    let o = moreau_in(p, &["validate", "h.toml"]);
+    assert_refused(&o, &["w2.csv", "header `t,wfoo`", "`t,w` or `t,w1`"]);
+    let poly = std::fs::read_to_string(root().join("examples/polytope-p2.toml")).unwrap();
+    let start = poly.find("[theta]").unwrap();
+    let end = poly.find("[input]").unwrap();
+    let flat = format!(
+        "{}[theta]\nshape = \"box\"\nlower = [0.0, -0.1]\nupper = [0.0, 0.1]\n\n{}",
+        &poly[..start],
+        &poly[end..]
+    );
+    put(p, "flat.toml", &flat);
+    let o = moreau_in(p, &["validate", "flat.toml"]);
+    assert_refused(&o, &["flat.toml", "empty interior", "width across half-space 0"]);
+    // control: the hexagon itself
+    put(p, "hex.toml", &poly);
+    assert!(moreau_in(p, &["validate", "hex.toml"]).status.success());
+}
+
+/// The stand config accepted `home_tolerance = -5`, `min_segment_samples = 0` and unknown keys.
+#[test]
+fn play_width_configs_refuse_bad_ranges_and_unknown_keys() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let data = root().join("data/robonine-backlash/logs/motor_telemetry_single.csv");
+    let cfg = std::fs::read_to_string(root().join("data/robonine-backlash/analysis_config_m5.json")).unwrap();
+    for (from, to, needles) in [
+        ("\"home_tolerance\": 5", "\"home_tolerance\": -5", vec!["cfg.json", "home_tolerance -5"]),
+        ("\"min_segment_samples\": 10", "\"min_segment_samples\": 0", vec!["cfg.json", "min_segment_samples 0"]),
+        ("\"home_tolerance\": 5", "\"home_tolerance\": 5, \"colour\": 1", vec!["cfg.json", "unknown field `colour`"]),
+    ] {
+        assert!(cfg.contains(from));
+        put(p, "cfg.json", &cfg.replacen(from, to, 1));
+        let o = moreau_in(p, &["play-width", "--data", data.to_str().unwrap(), "--config", "cfg.json"]);
+        assert_refused(&o, &needles);
+    }
+}
+
+/// `merge DIR` read only `sweep*.json` and left a conflicting `extra.json` out unseen.
+#[test]
+fn merge_of_a_folder_refuses_a_conflicting_extra_json() {
+    let d = workdir();
+    let p = d.path();
+    put(p, "s.toml", &spec("values = [1.0, 2.0]", "measure = false"));
+    for k in ["0/2", "1/2"] {
+        let o = moreau_in(p, &["sweep", "s.toml", "--out", "shards", "-q", "--shard", k]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let o = moreau_in(p, &["merge", "shards", "--out", "merged"]);
+    assert!(o.status.success(), "control: {}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(p.join("shards/sweep-shard-0-of-2.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["points"][0]["values"][0] = serde_json::json!(123.0);
+    put(&p.join("shards"), "extra.json", &serde_json::to_string(&v).unwrap());
+    let o = moreau_in(p, &["merge", "shards", "--out", "merged2"]);
+    assert_refused(&o, &["point 0 differs", "extra.json", "sweep-shard-0-of-2.json"]);
+    put(&p.join("shards"), "extra.json", "{\"note\": 1}");
+    let o = moreau_in(p, &["merge", "shards", "--out", "merged2"]);
+    assert_refused(&o, &["extra.json", "not a moreau sweep result"]);
+    assert!(!p.join("merged2").exists());
+}
+
+/// `discover-bench --json <unwritable>` failed only after the benchmark; `--allow-large` was
+/// advised when it had been given.
+#[test]
+fn outputs_are_checked_before_the_work_and_messages_do_not_contradict() {
+    let d = workdir();
+    let p = d.path();
+    put(p, "file.txt", "x");
+    std::fs::create_dir(p.join("dir.json")).unwrap();
+    for (out, needle) in [("file.txt/out.json", "file.txt is not a directory"), ("dir.json", "is a directory")] {
+        let o = moreau_in(p, &["discover-bench", "--cases", "1", "--classes", "none", "--json", out]);
+        // one line on stderr: no case was run (each prints a progress line) and no table
+        assert_refused(&o, &[out, needle]);
+        assert!(o.stdout.is_empty());
+    }
+    put(p, "s.toml", &spec("range = { from = 1.0, to = 2.0, count = 20000000 }", "measure = false"));
+    let o = moreau_in(p, &["sweep", "s.toml", "--out", "out", "-q", "--allow-large"]);
+    assert_refused(&o, &["20000000", "limit 10000000", "the hard limit"]);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("pass --allow-large"));
+    let o = moreau_in(p, &["sweep", "s.toml", "--out", "out", "-q"]);
+    assert_refused(&o, &["20000000", "limit 1000000;", "pass --allow-large"]);
+}
+
+/// `import` wrote models that `validate` refused: a fast sine (`--omega 1e4` with the default
+/// step 1e-3) and a `csv` input named relative to the working directory.
+#[test]
+fn import_writes_only_models_that_validate_accepts() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    std::fs::create_dir(p.join("js")).unwrap();
+    let ss = r#"{"A": [[0.0, 1.0], [-2.0, -0.6]], "B": [[0.0], [1.0]], "C": [[1.0, 0.0]], "E": [[0.0], [1.0]]"#;
+    put(p, "ss.json", &format!("{ss}}}"));
+    let o = moreau_in(
+        p,
+        &["import", "ss.json", "--out", "fast.toml", "--interval", "0.1", "--sine", "1", "--omega", "1e4"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = moreau_in(p, &["validate", "fast.toml"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    put(&p.join("js"), "w.csv", "t,w\n0,0\n1,1\n2,0\n");
+    put(
+        &p.join("js"),
+        "ss.json",
+        &format!(
+            r#"{ss}, "theta": {{"shape": "interval", "half_width": 0.1}}, "input": {{"kind": "csv", "file": "w.csv"}}}}"#
+        ),
+    );
+    for out in ["m.toml", "js/m.toml", "new/m.toml"] {
+        let o = moreau_in(p, &["import", "js/ss.json", "--out", out]);
+        assert!(o.status.success(), "{out}: {}", String::from_utf8_lossy(&o.stderr));
+        let o = moreau_in(p, &["validate", out]);
+        assert!(o.status.success(), "{out}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    // a model larger than a model file may be is refused, and nothing is written
+    let n = 1300;
+    let row = |i: usize| {
+        format!("[{}]", (0..n).map(|j| if i == j { "-1.0" } else { "0.123456789012" }).collect::<Vec<_>>().join(","))
+    };
+    let a: Vec<String> = (0..n).map(row).collect();
+    let col = vec!["[1.0]"; n].join(",");
+    let c = format!("[[1.0{}]]", ",0.0".repeat(n - 1));
+    put(p, "big.json", &format!(r#"{{"A": [{}], "B": [{col}], "C": {c}, "E": [{col}]}}"#, a.join(",")));
+    let o = moreau_in(p, &["import", "big.json", "--out", "big.toml", "--interval", "0.1", "--sine", "1"]);
+    assert_refused(&o, &["big.json", "bytes, more than the 16777216 a model file may have"]);
+    assert!(!p.join("big.toml").exists());
+}

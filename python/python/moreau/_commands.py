@@ -31,6 +31,16 @@ __all__ = [
 ]
 
 
+def _count(name: str, v: Any) -> int:
+    """A whole count (``periods``, ``pairs``) as an int: ``periods=2.5`` is refused naming the
+    argument (the CLI's ``--periods`` takes whole numbers), ``3.0`` is 3."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer, float, np.floating)):
+        raise TypeError(f"`{name}` must be a whole number, got {type(v).__name__}")
+    if isinstance(v, (float, np.floating)) and not float(v).is_integer():
+        raise MoreauError(f"`{name}` = {v}: must be a whole number")
+    return int(v)
+
+
 def _f64(b: bytes, shape: Any) -> np.ndarray:
     return np.frombuffer(b, dtype="<f8").reshape(shape).copy()
 
@@ -75,7 +85,12 @@ def simulate(
     ``max_rows`` keeps every k-th step (default: every step).
     """
     n, m, p, method, h, cols = _native.simulate(
-        _native_model(model), periods=periods, dt=dt, t_end=t_end, integrator=integrator, max_rows=max_rows
+        _native_model(model),
+        periods=None if periods is None else _count("periods", periods),
+        dt=dt,
+        t_end=t_end,
+        integrator=integrator,
+        max_rows=max_rows,
     )
     t = _f64(cols["t"], (-1,))
     k = len(t)
@@ -95,7 +110,9 @@ def simulate(
 def periodic(model: Model, *, dt: Optional[float] = None, periods: int = 60, pairs: int = 3) -> Dict[str, Any]:
     """The periodic regime (Poincare fixed point, residual, (loc) check) and the measured
     convergence exponent: ``moreau periodic FILE --json`` (same keys)."""
-    return json.loads(_native.periodic(_native_model(model), dt=dt, periods=periods, pairs=pairs))
+    return json.loads(
+        _native.periodic(_native_model(model), dt=dt, periods=_count("periods", periods), pairs=_count("pairs", pairs))
+    )
 
 
 class CheckResult(Dict[str, Any]):
@@ -146,7 +163,12 @@ def _recording_text(model: Model, rec: Any) -> str:
     ``t, w1..wm, y1..yp`` and optionally ``z1..zp`` (m and p from the model)."""
     if hasattr(rec, "to_csv") and hasattr(rec, "columns"):
         return str(rec.to_csv(index=False))
-    a = np.asarray(rec, dtype=float)
+    if rec is None:
+        raise TypeError("`recording` is missing (None): expected a path, CSV text, a DataFrame or an array")
+    a0 = np.asarray(rec)
+    if np.iscomplexobj(a0):
+        raise TypeError(f"`recording` is complex (dtype {a0.dtype}): recordings are real; the imaginary part would be dropped")
+    a = a0.astype(float)
     if a.ndim != 2:
         raise MoreauError(f"recording: expected a 2-D array (samples x columns t, w, y), got shape {a.shape}")
     sysm = model if isinstance(model, System) else System.load(model)

@@ -36,8 +36,33 @@ __all__ = [
 ]
 
 
+def _real_array(key: str, v: ArrayLike, what: str) -> np.ndarray:
+    """``v`` as a float64 array: refuses None (a missing argument), complex entries (the
+    imaginary part would be dropped) and None entries (they would become NaN), and checks the
+    model-size budget of the CLI before the array is converted further."""
+    if v is None:
+        raise TypeError(f"`{key}` is missing (None): expected {what}")
+    try:
+        a = np.asarray(v)
+    except (ValueError, TypeError) as e:
+        raise MoreauError(f"key `{key}`: expected {what}: {e}") from None
+    if np.iscomplexobj(a):
+        raise TypeError(f"`{key}` is complex (dtype {a.dtype}): expected real numbers; the imaginary part would be dropped")
+    if a.dtype == object:
+        flat = a.ravel()
+        if any(x is None for x in flat):
+            raise TypeError(f"`{key}` has a None entry: expected {what} of numbers")
+        if any(isinstance(x, complex) for x in flat):
+            raise TypeError(f"`{key}` has a complex entry: expected real numbers; the imaginary part would be dropped")
+    _native.check_model_numbers(int(a.size), f"`{key}` of shape {a.shape}")
+    try:
+        return a.astype(float)
+    except (ValueError, TypeError) as e:
+        raise MoreauError(f"key `{key}`: expected {what}: {e}") from None
+
+
 def _vector(key: str, v: ArrayLike) -> List[float]:
-    a = np.asarray(v, dtype=float)
+    a = _real_array(key, v, "a vector")
     if a.ndim == 0:
         a = a.reshape(1)
     if a.ndim != 1:
@@ -46,10 +71,7 @@ def _vector(key: str, v: ArrayLike) -> List[float]:
 
 
 def _matrix(key: str, m: ArrayLike) -> List[List[float]]:
-    try:
-        a = np.asarray(m, dtype=float)
-    except (ValueError, TypeError) as e:
-        raise MoreauError(f"key `{key}`: expected a matrix (a 2-D array or a list of equally long rows): {e}") from None
+    a = _real_array(key, m, "a matrix (a 2-D array or a list of equally long rows)")
     if a.ndim == 0:
         a = a.reshape(1, 1)
     if a.ndim != 2:
@@ -58,6 +80,33 @@ def _matrix(key: str, m: ArrayLike) -> List[List[float]]:
             "write a column as [[a], [b]] or use numpy's reshape(-1, 1)"
         )
     return [[float(x) for x in row] for row in a]
+
+
+def _real(key: str, x: Any) -> float:
+    """A real number: None (missing) and complex values are refused, not turned into NaN or
+    stripped of their imaginary part."""
+    if x is None:
+        raise TypeError(f"`{key}` is missing (None): expected a real number")
+    if np.iscomplexobj(x):
+        raise TypeError(f"`{key}` = {x!r} is complex: expected a real number (the imaginary part would be dropped)")
+    try:
+        return float(x)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"`{key}`: expected a real number, got {type(x).__name__} ({e})") from None
+
+
+def _whole(key: str, v: Any) -> Any:
+    """An integral count as an int; anything else unchanged, for the model-file reader to
+    refuse with the file's message (``periods=2.5`` is not truncated to 2)."""
+    if isinstance(v, (bool, np.bool_)):
+        return v
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)) and float(v).is_integer():
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v)
+    raise TypeError(f"`{key}` must be an integer, got {type(v).__name__}")
 
 
 def _describe_set(table: Dict[str, Any], p: int) -> "_native.System":
@@ -119,9 +168,9 @@ class Interval(Set):
 
     def __init__(self, a: float, b: Optional[float] = None) -> None:
         if b is None:
-            super().__init__({"shape": "interval", "half_width": float(a)}, 1)
+            super().__init__({"shape": "interval", "half_width": _real("theta.half_width", a)}, 1)
         else:
-            super().__init__({"shape": "interval", "lo": float(a), "hi": float(b)}, 1)
+            super().__init__({"shape": "interval", "lo": _real("theta.lo", a), "hi": _real("theta.hi", b)}, 1)
 
 
 class Ball(Set):
@@ -129,7 +178,7 @@ class Ball(Set):
 
     def __init__(self, radius: float, centre: Optional[ArrayLike] = None) -> None:
         c = None if centre is None else _vector("theta.centre", centre)
-        super().__init__({"shape": "ball", "radius": float(radius), "centre": c}, None if c is None else len(c))
+        super().__init__({"shape": "ball", "radius": _real("theta.radius", radius), "centre": c}, None if c is None else len(c))
 
 
 class Ellipsoid(Set):
@@ -203,14 +252,14 @@ class Sine(Input):
     """``w_i(t) = a_i sin(omega t + phase)``, period ``2 pi / omega``."""
 
     def __init__(self, amplitudes: ArrayLike, omega: float, phase: float = 0.0) -> None:
-        super().__init__({"kind": "sine", "amplitudes": _vector("input.amplitudes", amplitudes), "omega": float(omega), "phase": float(phase)})
+        super().__init__({"kind": "sine", "amplitudes": _vector("input.amplitudes", amplitudes), "omega": _real("input.omega", omega), "phase": _real("input.phase", phase)})
 
 
 class Square(Input):
     """``w_i(t) = a_i sign(sin(omega t + phase))``, period ``2 pi / omega``."""
 
     def __init__(self, amplitudes: ArrayLike, omega: float, phase: float = 0.0) -> None:
-        super().__init__({"kind": "square", "amplitudes": _vector("input.amplitudes", amplitudes), "omega": float(omega), "phase": float(phase)})
+        super().__init__({"kind": "square", "amplitudes": _vector("input.amplitudes", amplitudes), "omega": _real("input.omega", omega), "phase": _real("input.phase", phase)})
 
 
 class Zero(Input):
@@ -218,6 +267,18 @@ class Zero(Input):
 
     def __init__(self) -> None:
         super().__init__({"kind": "zero"})
+
+
+def _real_sample_array(key: str, v: ArrayLike) -> np.ndarray:
+    """Sample values as float64: None and complex values are refused (as in ``_real_array``)."""
+    if v is None:
+        raise TypeError(f"input samples `{key}` is None: expected an array")
+    a = np.asarray(v)
+    if np.iscomplexobj(a) or (a.dtype == object and any(isinstance(x, complex) for x in a.ravel())):
+        raise TypeError(f"input samples `{key}` are complex: the input is real; the imaginary part would be dropped")
+    if a.dtype == object and any(x is None for x in a.ravel()):
+        raise TypeError(f"input samples `{key}` have a None entry")
+    return a.astype(float)
 
 
 class Samples(Input):
@@ -228,14 +289,16 @@ class Samples(Input):
 
     def __init__(self, t: ArrayLike, w: ArrayLike, period: Optional[float] = None, name: str = "<samples>") -> None:
         super().__init__({"kind": "samples"})
-        self.t = np.asarray(t, dtype=float).ravel()
-        wa = np.asarray(w, dtype=float)
+        ta = _real_sample_array(f"{name}: t", t)
+        wa = _real_sample_array(f"{name}: w", w)
+        _native.check_sample_numbers(int(ta.size + wa.size), f"t and w of {name}")
+        self.t = ta.ravel()
         if wa.ndim == 1:
             wa = wa.reshape(-1, 1)
         if wa.ndim != 2:
             raise MoreauError(f"input CSV {name}: w must be an array of shape (len(t), m), got shape {wa.shape}")
         self.w = wa
-        self.period = None if period is None else float(period)
+        self.period = None if period is None else _real("input.period", period)
         self.name = name
 
     def _spec(self) -> Tuple[List[float], List[List[float]], Optional[float], str]:
@@ -298,11 +361,11 @@ class System:
             table["initial"] = initial
         sim: Dict[str, Any] = {}
         if dt is not None:
-            sim["dt"] = float(dt)
+            sim["dt"] = _real("simulation.dt", dt)
         if periods is not None:
-            sim["periods"] = int(periods)
+            sim["periods"] = _whole("simulation.periods", periods)
         if t_end is not None:
-            sim["t_end"] = float(t_end)
+            sim["t_end"] = _real("simulation.t_end", t_end)
         if sim:
             table["simulation"] = sim
         if effects:
@@ -344,7 +407,7 @@ class System:
             if not hasattr(ss, k):
                 raise TypeError(f"from_statespace needs an object with attributes A, B, C (a state-space model); {type(ss).__name__} has no {k}")
         D = getattr(ss, "D", None)
-        if D is not None and np.size(D) and np.any(np.asarray(D, dtype=float) != 0):
+        if D is not None and np.size(D) and np.any(_real_array("D", D, "a matrix") != 0):
             raise MoreauError(
                 "the state-space model has a direct feedthrough D != 0; the loop of the paper has y = C x (D = 0)"
             )

@@ -69,8 +69,9 @@ pub fn check_text(text: &str, source: &str, time: TimeColumn) -> Result<(), CsvC
         Ok(h) => h.iter().map(String::from).collect(),
         Err(e) => return Err(CsvCheckError::Header { file: file(), reason: e.to_string() }),
     };
+    let mut seen = std::collections::HashMap::with_capacity(header.len());
     for (j, name) in header.iter().enumerate() {
-        if let Some(i) = header[..j].iter().position(|h| h == name) {
+        if let Some(&i) = seen.get(name.as_str()) {
             return Err(CsvCheckError::DuplicateColumn {
                 file: file(),
                 name: name.clone(),
@@ -78,6 +79,7 @@ pub fn check_text(text: &str, source: &str, time: TimeColumn) -> Result<(), CsvC
                 second: j + 1,
             });
         }
+        seen.insert(name.as_str(), j);
     }
     let (tname, numeric) = match time {
         TimeColumn::Numeric(n) => (n, true),

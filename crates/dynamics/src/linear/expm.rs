@@ -9,9 +9,29 @@
 use nalgebra::DMatrix;
 use rounding::{gamma, UNIT_ROUNDOFF};
 
-/// `e^{M}` (scaling and squaring with Pade approximants, nalgebra's `exp`).
+/// Largest 1-norm handed to nalgebra's `exp` directly: it bounds `||M^k||` for k up to 27 to
+/// choose its scaling, and a norm above about 2.6e11 overflows those powers to infinity, which
+/// made the number of squarings `u64::MAX` (a plant entry of 1e60 hung `theta` and `simulate`).
+const EXP_MAX_NORM: f64 = 1e8;
+
+/// `e^{M}` (scaling and squaring with Pade approximants, nalgebra's `exp`). A matrix of 1-norm
+/// above [`EXP_MAX_NORM`] is first scaled by an exact power of two to that norm and the result
+/// squared back (at most about 1000 squarings for any finite matrix); below, nalgebra's own
+/// choice stands unchanged.
 pub fn expm(M: &DMatrix<f64>) -> DMatrix<f64> {
-    M.clone().exp()
+    let norm = (0..M.ncols()).map(|j| M.column(j).iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max);
+    if !norm.is_finite() {
+        return DMatrix::from_element(M.nrows(), M.ncols(), f64::NAN);
+    }
+    if norm <= EXP_MAX_NORM {
+        return M.clone().exp();
+    }
+    let squarings = (norm / EXP_MAX_NORM).log2().ceil() as i32;
+    let mut X = (M * 0.5f64.powi(squarings)).exp();
+    for _ in 0..squarings {
+        X = &X * &X;
+    }
+    X
 }
 
 /// Frobenius norm rounded upward: the computed `sqrt(sum x^2)` has relative error below
@@ -131,6 +151,24 @@ pub fn t_psi(A: &DMatrix<f64>, t: f64) -> DMatrix<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_matrices_end_with_an_answer() {
+        // nalgebra's exp alone does not return for this matrix (its scaling count saturates)
+        let M = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -2e60, -0.6]);
+        let X = expm(&M);
+        assert_eq!(X.shape(), (2, 2));
+        let stiff = DMatrix::from_row_slice(2, 2, &[-1e60, 0.0, 0.0, -1.0]);
+        let X = expm(&stiff);
+        assert_eq!(X[(0, 0)], 0.0);
+        // (the slow mode is lost to rounding at this stiffness: the CLI refuses such plants
+        // by default, see moreau's budget `MAX_PLANT_ENTRY`)
+        assert!((0.0..=1.0).contains(&X[(1, 1)]), "{X}");
+        // below the threshold the result is nalgebra's, bit for bit
+        let small = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -2.0, -0.6]);
+        assert_eq!(expm(&small), small.clone().exp());
+        assert!(expm(&DMatrix::from_element(1, 1, f64::INFINITY))[(0, 0)].is_nan());
+    }
     use approx::assert_relative_eq;
 
     #[test]

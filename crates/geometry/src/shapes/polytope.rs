@@ -19,7 +19,8 @@ pub struct Polytope {
 
 impl Polytope {
     /// `{x : normals[i]^T x <= offsets[i]}`. Checks finiteness, nonzero normals,
-    /// boundedness (no recession direction) and nonemptiness.
+    /// boundedness (no recession direction), nonemptiness and a nonempty interior
+    /// ([`check_full_dimensional`]).
     pub fn new(normals: Vec<Vec<f64>>, offsets: Vec<f64>) -> Result<Self, GeometryError> {
         if normals.is_empty() {
             return Err(GeometryError::NoParts { what: "half-space" });
@@ -107,12 +108,13 @@ impl Polytope {
         if vertices.is_empty() {
             return Err(GeometryError::EmptyPolytope);
         }
+        check_full_dimensional(&normals, &vertices)?;
         let row_norms = normals.iter().map(|a| norm(a)).collect();
         let dev_upper = vertices.iter().map(|v| norm(v)).fold(0.0, f64::max) * (1.0 + 1e-9);
         Ok(Self { normals, offsets, vertices, row_norms, dev_upper })
     }
 
-    /// The box `prod_i [lower_i, upper_i]`.
+    /// The box `prod_i [lower_i, upper_i]` (each `lower_i < upper_i`).
     pub fn from_box(lower: &[f64], upper: &[f64]) -> Result<Self, GeometryError> {
         if lower.len() != upper.len() {
             return Err(GeometryError::DimensionMismatch {
@@ -149,6 +151,34 @@ impl Polytope {
     fn feasible(&self, v: &[f64]) -> bool {
         self.normals.iter().zip(&self.offsets).all(|(a, b)| dot(a, v) <= b + 1e-12 * (1.0 + b.abs()) * norm(a).max(1.0))
     }
+}
+
+/// Width, relative to the diameter, below which a polytope counts as having an empty interior.
+pub const MIN_RELATIVE_WIDTH: f64 = 1e-9;
+
+/// Refuses a polytope with an empty interior (all vertices on a line in R^2, a single point,
+/// a box with `lower_i = upper_i`). A nonempty `{x : A x <= b}` with empty interior has an
+/// implicit equality: a row `i` with `a_i^T x = b_i` on the whole set, so its width across that
+/// row, `(max_v a_i^T v - min_v a_i^T v) / |a_i|` over the vertices, is zero. A width below
+/// [`MIN_RELATIVE_WIDTH`] times the diameter (or a diameter of zero) is refused.
+fn check_full_dimensional(normals: &[Vec<f64>], vertices: &[Vec<f64>]) -> Result<(), GeometryError> {
+    let mut diameter: f64 = 0.0;
+    for (i, u) in vertices.iter().enumerate() {
+        for v in &vertices[i + 1..] {
+            diameter = diameter.max(dist(u, v));
+        }
+    }
+    for (index, a) in normals.iter().enumerate() {
+        let (lo, hi) = vertices
+            .iter()
+            .map(|v| dot(a, v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        let width = (hi - lo) / norm(a);
+        if !(width > MIN_RELATIVE_WIDTH * diameter) || diameter == 0.0 {
+            return Err(GeometryError::DegeneratePolytope { index, width, diameter });
+        }
+    }
+    Ok(())
 }
 
 impl Polytope {

@@ -6,6 +6,7 @@
 //! module parses the arguments and prints the summary.
 use crate::commands::diagnose::{diagnose, write_outputs, DiagnoseOptions, RecordingSource};
 use crate::commands::Source;
+use crate::output::StagedDir;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -55,9 +56,10 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         metric: discovery::diagnose::Metric::parse(&a.metric).unwrap_or_default(),
         refit_nominal: !a.no_refit,
     };
+    let staged = StagedDir::replacing(&a.out)?;
     let run = diagnose(&Source::File(a.model.clone()), &RecordingSource::File(a.data.clone()), &o)?;
     let (r, secs) = (&run.report, run.seconds);
-    write_outputs(r, &a.out)?;
+    write_outputs(r, staged)?;
     println!("{}", r.verdict);
     println!(
         "input hold {}{}; {} sub-step(s) per sample (remaining discretisation error {:.2e} output standard deviations; noise level {}); initial state {}",

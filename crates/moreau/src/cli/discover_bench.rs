@@ -71,6 +71,10 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         st.commit()?;
         return Ok(ExitCode::SUCCESS);
     }
+    // an output that cannot be written is refused now, not after the benchmark
+    if let Some(p) = &a.json {
+        crate::output::check_writable(p)?;
+    }
     let settings = discovery::DiagnoseSettings { estimate_x0: a.estimate_x0, ..Default::default() };
     let r = discovery::bench::run_classes(&classes, a.cases, a.seed, profile, &settings, |c| {
         eprintln!(

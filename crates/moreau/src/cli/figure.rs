@@ -65,6 +65,18 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    // options and the output folder are checked before the work
+    anyhow::ensure!(
+        (200..=8000).contains(&a.width) && (150..=8000).contains(&a.height),
+        "--width {} --height {}: must be within 200..8000 x 150..8000 pixels",
+        a.width,
+        a.height
+    );
+    if let Some(dpi) = a.dpi {
+        figures::canvas::png_size((a.width, a.height), dpi).map_err(anyhow::Error::msg)?;
+    }
+    crate::output::register_input(&a.input);
+    crate::output::check_directory_writable(&a.out)?;
     for (name, v) in [("--t-end", a.t_end), ("--dt", a.dt)] {
         if let Some(v) = v {
             anyhow::ensure!(v > 0.0 && v.is_finite(), "{name} {v}: must be positive and finite");
@@ -140,12 +152,6 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             }
         }
     };
-    anyhow::ensure!(
-        (200..=8000).contains(&a.width) && (150..=8000).contains(&a.height),
-        "--width {} --height {}: must be within 200..8000 x 150..8000 pixels",
-        a.width,
-        a.height
-    );
     let figs: Vec<(String, Figure)> = figs
         .into_iter()
         .map(|(stem, mut f)| {

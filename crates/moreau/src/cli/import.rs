@@ -10,6 +10,7 @@
 //! and written atomically.
 use anyhow::{bail, Context};
 use geometry::{Ball, Interval, Shape};
+use model::error::clip;
 use model::{Input, System};
 use nalgebra::{DMatrix, DVector};
 use std::path::{Path, PathBuf};
@@ -72,13 +73,16 @@ fn matrix_from_json(name: &str, v: &serde_json::Value) -> anyhow::Result<DMatrix
                 serde_json::Value::Array(c) => c
                     .iter()
                     .enumerate()
-                    .map(|(j, x)| x.as_f64().with_context(|| format!("{name}[{i}][{j}] = {x} is not a number")))
+                    .map(|(j, x)| {
+                        x.as_f64()
+                            .with_context(|| format!("{name}[{i}][{j}] = {} is not a number", clip(&x.to_string())))
+                    })
                     .collect::<anyhow::Result<Vec<f64>>>(),
-                other => bail!("{name}[{i}] = {other} is not a list of numbers"),
+                other => bail!("{name}[{i}] = {} is not a list of numbers", clip(&other.to_string())),
             })
             .collect::<anyhow::Result<_>>()?,
         serde_json::Value::Number(x) => vec![vec![x.as_f64().unwrap_or(f64::NAN)]],
-        other => bail!("{name} = {other} is not a matrix (a list of rows)"),
+        other => bail!("{name} = {} is not a matrix (a list of rows)", clip(&other.to_string())),
     };
     let r = rows.len();
     let c = rows.first().map(Vec::len).unwrap_or(0);
@@ -105,15 +109,30 @@ pub fn read_json(text: &str) -> anyhow::Result<StateSpace> {
                     serde_json::from_value(val.clone()).with_context(|| format!("`{k}` is not a table"))?;
                 ss.rest.insert(k.clone(), t);
             }
-            other => bail!("unknown key `{other}` (known: A, B, C, D, E, theta, input)"),
+            other => bail!("unknown key `{}` (known: A, B, C, D, E, theta, input)", clip(other)),
         }
     }
     Ok(ss)
 }
 
+/// Parses a .mat file with `matfile`, whose parser panics on some damaged files (declared
+/// sizes whose product overflows): such a panic is reported as a damaged file, quietly.
+fn parse_mat(bytes: &[u8]) -> anyhow::Result<matfile::MatFile> {
+    const HOW: &str = "in MATLAB save with `save ss.mat A B C -v7` (v7.3/HDF5 files are not read)";
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let parsed = std::panic::catch_unwind(|| matfile::MatFile::parse(bytes));
+    std::panic::set_hook(hook);
+    match parsed {
+        Ok(Ok(mf)) => Ok(mf),
+        Ok(Err(e)) => bail!("not a readable MATLAB v5 .mat file ({e:?}); {HOW}"),
+        Err(_) => bail!("not a readable MATLAB v5 .mat file (damaged: its declared sizes do not fit its data); {HOW}"),
+    }
+}
+
 /// Reads a MATLAB v5 `.mat` file (real double or integer arrays A, B, C, optional D, E).
 pub fn read_mat(bytes: &[u8]) -> anyhow::Result<StateSpace> {
-    let mf = matfile::MatFile::parse(bytes).map_err(|e| anyhow::anyhow!("not a readable MATLAB v5 .mat file ({e:?}); in MATLAB save with `save ss.mat A B C -v7` (v7.3/HDF5 files are not read)"))?;
+    let mf = parse_mat(bytes)?;
     let get = |name: &str| -> anyhow::Result<Option<DMatrix<f64>>> {
         let Some(a) = mf.find_by_name(name) else { return Ok(None) };
         let size = a.size();
@@ -132,6 +151,9 @@ pub fn read_mat(bytes: &[u8]) -> anyhow::Result<StateSpace> {
             matfile::NumericData::Int64 { real, imag: None } => real.iter().map(|&x| x as f64).collect(),
             _ => bail!("{name} is not a real numeric array"),
         };
+        if size[0].checked_mul(size[1]) != Some(data.len()) {
+            bail!("{name} is declared {} x {} but holds {} values: the file is damaged", size[0], size[1], data.len());
+        }
         // MATLAB stores column-major
         Ok(Some(DMatrix::from_column_slice(size[0], size[1], &data)))
     };
@@ -189,6 +211,8 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
         (Some(_), Some(_)) => bail!("the JSON has `input` and --sine was given: use one"),
     };
     let name = a.name.clone().unwrap_or_else(|| format!("imported from {}", a.file.display()));
+    let mut sim = model::SimDefaults::default();
+    sim.dt = step_for(&input, ss.rest.get("input"), sim.dt);
     let sys = System::builder()
         .name(name)
         .A(A)
@@ -199,6 +223,7 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
         .input(input)
         .x0(DVector::zeros(n))
         .z0(DVector::zeros(p))
+        .sim(sim)
         .build()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     if ss.rest.is_empty() {
@@ -210,7 +235,47 @@ pub fn build(ss: StateSpace, a: &Args) -> anyhow::Result<System> {
     for (k, v) in ss.rest {
         t.insert(k, v);
     }
-    model::parse_str(&toml::to_string(&t)?).map_err(|e| anyhow::anyhow!("{e}"))
+    // `csv` inputs are read relative to the state-space file, as a model file reads them
+    let dir = a.file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    model::model_file::parse_str_with(&toml::to_string(&t)?, &a.file.display().to_string(), dir)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// Steps per input period the imported model's `simulation.dt` gives at least (the default
+/// step is kept where it is finer): a fast input (`--omega 1e4`) with the default `1e-3`
+/// would give a model that `validate` refuses (fewer than `MIN_STEPS_PER_PERIOD` steps).
+const IMPORT_STEPS_PER_PERIOD: f64 = 100.0;
+
+/// The step for the imported model: `default`, or the input period over
+/// [`IMPORT_STEPS_PER_PERIOD`] where that is finer. The period comes from the flags' input
+/// or the JSON `input` table (`omega`, or a `csv` input's `period`).
+fn step_for(input: &Input, table: Option<&toml::Value>, default: f64) -> f64 {
+    let num =
+        |k: &str| table.and_then(|t| t.get(k)).and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)));
+    let period = input.period().or_else(|| {
+        num("omega")
+            .filter(|w| w.is_finite() && *w != 0.0)
+            .map(|w| std::f64::consts::TAU / w.abs())
+            .or_else(|| num("period"))
+    });
+    match period {
+        Some(T) if T.is_finite() && T > 0.0 => default.min(T / IMPORT_STEPS_PER_PERIOD),
+        _ => default,
+    }
+}
+
+/// A `csv` input as the written model must name it: a model file reads relative paths from
+/// its own directory, so the samples file is named by its file name when it sits beside the
+/// output, else by its absolute path.
+fn relocate_samples(sys: &mut System, out: &Path) {
+    let Input::Samples { path, .. } = &mut sys.input else { return };
+    let Ok(csv) = std::fs::canonicalize(&*path) else { return };
+    let out_dir = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let beside = std::fs::canonicalize(out_dir).is_ok_and(|d| csv.parent() == Some(d.as_path()));
+    *path = match (beside, csv.file_name()) {
+        (true, Some(name)) => name.to_string_lossy().into_owned(),
+        _ => csv.display().to_string(),
+    };
 }
 
 fn read(path: &Path) -> anyhow::Result<StateSpace> {
@@ -229,10 +294,24 @@ fn read(path: &Path) -> anyhow::Result<StateSpace> {
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     crate::output::register_input(&a.file);
-    crate::output::refuse_input(&a.out)?;
+    crate::output::check_writable(&a.out)?;
     let ss = read(&a.file).with_context(|| a.file.display().to_string())?;
-    let sys = build(ss, a).with_context(|| a.file.display().to_string())?;
+    let mut sys = build(ss, a).with_context(|| a.file.display().to_string())?;
+    relocate_samples(&mut sys, &a.out);
     let text = model::to_toml_string(&sys);
+    // the file must be one that `moreau validate` accepts where it is written
+    if text.len() as u64 > model::files::MAX_MODEL_BYTES {
+        bail!(
+            "{}: the model it gives is {} bytes, more than the {} a model file may have",
+            a.file.display(),
+            text.len(),
+            model::files::MAX_MODEL_BYTES
+        );
+    }
+    let out_dir = a.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    model::model_file::parse_str_with(&text, &a.out.display().to_string(), out_dir).with_context(|| {
+        format!("{}: the model it gives would not validate as {}", a.file.display(), a.out.display())
+    })?;
     crate::output::write_atomic(&a.out, text.as_bytes())?;
     println!(
         "wrote {}: n = {}, m = {}, p = {}, Theta = {}",

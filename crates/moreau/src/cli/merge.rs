@@ -6,7 +6,8 @@ use std::process::ExitCode;
 #[command(after_help = "Examples:
   moreau merge out/shard1 out/shard2 out/shard3 out/shard4 --out out/amplitude")]
 pub struct Args {
-    /// Shard result files (sweep-shard-K-of-N.json) or directories holding them.
+    /// Shard result files (sweep-shard-K-of-N.json) or directories holding them (every
+    /// `*.json` file of a directory is read: each must be a result of the same sweep).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Output directory: sweep.{csv,json,md,tex}.

@@ -16,7 +16,9 @@ pub struct Args {
     #[arg(long)]
     pub data: PathBuf,
     /// Upstream analysis config (`analysis_config_*.json`: home position, tested servos,
-    /// puller relaxed/stretched targets and tolerances).
+    /// puller relaxed/stretched targets and tolerances). Unknown keys are refused; the
+    /// upstream script's `home_tolerance`, `home_motor_ids`, `require_home_position_match` and
+    /// `min_segment_samples` are range-checked but not used (see --min-segment-samples).
     #[arg(long)]
     pub config: PathBuf,
     /// Shortest steady segment (samples).

@@ -38,11 +38,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         integrator: a.integrator,
         max_rows: Some(a.max_rows),
     };
+    let stage = StagedDir::replacing(&a.out)?;
     let Simulation { sys, trajectory: tr, method: what, .. } = simulate(&Source::File(a.file.clone()), &o)?;
     let csv = tr.to_csv(&sys.C);
     let plot = simulation_figure(&sys, &tr, &what);
     let svg = canvas::to_svg(&plot)?;
-    let stage = StagedDir::new(&a.out)?;
     std::fs::write(stage.path("trajectory.csv"), csv)?;
     std::fs::write(stage.path("trajectory.svg"), svg)?;
     canvas::write_png(&plot, &stage.path("trajectory.png"))?;

@@ -142,7 +142,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     // refused before the work, not after it
     crate::output::register_input(&a.file);
     if let Some(out) = &a.out {
-        crate::output::refuse_input(out)?;
+        crate::output::check_writable(out)?;
     }
     let run = theta(&Source::File(a.file.clone()), &o)?;
     let json = serde_json::to_string_pretty(&run.to_json()?)?;

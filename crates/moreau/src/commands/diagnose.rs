@@ -8,6 +8,7 @@ use crate::figures::canvas;
 use crate::output::StagedDir;
 use anyhow::Context;
 use discovery::diagnose::Metric;
+use discovery::recording::TimeColumn;
 use discovery::{DiagnoseSettings, HoldChoice, Recording, Report};
 use std::path::PathBuf;
 
@@ -57,14 +58,22 @@ pub struct DiagnoseRun {
 pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) -> anyhow::Result<DiagnoseRun> {
     let (sys, stated) = match model_src {
         Source::File(p) => {
-            let sys = model::load(p).with_context(|| format!("model {}", p.display()))?;
+            let sys = super::load(p).with_context(|| format!("model {}", p.display()))?;
             (sys, None)
         }
-        Source::Built(s, stated) => ((**s).clone(), Some(*stated)),
+        Source::Built(_, stated) => (model_src.system()?, Some(*stated)),
     };
     let rec = match rec {
-        RecordingSource::File(p) => Recording::load(p)?,
-        RecordingSource::Text { text, source } => Recording::parse_checked(text, source)?,
+        RecordingSource::File(p) => {
+            let text = discovery::recording::read_checked(p, "recording", TimeColumn::Numeric("t"))?;
+            let source = p.display().to_string();
+            crate::budget::recording_rows(&source, &text)?;
+            Recording::parse_str(&text, &source)?
+        }
+        RecordingSource::Text { text, source } => {
+            crate::budget::recording_rows(source, text)?;
+            Recording::parse_checked(text, source)?
+        }
     };
     let stated = match (stated, model_src) {
         (Some(s), _) => s,
@@ -89,10 +98,11 @@ pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) 
     Ok(DiagnoseRun { report, seconds: start.elapsed().as_secs_f64() })
 }
 
-/// Writes every output of a report into `out` atomically.
-pub fn write_outputs(r: &Report, out: &std::path::Path) -> anyhow::Result<()> {
+/// Writes every output of a report into the output directory `st` (made with
+/// [`StagedDir::replacing`] before the work, so the directory is locked during the run),
+/// all files together; the previous run's files there are replaced.
+pub fn write_outputs(r: &Report, st: StagedDir) -> anyhow::Result<()> {
     let figs = crate::figures::diagnosis::figures(r);
-    let st = StagedDir::new(out)?;
     let mut captions = Vec::new();
     for (name, fig) in &figs {
         let svg = canvas::to_svg(fig).with_context(|| format!("figure {name}"))?;

@@ -69,7 +69,10 @@ impl Source {
     pub fn system(&self) -> anyhow::Result<System> {
         match self {
             Source::File(p) => load(p),
-            Source::Built(s, _) => Ok((**s).clone()),
+            Source::Built(s, _) => {
+                crate::budget::plant_entries(s)?;
+                Ok((**s).clone())
+            }
         }
     }
 
@@ -86,7 +89,9 @@ impl Source {
 /// `model::load` with the path as context (as every command reads `FILE`).
 pub fn load(path: &Path) -> anyhow::Result<System> {
     crate::output::register_input(path);
-    model::load(path).with_context(|| path.display().to_string())
+    let sys = model::load(path).with_context(|| path.display().to_string())?;
+    crate::budget::plant_entries(&sys).with_context(|| path.display().to_string())?;
+    Ok(sys)
 }
 
 /// The error and its causes on one line; a cause whose text an outer message already carries
@@ -106,5 +111,40 @@ pub fn one_line(e: &anyhow::Error) -> String {
             _ => parts.push(text),
         }
     }
-    parts.join(": ")
+    clip_message(&parts.join(": "))
+}
+
+/// Longest one-line error printed whole (bytes).
+pub const MAX_ERROR_BYTES: usize = 4000;
+
+/// An error line of bounded size: each word longer than [`model::error::MAX_ECHO`] (a 10 MB
+/// key, header name or cell that a message quotes) is clipped to its start and its length,
+/// and the whole line to [`MAX_ERROR_BYTES`].
+fn clip_message(line: &str) -> String {
+    use model::error::{clip, clip_to, MAX_ECHO};
+    if line.len() <= MAX_ECHO {
+        return line.to_string();
+    }
+    let words: Vec<std::borrow::Cow<str>> = line.split(' ').map(clip).collect();
+    clip_to(&words.join(" "), MAX_ERROR_BYTES).into_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_lines_are_bounded_whatever_they_quote() {
+        let key = "k".repeat(10 << 20);
+        let e = anyhow::anyhow!("recording r.csv: header [\"t\", \"w\", \"{key}\"] lacks column `y`");
+        let line = one_line(&e);
+        assert!(line.len() < 400, "{} bytes", line.len());
+        assert!(line.ends_with("lacks column `y`") && line.contains("bytes in all"), "{line}");
+        let many = (0..100_000).map(|k| format!("\"y{k}\"")).collect::<Vec<_>>().join(", ");
+        let line = one_line(&anyhow::anyhow!("header [{many}]"));
+        assert!(line.len() <= MAX_ERROR_BYTES + 100, "{} bytes", line.len());
+        // negative control: an ordinary message is kept as it is
+        let e = anyhow::anyhow!("key `plant.A`: expected 2 rows, got 3").context("m.toml");
+        assert_eq!(one_line(&e), "m.toml: key `plant.A`: expected 2 rows, got 3");
+    }
 }

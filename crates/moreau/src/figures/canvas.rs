@@ -466,13 +466,16 @@ pub fn to_png_at_dpi(f: &Figure, dpi: f64) -> Result<Vec<u8>, FigureError> {
 
 /// The pixel size of `f` at `dpi`, or the error naming the value.
 fn check_dpi(f: &Figure, dpi: f64) -> Result<(u32, u32), FigureError> {
+    png_size(f.size, dpi).map_err(|reason| FigureError::Draw { figure: f.title.clone(), reason })
+}
+
+/// Pixel size of a PNG of a figure of `size` CSS pixels at `dpi`, or why it is refused
+/// (checked by `figure` before any work, and by the writer).
+pub fn png_size(size: (u32, u32), dpi: f64) -> Result<(u32, u32), String> {
     let scale = dpi / 96.0;
-    let (w, h) = ((f.size.0 as f64 * scale).round(), (f.size.1 as f64 * scale).round());
+    let (w, h) = ((size.0 as f64 * scale).round(), (size.1 as f64 * scale).round());
     if !(scale.is_finite() && scale > 0.0 && w >= 1.0 && h >= 1.0 && w * h <= 1e8) {
-        return Err(FigureError::Draw {
-            figure: f.title.clone(),
-            reason: format!("--dpi {dpi} gives a {w} x {h} pixel image (at most 1e8 pixels; dpi must be positive)"),
-        });
+        return Err(format!("--dpi {dpi} gives a {w} x {h} pixel image (at most 1e8 pixels; dpi must be positive)"));
     }
     Ok((w as u32, h as u32))
 }

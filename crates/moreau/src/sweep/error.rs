@@ -10,17 +10,15 @@ pub enum SweepError {
     Toml { path: PathBuf, message: String },
     #[error("{source}")]
     File { source: model::ModelError },
-    #[error(
-        "{path} is in use by another sweep ({holder}; lock file {lock}): wait for it to finish or choose another --out"
-    )]
-    Locked { path: PathBuf, holder: String, lock: PathBuf },
+    #[error(transparent)]
+    Locked(#[from] crate::output::LockError),
     #[error("cannot merge: {path}: {reason}")]
     MergeGrid { path: PathBuf, reason: String },
     #[error("[evaluate] {key}: {reason}")]
     Evaluate { key: &'static str, reason: String },
     #[error("{path}: missing key `{key}`")]
     MissingKey { path: PathBuf, key: String },
-    #[error("{path}: unknown key `{key}` (allowed: {allowed})")]
+    #[error("{path}: unknown key `{}` (allowed: {allowed})", model::error::clip(key))]
     UnknownKey { path: PathBuf, key: String, allowed: &'static str },
     #[error("{path}: key `{key}` has the wrong type: expected {expected}")]
     WrongType { path: PathBuf, key: String, expected: &'static str },
@@ -46,7 +44,7 @@ pub enum SweepError {
     NotFinite { name: String, value: f64 },
     #[error("axis `{name}`: value {value} gives an invalid model: {source}")]
     InvalidPoint { name: String, value: f64, source: model::ModelError },
-    #[error("the grid has {points} points, more than the limit {limit} (--allow-large raises it to 10^7)")]
+    #[error("the grid has {points} points, more than the limit {limit}{}", points_hint(*limit))]
     TooManyPoints { points: u128, limit: usize },
     #[error("bad shard `{text}`: expected K/N with 0 <= K < N (K counts from 0, e.g. $SLURM_ARRAY_TASK_ID)")]
     BadShard { text: String },
@@ -70,4 +68,14 @@ pub enum SweepError {
     ThreadPool { threads: usize, reason: String },
     #[error("cannot write {path}: {reason}")]
     Write { path: PathBuf, reason: String },
+}
+
+/// What lifts a grid-point limit: `--allow-large` the soft one, nothing the hard one (so the
+/// message never advises `--allow-large` when it was given).
+fn points_hint(limit: usize) -> String {
+    if limit < super::spec::MAX_POINTS {
+        format!("; pass --allow-large to raise it to {}", super::spec::MAX_POINTS)
+    } else {
+        " (the hard limit; --allow-large does not raise it)".to_string()
+    }
 }

@@ -6,8 +6,11 @@ use super::SweepError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Result files named by `inputs`: files as given, directories expanded to their
-/// `sweep*.json` files (sorted by name).
+/// Result files named by `inputs`: files as given, directories expanded to every `*.json`
+/// file in them (sorted by name). Each must then be a result of the same sweep: a JSON file of
+/// another sweep, or no sweep result at all, beside the shards is refused by [`merge`] rather
+/// than left out unseen (a conflicting `extra.json` was once ignored because only `sweep*`
+/// names were read).
 pub fn collect_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, SweepError> {
     let mut files = Vec::new();
     for p in inputs {
@@ -15,11 +18,7 @@ pub fn collect_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, SweepError> {
             let rd = std::fs::read_dir(p).map_err(|source| SweepError::Io { path: p.clone(), source })?;
             let mut found: Vec<PathBuf> = rd
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|f| {
-                    f.file_name()
-                        .and_then(|n| n.to_str())
-                        .is_some_and(|n| n.starts_with("sweep") && n.ends_with(".json"))
-                })
+                .filter(|f| f.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.ends_with(".json")))
                 .collect();
             if found.is_empty() {
                 return Err(SweepError::NothingToMerge { path: p.clone() });

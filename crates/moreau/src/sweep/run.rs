@@ -54,82 +54,6 @@ pub fn stem(shard: Option<Shard>) -> String {
     shard.map(|s| s.stem()).unwrap_or_else(|| "sweep".into())
 }
 
-/// An exclusive lock on one sweep output (`--out` and stem): a second run into the same
-/// output refuses, naming the holder, instead of interleaving checkpoint lines or replacing
-/// the first run's tables. The lock file `.STEM.lock` inside `--out` holds the holder's
-/// process id; the operating system releases the lock when the holder exits (even when
-/// killed), and the file is removed when the run ends or is interrupted.
-pub struct OutLock {
-    path: PathBuf,
-    _file: std::fs::File,
-}
-
-impl OutLock {
-    pub fn acquire(out: &Path, stem: &str) -> Result<Self, SweepError> {
-        use std::io::{Read, Seek};
-        let path = out.join(format!(".{stem}.lock"));
-        let werr = |e: std::io::Error| SweepError::Write { path: path.clone(), reason: e.to_string() };
-        std::fs::create_dir_all(out)
-            .map_err(|e| SweepError::Write { path: out.to_path_buf(), reason: e.to_string() })?;
-        for _ in 0..100 {
-            let mut f = std::fs::OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&path)
-                .map_err(werr)?;
-            match f.try_lock() {
-                Ok(()) => {}
-                Err(std::fs::TryLockError::WouldBlock) => {
-                    let mut holder = String::new();
-                    let _ = f.read_to_string(&mut holder);
-                    let holder = holder.trim();
-                    return Err(SweepError::Locked {
-                        path: out.to_path_buf(),
-                        holder: if holder.is_empty() { "pid unknown".into() } else { holder.to_string() },
-                        lock: path.clone(),
-                    });
-                }
-                Err(std::fs::TryLockError::Error(e)) => return Err(werr(e)),
-            }
-            // the previous holder may have removed the file between our open and lock
-            if !same_file(&f, &path) {
-                continue;
-            }
-            f.set_len(0).map_err(werr)?;
-            f.seek(std::io::SeekFrom::Start(0)).map_err(werr)?;
-            f.write_all(format!("pid {}", std::process::id()).as_bytes()).map_err(werr)?;
-            let _ = f.flush();
-            crate::output::register_cleanup(&path);
-            return Ok(Self { path, _file: f });
-        }
-        Err(SweepError::Write { path, reason: "the lock file keeps being replaced".into() })
-    }
-}
-
-#[cfg(unix)]
-fn same_file(f: &std::fs::File, path: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    match (f.metadata(), std::fs::metadata(path)) {
-        (Ok(a), Ok(b)) => a.ino() == b.ino() && a.dev() == b.dev(),
-        _ => false,
-    }
-}
-
-#[cfg(not(unix))]
-fn same_file(_f: &std::fs::File, path: &Path) -> bool {
-    path.exists()
-}
-
-impl Drop for OutLock {
-    fn drop(&mut self) {
-        // removed while still locked; the lock goes with the file handle right after
-        let _ = std::fs::remove_file(&self.path);
-        crate::output::unregister_cleanup(&self.path);
-    }
-}
-
 fn checkpoint_path(out: &Path, stem: &str) -> PathBuf {
     out.join(format!(".{stem}.checkpoint.jsonl"))
 }
@@ -269,7 +193,7 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
         });
     }
     let stem = stem(opts.shard);
-    let _lock = OutLock::acquire(&opts.out, &stem)?;
+    let _lock = crate::output::DirLock::acquire(&opts.out, &stem, "sweep")?;
     // staging directories of interrupted runs beside `--out`
     crate::output::remove_stale_staging(
         opts.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")),
