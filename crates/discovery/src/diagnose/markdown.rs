@@ -235,7 +235,11 @@ pub(super) fn fmt_opt(v: &[Option<f64>]) -> String {
 
 /// Four significant digits.
 pub(super) fn g4(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+    if x == 0.0 {
+        // log10(0) = -inf: the digit count below would overflow
+        return format!("{x:.0}");
+    }
+    if (1e-3..1e5).contains(&x.abs()) {
         let d = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
         format!("{x:.d$}")
     } else {
@@ -255,4 +259,19 @@ pub(super) fn fmt_units(v: &[f64], units: &[String]) -> String {
 /// Values in scientific notation (4 decimals).
 fn fmt_e(v: &[f64]) -> String {
     v.iter().map(|x| format!("{x:.4e}")).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::g4;
+
+    /// Found by the coverage-guided fuzzer (fuzz/regressions/diagnose/): a refitted nominal
+    /// value of 0 overflowed the digit count (3 - log10(0) as i32) in debug builds.
+    #[test]
+    fn g4_prints_zero() {
+        assert_eq!(g4(0.0), "0");
+        assert_eq!(g4(-0.0), "-0");
+        assert_eq!(g4(1.5), "1.500");
+        assert_eq!(g4(2e-5), "2.000e-5");
+    }
 }
