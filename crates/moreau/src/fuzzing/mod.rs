@@ -29,9 +29,12 @@ pub use commands::{diagnose, simulate, theta};
 pub use outputs::write_output;
 pub use parsers::{import_json, input_csv, model_file, playwidth_config, playwidth_log, recording_csv, sweep_spec};
 
+/// A target body: arbitrary bytes in, nothing out.
+pub type Target = fn(&[u8]);
+
 /// Every target by name (the name of its `fuzz/fuzz_targets/<name>.rs` and of its corpus
 /// folder `fuzz/corpus/<name>/`).
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Target)] = &[
     ("model_file", model_file),
     ("sweep_spec", sweep_spec),
     ("input_csv", input_csv),
