@@ -10,6 +10,8 @@ pub mod budget;
 pub mod cli;
 pub mod commands;
 pub mod figures;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod guidance;
 pub mod output;
 pub mod sweep;

@@ -24,6 +24,14 @@ pub fn register_input(path: &Path) {
     }
 }
 
+/// Forgets every registered input: for a process that runs many commands one after another
+/// (the fuzz targets of `crate::fuzzing`); a command-line run never needs it.
+pub fn forget_inputs() {
+    if let Ok(mut v) = INPUTS.lock() {
+        v.clear();
+    }
+}
+
 /// Refuses an output target that is (or resolves to, through links) an input of the command.
 pub fn refuse_input(path: &Path) -> Result<()> {
     let Ok(m) = std::fs::metadata(path) else { return Ok(()) };
@@ -81,7 +89,8 @@ fn resolve_target(path: &Path) -> Result<Target> {
         bail!("output {} ends with '/', which names a directory: give a file path", path.display());
     }
     let mut p = path.to_path_buf();
-    for _ in 0..MAX_LINKS {
+    // MAX_LINKS links, then the file they lead to
+    for _ in 0..=MAX_LINKS {
         if let Some(fd) = own_descriptor(&p) {
             return Ok(Target::Descriptor(fd));
         }

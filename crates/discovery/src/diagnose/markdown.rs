@@ -236,7 +236,7 @@ pub(super) fn fmt_opt(v: &[Option<f64>]) -> String {
 /// Four significant digits.
 pub(super) fn g4(x: f64) -> String {
     if x == 0.0 {
-        // (log10(0) = -inf: the digit count below overflowed in debug builds)
+        // log10(0) = -inf: the digit count below would overflow
         return format!("{x:.0}");
     }
     if (1e-3..1e5).contains(&x.abs()) {
@@ -262,14 +262,16 @@ fn fmt_e(v: &[f64]) -> String {
 }
 
 #[cfg(test)]
-mod g4_tests {
+mod tests {
     use super::g4;
 
+    /// Found by the coverage-guided fuzzer (fuzz/regressions/diagnose/): a refitted nominal
+    /// value of 0 overflowed the digit count (3 - log10(0) as i32) in debug builds.
     #[test]
-    fn g4_of_zero_and_ordinary_values() {
+    fn g4_prints_zero() {
         assert_eq!(g4(0.0), "0");
-        assert_eq!(g4(1.23456), "1.235");
-        assert_eq!(g4(12345.6), "12346");
-        assert_eq!(g4(1e-5), "1.000e-5");
+        assert_eq!(g4(-0.0), "-0");
+        assert_eq!(g4(1.5), "1.500");
+        assert_eq!(g4(2e-5), "2.000e-5");
     }
 }

@@ -101,12 +101,14 @@ pub fn check_text(text: &str, source: &str, time: TimeColumn) -> Result<(), CsvC
         for (j, cell) in rec.iter().enumerate() {
             if let Ok(x) = cell.parse::<f64>() {
                 if x.is_finite() && x.abs() > MAX_MAGNITUDE {
-                    return Err(CsvCheckError::Overflow { file: file(), row, column: header[j].clone(), value: x });
+                    // a row may be longer than the header (the reader names ragged rows)
+                    let column = header.get(j).cloned().unwrap_or_else(|| format!("#{}", j + 1));
+                    return Err(CsvCheckError::Overflow { file: file(), row, column, value: x });
                 }
             }
         }
-        let Some(it) = it else { continue };
-        let cell = &rec[it];
+        // a row shorter than the time column is named by the reader
+        let Some(cell) = it.and_then(|it| rec.get(it)) else { continue };
         if numeric {
             let Ok(t) = cell.parse::<f64>() else { continue }; // the reader names bad cells
             if let Some(p) = prev_num {
@@ -161,6 +163,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("earlier"), "{e}");
+    }
+
+    /// Found by the coverage-guided fuzzer (fuzz/regressions/recording_csv/): ragged rows of a
+    /// recording (the reader names them) panicked here: a row shorter than the time column
+    /// (`rec[it]`), an over-large cell beyond the header (`header[j]`).
+    #[test]
+    fn ragged_rows_do_not_panic() {
+        let t = TimeColumn::Numeric("t");
+        assert!(check_text("w,t\n0\n", "r", t).is_ok(), "the reader names the short row");
+        let e = check_text("t,w,y\n0,1,2,1e200\n", "r", t).unwrap_err().to_string();
+        assert_eq!(e, "r: row 2, column `#4`: value 1e200 has a magnitude above 1e100");
+        let e = crate::Recording::parse_checked("w,t\n0\n", "r").unwrap_err().to_string();
+        assert!(!e.contains('\n'), "{e}");
     }
 
     #[test]

@@ -34,7 +34,7 @@ pub struct Args {
 
 /// Values of the stand configuration that make no sense: non-finite or negative tolerances,
 /// non-finite targets, both pullers on the same servo, the servo under test among them.
-fn check_config(c: &robonine::StandConfig) -> anyhow::Result<()> {
+pub(crate) fn check_config(c: &robonine::StandConfig) -> anyhow::Result<()> {
     let lim = model::MAX_MAGNITUDE;
     anyhow::ensure!(
         c.home_position.is_finite() && c.home_position.abs() <= lim,

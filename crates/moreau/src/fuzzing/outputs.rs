@@ -1,0 +1,237 @@
+//! The output writer against hostile targets: the bytes choose what the output path names
+//! (nothing, a file, links of every kind, a directory, a FIFO with a reader, a socket, an input
+//! of the command, `/dev/null`, a path below a file), the file name and the content; the
+//! target checks what [`crate::output::write_atomic`] promises and panics when it is broken:
+//! a link, FIFO, socket, device or directory stays what it was, an input keeps its content, a
+//! written file holds exactly the content, nothing else is left in the directory.
+//!
+//! Everything happens in a fresh temporary directory; the only path outside it ever written
+//! is `/dev/null` (directly or through a link).
+use crate::output::{forget_inputs, register_input, write_atomic};
+use std::ffi::OsStr;
+use std::io::Read;
+use std::os::unix::ffi::OsStrExt;
+use std::os::unix::fs::{symlink, FileTypeExt, OpenOptionsExt};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Content written, at most (a FIFO's buffer holds it without a reader thread).
+const MAX_CONTENT: usize = 4096;
+/// `O_NONBLOCK` of Linux (x86, arm): a FIFO's read end opens without waiting for a writer.
+const O_NONBLOCK: i32 = 0o4000;
+
+/// The registry of inputs is process-wide: targets that register or forget inputs hold this.
+pub(super) static REGISTRY: Mutex<()> = Mutex::new(());
+
+/// What the output path names before the write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Nothing,
+    File,
+    LinkToFile,
+    Dangling,
+    LinkLoop,
+    LinkChain(usize),
+    Directory,
+    LinkToDirectory,
+    Fifo,
+    Socket,
+    Input,
+    LinkToInput,
+    DevNull,
+    LinkToDevNull,
+    BelowFile,
+}
+
+impl Kind {
+    fn of(b: u8, depth: u8) -> Self {
+        match b % 15 {
+            0 => Kind::Nothing,
+            1 => Kind::File,
+            2 => Kind::LinkToFile,
+            3 => Kind::Dangling,
+            4 => Kind::LinkLoop,
+            5 => Kind::LinkChain(1 + depth as usize % 45),
+            6 => Kind::Directory,
+            7 => Kind::LinkToDirectory,
+            8 => Kind::Fifo,
+            9 => Kind::Socket,
+            10 => Kind::Input,
+            11 => Kind::LinkToInput,
+            12 => Kind::DevNull,
+            13 => Kind::LinkToDevNull,
+            _ => Kind::BelowFile,
+        }
+    }
+}
+
+/// What kind of file `p` is, links not followed (`None`: nothing there).
+fn kind_of(p: &Path) -> Option<&'static str> {
+    let t = std::fs::symlink_metadata(p).ok()?.file_type();
+    Some(if t.is_symlink() {
+        "symlink"
+    } else if t.is_file() {
+        "file"
+    } else if t.is_dir() {
+        "directory"
+    } else if t.is_fifo() {
+        "fifo"
+    } else if t.is_socket() {
+        "socket"
+    } else if t.is_char_device() {
+        "char device"
+    } else {
+        "other"
+    })
+}
+
+fn names(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok()).map(|e| PathBuf::from(e.file_name())).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The output's file name: the fuzz bytes when they make one path component, else `out`.
+fn file_name(bytes: &[u8]) -> PathBuf {
+    let ok = !bytes.is_empty()
+        && bytes.len() <= 200
+        && !bytes.iter().any(|b| *b == b'/' || *b == 0)
+        && bytes != b"."
+        && bytes != b"..";
+    PathBuf::from(if ok { OsStr::from_bytes(bytes) } else { OsStr::new("out") })
+}
+
+/// Byte 0 chooses the kind, byte 1 the depth of a link chain, byte 2 the length of the file
+/// name taken from the following bytes (0: `out`); the rest is the content.
+pub fn write_output(data: &[u8]) {
+    let _registry = REGISTRY.lock().unwrap_or_else(|e| e.into_inner());
+    let Some((&k, rest)) = data.split_first() else { return };
+    let (depth, rest) = rest.split_first().map_or((0, rest), |(d, r)| (*d, r));
+    let (len, rest) = rest.split_first().map_or((0, rest), |(l, r)| (*l as usize % 32, r));
+    let (name, content) = rest.split_at(len.min(rest.len()));
+    let content = &content[..content.len().min(MAX_CONTENT)];
+    let kind = Kind::of(k, depth);
+    let Ok(root) = super::scratch() else { return };
+    let (fx, d) = (root.path().join("fx"), root.path().join("d"));
+    if std::fs::create_dir(&fx).is_err() || std::fs::create_dir(&d).is_err() {
+        return;
+    }
+    let target = d.join(file_name(name));
+    let real = fx.join("real");
+    let old = b"old content".as_slice();
+    let mut reader = None;
+    let mut _listener = None;
+    let set_up = match kind {
+        Kind::Nothing => Ok(()),
+        Kind::File | Kind::BelowFile => std::fs::write(&target, old),
+        Kind::LinkToFile => std::fs::write(&real, old).and_then(|_| symlink("../fx/real", &target)),
+        Kind::Dangling => symlink("../fx/made", &target),
+        Kind::LinkLoop => symlink("../fx/b", &target)
+            .and_then(|_| symlink("c", fx.join("b")))
+            .and_then(|_| symlink("b", fx.join("c"))),
+        Kind::LinkChain(n) => {
+            // target -> fx/l1 -> fx/l2 -> ... -> fx/l(n-1) -> fx/real: n links
+            let first = if n == 1 { "../fx/real".to_string() } else { "../fx/l1".to_string() };
+            let mut r = std::fs::write(&real, old).and_then(|_| symlink(first, &target));
+            for i in 1..n {
+                let to = if i + 1 == n { "real".to_string() } else { format!("l{}", i + 1) };
+                r = r.and_then(|_| symlink(&to, fx.join(format!("l{i}"))));
+            }
+            r
+        }
+        Kind::Directory => std::fs::create_dir(&target).and_then(|_| std::fs::write(target.join("keep"), old)),
+        Kind::LinkToDirectory => std::fs::create_dir(fx.join("dir")).and_then(|_| symlink("../fx/dir", &target)),
+        Kind::Fifo => {
+            let made = std::process::Command::new("mkfifo").arg(&target).status().is_ok_and(|s| s.success());
+            if !made {
+                return; // no mkfifo here
+            }
+            std::fs::OpenOptions::new().read(true).custom_flags(O_NONBLOCK).open(&target).map(|r| reader = Some(r))
+        }
+        Kind::Socket => std::os::unix::net::UnixListener::bind(&target).map(|l| _listener = Some(l)),
+        Kind::Input => std::fs::write(&target, old).map(|_| register_input(&target)),
+        Kind::LinkToInput => {
+            std::fs::write(&real, old).and_then(|_| symlink("../fx/real", &target)).map(|_| register_input(&real))
+        }
+        Kind::DevNull => return write_dev_null(Path::new("/dev/null"), content),
+        Kind::LinkToDevNull => symlink("/dev/null", &target),
+    };
+    if set_up.is_err() {
+        forget_inputs();
+        return; // e.g. a socket path longer than sun_path
+    }
+    let path = if kind == Kind::BelowFile { target.join("out") } else { target.clone() };
+    let before = kind_of(&target);
+    let r = write_atomic(&path, content);
+    forget_inputs();
+    let after = kind_of(&target);
+    let what = format!("{kind:?} target {}: {r:?}", path.display());
+    // the target keeps its kind (a new file appears only where there was nothing)
+    match kind {
+        Kind::Nothing => assert_eq!(after, Some("file"), "{what}"),
+        _ => assert_eq!(after, before, "{what}: the target changed kind"),
+    }
+    // nothing else is left beside it
+    assert_eq!(names(&d), vec![PathBuf::from(target.file_name().unwrap_or_default())], "{what}: files left");
+    let read = |p: &Path| std::fs::read(p).unwrap_or_default();
+    match kind {
+        Kind::Nothing | Kind::File => {
+            assert!(r.is_ok(), "{what}");
+            assert_eq!(read(&target), content, "{what}");
+        }
+        Kind::LinkToFile => {
+            assert!(r.is_ok(), "{what}");
+            assert_eq!(read(&real), content, "{what}");
+        }
+        Kind::Dangling => {
+            assert!(r.is_ok(), "{what}");
+            assert_eq!(read(&fx.join("made")), content, "{what}");
+        }
+        Kind::LinkChain(n) if n <= 40 => {
+            assert!(r.is_ok(), "{what}");
+            assert_eq!(read(&real), content, "{what}");
+        }
+        Kind::LinkChain(_) => {
+            assert!(r.is_err(), "{what}: a chain of more than 40 links must be refused");
+            assert_eq!(read(&real), old, "{what}");
+        }
+        Kind::LinkLoop | Kind::Socket | Kind::LinkToDirectory | Kind::BelowFile => {
+            assert!(r.is_err(), "{what}");
+        }
+        Kind::Directory => {
+            assert!(r.is_err(), "{what}");
+            assert_eq!(names(&target), vec![PathBuf::from("keep")], "{what}");
+            assert_eq!(read(&target.join("keep")), old, "{what}");
+        }
+        Kind::Fifo => {
+            assert!(r.is_ok(), "{what}");
+            let mut got = Vec::new();
+            if let Some(mut rd) = reader {
+                let _ = rd.read_to_end(&mut got);
+            }
+            assert_eq!(got, content, "{what}: the reader of the FIFO");
+        }
+        Kind::Input => {
+            assert!(r.is_err(), "{what}: an input must not be overwritten");
+            assert_eq!(read(&target), old, "{what}");
+        }
+        Kind::LinkToInput => {
+            assert!(r.is_err(), "{what}: an input must not be overwritten through a link");
+            assert_eq!(read(&real), old, "{what}");
+        }
+        Kind::LinkToDevNull => {
+            assert!(r.is_ok(), "{what}");
+            assert_eq!(kind_of(Path::new("/dev/null")), Some("char device"), "{what}");
+        }
+        Kind::DevNull => unreachable!("returned above"),
+    }
+}
+
+/// `/dev/null` itself: written through, still the device afterwards.
+fn write_dev_null(p: &Path, content: &[u8]) {
+    let r = write_atomic(p, content);
+    assert!(r.is_ok(), "/dev/null: {r:?}");
+    assert_eq!(kind_of(p), Some("char device"), "/dev/null was replaced");
+}
