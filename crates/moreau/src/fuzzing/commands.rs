@@ -86,7 +86,7 @@ pub fn diagnose(data: &[u8]) {
         jackknife_iter: 0,
         max_substeps: 4,
         parallel: false,
-        initial_state: stated.initial_state(&sys),
+        initial_state: crate::commands::initial_state(stated, &sys),
         fit: FitSettings { max_iter_start: 2, max_iter: 4, ..Default::default() },
         ..Default::default()
     };
