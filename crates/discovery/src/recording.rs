@@ -27,6 +27,21 @@ pub enum RecordingError {
     Read(#[from] DiscoveryError),
 }
 
+/// `Some(len - 1)` when the time stamps are regular but for a last interval shorter than the
+/// others (at least 3 intervals before it); `None` otherwise.
+fn short_last_step(t: &[f64]) -> Option<usize> {
+    if t.len() < 5 {
+        return None;
+    }
+    let n = t.len() - 1;
+    let mut d: Vec<f64> = t[..n].windows(2).map(|p| p[1] - p[0]).collect();
+    d.sort_by(f64::total_cmp);
+    let dt = d[d.len() / 2];
+    let regular = d[d.len() - 1] - d[0] <= 0.01 * dt;
+    let last = t[n] - t[n - 1];
+    (regular && last > 0.0 && last < 0.99 * dt).then_some(n)
+}
+
 /// The number with the fewest significant decimal digits within `tol` of `dt` (`dt` itself when
 /// none is closer than `tol` with fewer than 17 digits).
 fn shortest_step(dt: f64, tol: f64) -> f64 {
@@ -245,6 +260,17 @@ impl Recording {
         z: Option<Vec<Vec<f64>>>,
         extra: Vec<(String, Vec<f64>)>,
     ) -> Self {
+        // `moreau simulate --max-rows` keeps every k-th step and the last one: a final interval
+        // shorter than the others is the end of the simulation off the output grid, not an
+        // irregular clock; that row is left out rather than resampling every row
+        if let Some(n) = short_last_step(t) {
+            let keep = |v: Vec<Vec<f64>>| v.into_iter().take(n).collect::<Vec<_>>();
+            let (w, y, z) = (keep(w), keep(y), z.map(keep));
+            let extra = extra.into_iter().map(|(name, v)| (name, v.into_iter().take(n).collect())).collect();
+            let mut r = Self::from_samples_with_extra(source, &t[..n], w, y, z, extra);
+            r.rows_in_file = t.len();
+            return r;
+        }
         let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
         d.sort_by(f64::total_cmp);
         let dt = d[d.len() / 2];
@@ -398,5 +424,26 @@ mod tests {
         let t: Vec<f64> = (0..6000).map(|k| format!("{:e}", k as f64 * h).parse().unwrap()).collect();
         let r = Recording::from_samples("sim", &t, w.clone(), w, None);
         assert!((r.dt - h).abs() <= 1e-15 && r.dt.to_string().len() > 12, "{}", r.dt);
+    }
+
+    #[test]
+    fn a_short_last_step_is_left_out_not_resampled() {
+        // `moreau simulate --periods 1 --max-rows 1000` of the worked example: 6284 steps of h,
+        // every 7th kept and the last one (6284 = 7 * 897 + 5): a final interval of 5 h
+        let h = 9.998703544206852e-4;
+        let mut k: Vec<usize> = (0..=6284).step_by(7).collect();
+        k.push(6284);
+        let t: Vec<f64> = k.iter().map(|&k| format!("{:e}", k as f64 * h).parse().unwrap()).collect();
+        let w: Vec<Vec<f64>> = t.iter().map(|x| vec![x.sin()]).collect();
+        let r = Recording::from_samples("sim", &t, w.clone(), w.clone(), None);
+        assert!(!r.resampled, "simulate's own time stamps are not irregular");
+        assert_eq!((r.len(), r.rows_in_file), (t.len() - 1, t.len()));
+        assert!((r.dt - 7.0 * h).abs() < 1e-12, "{}", r.dt);
+        assert_eq!(r.w[r.len() - 1], w[t.len() - 2]);
+        // negative control: a short interval inside the record is still irregular
+        let mut t2 = t.clone();
+        t2[10] = t2[9] + 0.5 * (t2[11] - t2[9]) * 0.5;
+        let r = Recording::from_samples("sim", &t2, w.clone(), w, None);
+        assert!(r.resampled);
     }
 }
