@@ -27,6 +27,34 @@ pub enum RecordingError {
     Read(#[from] DiscoveryError),
 }
 
+/// `Some(len - 1)` when the time stamps are regular but for a last interval shorter than the
+/// others (at least 3 intervals before it); `None` otherwise.
+fn short_last_step(t: &[f64]) -> Option<usize> {
+    if t.len() < 5 {
+        return None;
+    }
+    let n = t.len() - 1;
+    let mut d: Vec<f64> = t[..n].windows(2).map(|p| p[1] - p[0]).collect();
+    d.sort_by(f64::total_cmp);
+    let dt = d[d.len() / 2];
+    let regular = d[d.len() - 1] - d[0] <= 0.01 * dt;
+    let last = t[n] - t[n - 1];
+    (regular && last > 0.0 && last < 0.99 * dt).then_some(n)
+}
+
+/// The number with the fewest significant decimal digits within `tol` of `dt` (`dt` itself when
+/// none is closer than `tol` with fewer than 17 digits).
+fn shortest_step(dt: f64, tol: f64) -> f64 {
+    for digits in 0..17 {
+        if let Ok(v) = format!("{dt:.digits$e}").parse::<f64>() {
+            if (v - dt).abs() <= tol {
+                return v;
+            }
+        }
+    }
+    dt
+}
+
 /// A recording on a uniform grid `t_k = t0 + k dt`.
 #[derive(Debug, Clone)]
 pub struct Recording {
@@ -215,7 +243,10 @@ impl Recording {
         Ok(Self::from_samples_with_extra(source, &t, w, y, z, extra))
     }
 
-    /// Builds a recording from (possibly irregular) samples; times must increase strictly.
+    /// Builds a recording from (possibly irregular) samples; times must increase strictly. On a
+    /// regular grid the step is the median difference of the time stamps, written with the
+    /// fewest decimal digits within their rounding ([`shortest_step`]): time stamps `k * 0.016`
+    /// printed in shortest form give the step 0.016, not 0.016000000000000014.
     pub fn from_samples(source: &str, t: &[f64], w: Vec<Vec<f64>>, y: Vec<Vec<f64>>, z: Option<Vec<Vec<f64>>>) -> Self {
         Self::from_samples_with_extra(source, t, w, y, z, vec![])
     }
@@ -229,6 +260,17 @@ impl Recording {
         z: Option<Vec<Vec<f64>>>,
         extra: Vec<(String, Vec<f64>)>,
     ) -> Self {
+        // `moreau simulate --max-rows` keeps every k-th step and the last one: a final interval
+        // shorter than the others is the end of the simulation off the output grid, not an
+        // irregular clock; that row is left out rather than resampling every row
+        if let Some(n) = short_last_step(t) {
+            let keep = |v: Vec<Vec<f64>>| v.into_iter().take(n).collect::<Vec<_>>();
+            let (w, y, z) = (keep(w), keep(y), z.map(keep));
+            let extra = extra.into_iter().map(|(name, v)| (name, v.into_iter().take(n).collect())).collect();
+            let mut r = Self::from_samples_with_extra(source, &t[..n], w, y, z, extra);
+            r.rows_in_file = t.len();
+            return r;
+        }
         let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
         d.sort_by(f64::total_cmp);
         let dt = d[d.len() / 2];
@@ -236,6 +278,9 @@ impl Recording {
         let irregular = (hi - lo) > 0.01 * dt;
         let rows_in_file = t.len();
         if !irregular {
+            // a difference of two rounded time stamps is the step only up to their rounding
+            let t_max = t.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
+            let dt = shortest_step(dt, 4.0 * f64::EPSILON * t_max);
             return Self { source: source.into(), t0: t[0], dt, w, y, z, resampled: false, rows_in_file, extra };
         }
         let n = ((t[t.len() - 1] - t[0]) / dt).floor() as usize + 1;
@@ -360,5 +405,45 @@ mod tests {
             "x",
         );
         assert!(ok.is_ok_and(|r| r.resampled));
+    }
+
+    #[test]
+    fn the_step_of_shortest_printed_time_stamps_is_the_stated_step() {
+        // `moreau simulate` writes t_k = k h in shortest form (`{:e}`): the median difference is
+        // 0.016000000000000014, a different f64 from the step 0.016
+        let t: Vec<f64> = (0..6000).map(|k| format!("{:e}", k as f64 * 0.016).parse().unwrap()).collect();
+        let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+        d.sort_by(f64::total_cmp);
+        assert_ne!(d[d.len() / 2], 0.016, "the raw median must show the rounding this test is about");
+        let w: Vec<Vec<f64>> = t.iter().map(|x| vec![x.sin()]).collect();
+        let r = Recording::from_samples("sim", &t, w.clone(), w.clone(), None);
+        assert!(!r.resampled);
+        assert_eq!(r.dt, 0.016);
+        // a step that is not a short decimal is kept as it is (negative control)
+        let h = 9.998703544206852e-4;
+        let t: Vec<f64> = (0..6000).map(|k| format!("{:e}", k as f64 * h).parse().unwrap()).collect();
+        let r = Recording::from_samples("sim", &t, w.clone(), w, None);
+        assert!((r.dt - h).abs() <= 1e-15 && r.dt.to_string().len() > 12, "{}", r.dt);
+    }
+
+    #[test]
+    fn a_short_last_step_is_left_out_not_resampled() {
+        // `moreau simulate --periods 1 --max-rows 1000` of the worked example: 6284 steps of h,
+        // every 7th kept and the last one (6284 = 7 * 897 + 5): a final interval of 5 h
+        let h = 9.998703544206852e-4;
+        let mut k: Vec<usize> = (0..=6284).step_by(7).collect();
+        k.push(6284);
+        let t: Vec<f64> = k.iter().map(|&k| format!("{:e}", k as f64 * h).parse().unwrap()).collect();
+        let w: Vec<Vec<f64>> = t.iter().map(|x| vec![x.sin()]).collect();
+        let r = Recording::from_samples("sim", &t, w.clone(), w.clone(), None);
+        assert!(!r.resampled, "simulate's own time stamps are not irregular");
+        assert_eq!((r.len(), r.rows_in_file), (t.len() - 1, t.len()));
+        assert!((r.dt - 7.0 * h).abs() < 1e-12, "{}", r.dt);
+        assert_eq!(r.w[r.len() - 1], w[t.len() - 2]);
+        // negative control: a short interval inside the record is still irregular
+        let mut t2 = t.clone();
+        t2[10] = t2[9] + 0.5 * (t2[11] - t2[9]) * 0.5;
+        let r = Recording::from_samples("sim", &t2, w.clone(), w, None);
+        assert!(r.resampled);
     }
 }

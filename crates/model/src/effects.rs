@@ -259,63 +259,103 @@ impl Effects {
             .map(|e| {
                 let mut t = Table::new();
                 t.insert("kind".into(), Value::String(e.kind().into()));
-                match e {
-                    Effect::Backlash { width, location } => {
-                        t.insert("width".into(), Value::Float(*width));
-                        t.insert(
-                            "location".into(),
-                            Value::String(if *location == PlayLocation::Loop { "loop" } else { "input" }.into()),
-                        );
-                    }
-                    Effect::GapWidth { relative_change } => {
-                        t.insert("relative_change".into(), Value::Float(*relative_change));
-                    }
-                    Effect::CoulombFriction { state, level } => {
-                        t.insert("state".into(), Value::Integer(*state as i64));
-                        t.insert("level".into(), Value::Float(*level));
-                    }
-                    Effect::ConstantForce { state, force } => {
-                        t.insert("state".into(), Value::Integer(*state as i64));
-                        t.insert("force".into(), Value::Float(*force));
-                    }
-                    Effect::BacklashInertia { mass, damping } => {
-                        t.insert("mass".into(), Value::Float(*mass));
-                        t.insert("damping".into(), Value::Float(*damping));
-                    }
-                    Effect::InputDelay { delay } => {
-                        t.insert("delay".into(), Value::Float(*delay));
-                    }
-                    Effect::InputSaturation { limit } => {
-                        t.insert("limit".into(), Value::Float(*limit));
-                    }
-                    Effect::SensorOffset { offset } => {
-                        t.insert("offset".into(), vec_value(offset));
-                    }
-                    Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
-                        t.insert("state".into(), Value::Integer(*state as i64));
-                        t.insert("level".into(), Value::Float(*level));
-                        t.insert("static_level".into(), Value::Float(*static_level));
-                        t.insert("stribeck_velocity".into(), Value::Float(*stribeck_velocity));
-                        if *viscous != 0.0 {
-                            t.insert("viscous".into(), Value::Float(*viscous));
-                        }
-                    }
-                    Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
-                        t.insert("state".into(), Value::Integer(*state as i64));
-                        t.insert("level_positive".into(), Value::Float(*level_positive));
-                        t.insert("level_negative".into(), Value::Float(*level_negative));
-                    }
-                    Effect::Cogging { state, position_state, amplitude, period, phase } => {
-                        t.insert("state".into(), Value::Integer(*state as i64));
-                        t.insert("position_state".into(), Value::Integer(*position_state as i64));
-                        t.insert("amplitude".into(), Value::Float(*amplitude));
-                        t.insert("period".into(), Value::Float(*period));
-                        t.insert("phase".into(), Value::Float(*phase));
-                    }
+                for (k, v) in e.fields() {
+                    t.insert(k.into(), v);
                 }
                 Value::Table(t)
             })
             .collect();
         Some(Value::Array(items))
+    }
+}
+
+impl Effect {
+    /// The keys and values of the effect's `[[effects]]` table other than `kind`, in the order
+    /// the file format documents them (defaults left out: `viscous = 0`).
+    pub fn fields(&self) -> Vec<(&'static str, Value)> {
+        let int = |i: &usize| Value::Integer(*i as i64);
+        let f = |x: &f64| Value::Float(*x);
+        match self {
+            Effect::Backlash { width, location } => vec![
+                ("width", f(width)),
+                ("location", Value::String(if *location == PlayLocation::Loop { "loop" } else { "input" }.into())),
+            ],
+            Effect::GapWidth { relative_change } => vec![("relative_change", f(relative_change))],
+            Effect::CoulombFriction { state, level } => vec![("state", int(state)), ("level", f(level))],
+            Effect::ConstantForce { state, force } => vec![("state", int(state)), ("force", f(force))],
+            Effect::BacklashInertia { mass, damping } => vec![("mass", f(mass)), ("damping", f(damping))],
+            Effect::InputDelay { delay } => vec![("delay", f(delay))],
+            Effect::InputSaturation { limit } => vec![("limit", f(limit))],
+            Effect::SensorOffset { offset } => vec![("offset", vec_value(offset))],
+            Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
+                let mut v = vec![
+                    ("state", int(state)),
+                    ("level", f(level)),
+                    ("static_level", f(static_level)),
+                    ("stribeck_velocity", f(stribeck_velocity)),
+                ];
+                if *viscous != 0.0 {
+                    v.push(("viscous", f(viscous)));
+                }
+                v
+            }
+            Effect::AsymmetricCoulomb { state, level_positive, level_negative } => vec![
+                ("state", int(state)),
+                ("level_positive", f(level_positive)),
+                ("level_negative", f(level_negative)),
+            ],
+            Effect::Cogging { state, position_state, amplitude, period, phase } => vec![
+                ("state", int(state)),
+                ("position_state", int(position_state)),
+                ("amplitude", f(amplitude)),
+                ("period", f(period)),
+                ("phase", f(phase)),
+            ],
+        }
+    }
+
+    /// The effect in the model file's own words, one line: its `kind` and its keys, e.g.
+    /// `coulomb_friction on state 1, level 0.2` or `input_delay: delay 0.05` (numbers in the
+    /// shortest form that reads back to the same value).
+    pub fn describe(&self) -> String {
+        fn show(v: &Value) -> String {
+            match v {
+                Value::Float(x) => format!("{x}"),
+                Value::Integer(i) => format!("{i}"),
+                Value::String(s) => s.clone(),
+                Value::Array(a) => format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", ")),
+                other => other.to_string(),
+            }
+        }
+        let fields = self.fields();
+        let (state, rest): (Vec<_>, Vec<_>) = fields.iter().partition(|(k, _)| *k == "state");
+        let rest: Vec<String> = rest.iter().map(|(k, v)| format!("{k} {}", show(v))).collect();
+        match state.first() {
+            Some((_, s)) if rest.is_empty() => format!("{} on state {}", self.kind(), show(s)),
+            Some((_, s)) => format!("{} on state {}, {}", self.kind(), show(s), rest.join(", ")),
+            None => format!("{}: {}", self.kind(), rest.join(", ")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod describe_tests {
+    use super::*;
+
+    #[test]
+    fn effects_are_described_in_the_model_files_words() {
+        assert_eq!(
+            Effect::CoulombFriction { state: 1, level: 0.2 }.describe(),
+            "coulomb_friction on state 1, level 0.2"
+        );
+        assert_eq!(Effect::InputDelay { delay: 0.05 }.describe(), "input_delay: delay 0.05");
+        assert_eq!(Effect::SensorOffset { offset: vec![0.1, -2.0] }.describe(), "sensor_offset: offset [0.1, -2]");
+        assert_eq!(
+            Effect::Backlash { width: 0.3, location: PlayLocation::Input }.describe(),
+            "backlash: width 0.3, location input"
+        );
+        // every described key is a key of the file (the parser accepts what describe names)
+        let e = Effect::Cogging { state: 1, position_state: 0, amplitude: 0.5, period: 0.25, phase: 0.0 };
+        assert_eq!(e.describe(), "cogging on state 1, position_state 0, amplitude 0.5, period 0.25, phase 0");
     }
 }

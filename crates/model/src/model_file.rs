@@ -504,8 +504,27 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     if let Some(t) = signals_table(&s.signals) {
         root.insert("signals".into(), Value::Table(t));
     }
-    toml::to_string(&root).expect("a TOML table always serialises")
+    // sections in the order of the file format (the parser's key list and the examples), not
+    // alphabetically as a TOML table would serialise them
+    let mut out = String::new();
+    for k in SECTION_ORDER {
+        if let Some(v) = root.remove(*k) {
+            let mut one = Table::new();
+            one.insert((*k).into(), v);
+            if !out.is_empty() && !out.ends_with("\n\n") {
+                out.push('\n');
+            }
+            out.push_str(&toml::to_string(&one).expect("a TOML table always serialises"));
+        }
+    }
+    debug_assert!(root.is_empty(), "every section of a model file is in SECTION_ORDER");
+    out
 }
+
+/// The top-level keys of a model file in the order files are written (the order of the
+/// examples and of the file-format reference).
+const SECTION_ORDER: &[&str] =
+    &["name", "plant", "theta", "input", "initial", "simulation", "effects", "fit", "signals"];
 
 const FREE_FORM: &str =
     "a nominal parameter `plant.X[row][col]` with X one of A, B, C, E and 0-based indices, e.g. \"plant.A[1][1]\"";

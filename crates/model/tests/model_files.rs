@@ -60,6 +60,18 @@ fn examples_parse_and_round_trip() {
         assert_eq!(s.E, again.E);
         assert_eq!(s.theta, again.theta, "{}", path.display());
         assert_eq!(s.input, again.input);
+        // sections written in the file format's order (the examples' order), not alphabetically
+        let heads = |t: &str| -> Vec<String> {
+            t.lines()
+                .filter(|l| l.starts_with('['))
+                .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string())
+                .collect()
+        };
+        let order = ["plant", "theta", "input", "initial", "simulation", "effects", "fit", "signals"];
+        let rank = |h: &String| order.iter().position(|o| h.split('.').next() == Some(*o)).unwrap();
+        let written = heads(&to_toml_string(&s));
+        assert!(written.windows(2).all(|w| rank(&w[0]) <= rank(&w[1])), "{}: {written:?}", path.display());
+        assert!(to_toml_string(&s).starts_with("name = "), "{}", path.display());
         n += 1;
     }
     assert!(n >= 4, "expected at least 4 example models, found {n}");

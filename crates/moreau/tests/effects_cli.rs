@@ -62,7 +62,15 @@ fn simulate_and_validate_honour_effects() {
     let m = write_model(dir.path(), "offset.toml", offset);
     let n = write_model(dir.path(), "nominal.toml", "");
     let v = ok(&moreau().arg("validate").arg(&m).output().unwrap());
-    assert!(v.contains("SensorOffset") && v.contains("outside the paper's class"), "{v}");
+    // in the model file's words, one per line (not Rust debug syntax)
+    assert!(v.contains("outside the paper's class") && v.contains("\n    sensor_offset: offset [0.25]\n"), "{v}");
+    assert!(!v.contains("SensorOffset") && !v.contains('{'), "{v}");
+    let f = write_model(dir.path(), "friction.toml", &format!("{FRICTION}{offset}"));
+    let v = ok(&moreau().arg("validate").arg(&f).output().unwrap());
+    assert!(
+        v.contains("effects: 2 (outside the paper's class: theta is not a certificate)\n    coulomb_friction on state 1, level 5\n    sensor_offset: offset [0.25]\n"),
+        "{v}"
+    );
     let v0 = ok(&moreau().arg("validate").arg(&n).output().unwrap());
     assert!(v0.contains("effects: none"), "{v0}");
     for (model, out) in [(&m, "sim-offset"), (&n, "sim-nominal")] {

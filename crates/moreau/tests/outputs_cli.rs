@@ -149,3 +149,25 @@ fn huge_plant_entries_need_allow_large() {
     worked(d.path());
     assert!(moreau_in(d.path(), &["validate", "w.toml"]).status.success());
 }
+
+#[test]
+fn simulate_says_when_max_rows_thins_the_trajectory() {
+    let d = tempfile::tempdir().unwrap();
+    worked(d.path());
+    // 1 period of 2 pi at dt ~ 1e-3: 6284 steps, thinned to every 7th by --max-rows 1000
+    let o = moreau_in(d.path(), &["simulate", "w.toml", "--periods", "1", "--max-rows", "1000", "--out", "sim"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = String::from_utf8(o.stdout).unwrap();
+    assert!(line.contains("), kept every 7th of 6,284 steps (--max-rows 1000) -> sim"), "{line}");
+    let rows = std::fs::read_to_string(d.path().join("sim/trajectory.csv")).unwrap().lines().count() - 1;
+    assert!(line.starts_with(&format!("worked example (NOTES.md), a = 1: {rows} samples")), "{line}");
+    // diagnose reads simulate's own time stamps as a regular grid: the short last step (the end
+    // of the simulation off the thinned grid) is left out, nothing is resampled
+    let rec = discovery::recording::Recording::load(&d.path().join("sim/trajectory.csv")).unwrap();
+    assert!(!rec.resampled && rec.rows_in_file == rows && rec.len() == rows - 1, "{} of {rows}", rec.len());
+    // negative control: every step kept, nothing said
+    let o = moreau_in(d.path(), &["simulate", "w.toml", "--periods", "1", "--out", "sim"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = String::from_utf8(o.stdout).unwrap();
+    assert!(!line.contains("kept every") && line.contains("6285 samples"), "{line}");
+}

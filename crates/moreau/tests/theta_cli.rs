@@ -22,7 +22,7 @@ fn readable_report_and_json() {
         "(path1)",
         "(path2)",
         "(stat1)",
-        "Verdict: theta_engaged = ",
+        "Verdict: convergence CERTIFIED; theta_best = theta_engaged = ",
         "theta*",
         "theta_profile",
         "theta_engaged",
@@ -31,6 +31,10 @@ fn readable_report_and_json() {
     ] {
         assert!(s.contains(needle), "missing {needle} in\n{s}");
     }
+    // the verdict leads: before the table's header row
+    let verdict = s.find("Verdict: ").unwrap();
+    let table = s.find("\nsymbol ").expect("the table's header row");
+    assert!(verdict < table, "the verdict must come before the table:\n{s}");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("theta.json");
     let out = moreau()
@@ -94,4 +98,29 @@ fn explain_prints_a_glossary_row_for_every_quantity() {
         .filter(|l| l.contains(" yes ") || l.contains(" no "))
         .count();
     assert!(rows >= 20 && rows >= table_rows, "{rows} glossary rows for {table_rows} table rows");
+}
+
+#[test]
+fn brief_prints_only_the_verdict_block_in_100_columns() {
+    for (file, head) in [
+        ("worked-example.toml", "Verdict: convergence CERTIFIED; theta_best = theta_engaged = "),
+        ("polytope-p2.toml", "Verdict: NOTHING certified; theta_best = theta = "),
+    ] {
+        let out = moreau().args(["theta", &example(file), "--brief", "--no-stationary"]).output().unwrap();
+        assert!(out.status.success(), "{file}: {}", String::from_utf8_lossy(&out.stderr));
+        let s = String::from_utf8(out.stdout).unwrap();
+        assert!(s.starts_with(head), "{file}:\n{s}");
+        let lines: Vec<&str> = s.lines().collect();
+        assert!((2..=8).contains(&lines.len()), "{file}: {} lines:\n{s}", lines.len());
+        assert!(lines.iter().all(|l| l.chars().count() <= 100), "{file}: a line over 100 columns:\n{s}");
+        // no table, no guidance
+        assert!(!s.contains("symbol ") && !s.contains("(ginf)"), "{file}:\n{s}");
+    }
+    // the measured side is part of the block
+    let out = moreau().args(["theta", &example("worked-example.toml"), "--brief"]).output().unwrap();
+    let s = String::from_utf8(out.stdout).unwrap();
+    assert!(s.contains("\nReality: measured exponent "), "{s}");
+    // --brief is readable text only
+    let out = moreau().args(["theta", &example("worked-example.toml"), "--brief", "--json"]).output().unwrap();
+    assert!(!out.status.success());
 }

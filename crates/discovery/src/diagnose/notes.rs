@@ -25,6 +25,9 @@ pub(super) fn selection(
     notes: &mut Vec<String>,
 ) {
     let rec = data.rec;
+    if !rec.resampled && rec.rows_in_file > rec.len() {
+        notes.push(format!("The last of the {} rows, a shorter final step off the uniform grid of dt = {:.6} s (the end of a thinned simulation), was left out.", rec.rows_in_file, data.dt));
+    }
     if rec.resampled {
         notes.push(format!("Irregular time stamps ({} rows) were resampled by linear interpolation to a uniform grid of dt = {:.6} s ({} samples).", rec.rows_in_file, data.dt, data.n_samp));
     }

@@ -13,6 +13,7 @@ use std::process::ExitCode;
 #[command(after_help = "Examples:
   moreau theta examples/worked-example.toml              # readable report, verdict, guidance
   moreau theta examples/worked-example.toml --explain    # plus what every row means
+  moreau theta examples/worked-example.toml --brief      # only the verdict, a few lines
   moreau theta examples/ellipse-p2.toml --json --out theta.json --no-measure")]
 pub struct Args {
     /// Model file (TOML) with a periodic input.
@@ -30,21 +31,119 @@ pub struct Args {
     #[arg(long)]
     pub no_stationary: bool,
     /// After the report, explain every row in plain words (what it is, what to conclude).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "brief")]
     pub explain: bool,
+    /// Print only the verdict block (what is certified, theta_best, whether verified, the
+    /// measured exponent): a few lines of at most 100 columns, without the table.
+    #[arg(long, conflicts_with = "json")]
+    pub brief: bool,
     /// Skip the design guidance printed when nothing is certified (which term blocks,
     /// sensitivities, smallest certifying amplitude: a few dozen bound computations).
     #[arg(long)]
     pub no_guidance: bool,
 }
 
-/// The readable report.
+/// Width of the verdict block (`--brief` and the head of the report).
+const VERDICT_WIDTH: usize = 100;
+
+/// Appends `first` then `text` word-wrapped to [`VERDICT_WIDTH`] columns, continuation lines
+/// indented by two spaces (a word longer than the width stays whole on its line).
+fn push_wrapped(s: &mut String, first: &str, text: &str) {
+    let mut line = String::from(first);
+    let mut empty = true;
+    for word in text.split_whitespace() {
+        if !empty && line.len() + 1 + word.len() > VERDICT_WIDTH {
+            s.push_str(&line);
+            s.push('\n');
+            line = String::from("  ");
+        } else if !empty {
+            line.push(' ');
+        }
+        line.push_str(word);
+        empty = false;
+    }
+    s.push_str(&line);
+    s.push('\n');
+}
+
+/// The verdict block that leads the report and is all of `--brief`: what is certified, the best
+/// bound `theta_best` and whether it is verified, the verdict sentence and the measured side, in
+/// lines of at most [`VERDICT_WIDTH`] columns.
+pub fn render_verdict(rep: &ThetaReport) -> String {
+    let mut s = String::new();
+    let what = if rep.convergence_guaranteed && rep.effects.is_empty() {
+        "convergence CERTIFIED"
+    } else {
+        "NOTHING certified"
+    };
+    s.push_str(&format!(
+        "Verdict: {what}; theta_best = {} = {} ({})\n",
+        rep.theta_best_method,
+        fmt_value(rep.theta_best),
+        if rep.theta_best_verified { "verified bound" } else { "NOT verified" }
+    ));
+    let verdict = if !rep.effects.is_empty() {
+        format!(
+            "theta = {} is the NOMINAL model's bound, NOT verified for this model: its effects ({}) are outside the paper's class; no convergence guarantee.",
+            fmt_value(rep.theta),
+            rep.effects.join(", ")
+        )
+    } else if rep.convergence_guaranteed && rep.theta_best_method != "theta" {
+        format!(
+            "{m} = {} < 0 (verified; paper's theta = {}): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= {m}.",
+            fmt_value(rep.theta_best),
+            fmt_value(rep.theta),
+            m = rep.theta_best_method
+        )
+    } else if rep.convergence_guaranteed {
+        format!(
+            "theta = {} < 0 (verified): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= theta.",
+            fmt_value(rep.theta)
+        )
+    } else if rep.theta < 0.0 {
+        format!("theta = {} < 0 but NOT verified (see the flags in the table): no guarantee.", fmt_value(rep.theta))
+    } else if rep.R.is_infinite() {
+        format!(
+            "theta = psi(0) = {} >= 0: Theta is not strongly convex, and then no certificate of this kind exists (psi(0) >= 0 for every admissible Pi, proofs-notes/psi0.md).",
+            fmt_value(rep.theta)
+        )
+    } else {
+        format!(
+            "theta = {} >= 0: the bound does not guarantee convergence (psi(0) = {}; kappa = gamma_1/gamma_inf = {}; theta < 0 needs psi(0) < kappa lambda/(1 - kappa)).",
+            fmt_value(rep.theta),
+            fmt_value(rep.psi_0),
+            fmt_value(rep.kappa)
+        )
+    };
+    push_wrapped(&mut s, "  ", &verdict);
+    if let Some(m) = &rep.measured {
+        push_wrapped(&mut s, "", &format!(
+            "Reality: measured exponent {} (95% CI [{}, {}]); path length/period {} vs bounds (path) {}, (path1) {}, (path2) {}; limsup |z'| {} vs (zinf) {}, pinned {}.\n",
+            fmt_value(m.rate),
+            fmt_value(m.ci_low),
+            fmt_value(m.ci_high),
+            fmt_value(m.path_length_per_period),
+            fmt_value(rep.path_bound),
+            fmt_value(rep.path1_bound),
+            fmt_value(rep.path2.value),
+            fmt_value(m.limsup_zdot),
+            fmt_value(rep.zdot_bound),
+            fmt_value(rep.zdot_star_bound)
+        ));
+    }
+    s
+}
+
+/// The readable report: the header, the verdict block ([`render_verdict`]), the table of every
+/// quantity, the stationary set and the notes.
 pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
     let mut s = String::new();
     s.push_str(&format!(
         "moreau theta: {}\n  n = {}, m = {}, p = {}, T = {:.6}, Theta = {}\n\n",
         rep.name, rep.n, rep.m, rep.p, rep.period, theta_desc
     ));
+    s.push_str(&render_verdict(rep));
+    s.push('\n');
     s.push_str(&render_table(&rep.quantities()));
     s.push('\n');
     if let Some(st) = &rep.stationary {
@@ -69,55 +168,6 @@ pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
             }
         }
     }
-    let verdict = if !rep.effects.is_empty() {
-        format!(
-            "theta = {} is the NOMINAL model's bound, NOT verified for this model: its effects ({}) are outside the paper's class; no convergence guarantee.",
-            fmt_value(rep.theta),
-            rep.effects.join(", ")
-        )
-    } else if rep.convergence_guaranteed && rep.theta_best_method != "theta" {
-        format!(
-            "{m} = {} < 0 (verified; paper's theta = {}): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= {m}.",
-            fmt_value(rep.theta_best),
-            fmt_value(rep.theta),
-            m = rep.theta_best_method
-        )
-    } else if rep.convergence_guaranteed {
-        format!(
-            "theta = {} < 0 (verified): every trajectory converges to the unique T-periodic regime, Lyapunov exponent <= theta.",
-            fmt_value(rep.theta)
-        )
-    } else if rep.theta < 0.0 {
-        format!("theta = {} < 0 but NOT verified (see the flags above): no guarantee.", fmt_value(rep.theta))
-    } else if rep.R.is_infinite() {
-        format!(
-            "theta = psi(0) = {} >= 0: Theta is not strongly convex, and then no certificate of this kind exists (psi(0) >= 0 for every admissible Pi, proofs-notes/psi0.md).",
-            fmt_value(rep.theta)
-        )
-    } else {
-        format!(
-            "theta = {} >= 0: the bound does not guarantee convergence (psi(0) = {}; kappa = gamma_1/gamma_inf = {}; theta < 0 needs psi(0) < kappa lambda/(1 - kappa)).",
-            fmt_value(rep.theta),
-            fmt_value(rep.psi_0),
-            fmt_value(rep.kappa)
-        )
-    };
-    s.push_str(&format!("\nVerdict: {verdict}\n"));
-    if let Some(m) = &rep.measured {
-        s.push_str(&format!(
-            "Reality: measured exponent {} (95% CI [{}, {}]); path length/period {} vs bounds (path) {}, (path1) {}, (path2) {}; limsup |z'| {} vs (zinf) {}, pinned {}.\n",
-            fmt_value(m.rate),
-            fmt_value(m.ci_low),
-            fmt_value(m.ci_high),
-            fmt_value(m.path_length_per_period),
-            fmt_value(rep.path_bound),
-            fmt_value(rep.path1_bound),
-            fmt_value(rep.path2.value),
-            fmt_value(m.limsup_zdot),
-            fmt_value(rep.zdot_bound),
-            fmt_value(rep.zdot_star_bound)
-        ));
-    }
     for n in &rep.notes {
         s.push_str(&format!("note: {n}\n"));
     }
@@ -138,7 +188,9 @@ pub fn explain(rep: &ThetaReport) -> String {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
-    let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance: !a.no_guidance };
+    // `--brief` prints no guidance: computed only when a JSON object carries it
+    let guidance = !a.no_guidance && (!a.brief || a.out.is_some());
+    let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance };
     // refused before the work, not after it
     crate::output::register_input(&a.file);
     if let Some(out) = &a.out {
@@ -151,6 +203,8 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     if a.json {
         println!("{json}");
+    } else if a.brief {
+        print!("{}", render_verdict(&run.report));
     } else {
         print!("{}", render(&run.report, &run.sys.theta.describe()));
         if let Some(g) = &run.guidance {

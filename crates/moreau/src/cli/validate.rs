@@ -25,8 +25,9 @@ pub fn summary(s: &model::System) -> String {
     let effects = if s.effects.list.is_empty() {
         "none (the paper's class)".to_string()
     } else {
-        let list: Vec<String> = s.effects.list.iter().map(|e| format!("{e:?}")).collect();
-        format!("{} (outside the paper's class: theta is not a certificate)", list.join("; "))
+        // one per line, in the model file's words (`kind` and keys)
+        let list: String = s.effects.list.iter().map(|e| format!("\n    {}", e.describe())).collect();
+        format!("{} (outside the paper's class: theta is not a certificate){list}", s.effects.list.len())
     };
     format!(
         "name:    {}\n  n = {}, m = {}, p = {}\n  Theta:   {}\n  R:       {}\n  eig(F):  {}\n  mu:      {:.6}{}\n  input:   {} (period {per})\n  effects: {effects}\n",

@@ -43,6 +43,9 @@ pub struct Simulation {
     pub method: String,
     /// The step used.
     pub h: f64,
+    /// Steps simulated, and the thinning: every `every`-th step is kept (1: all of them).
+    pub steps: usize,
+    pub every: usize,
 }
 
 /// Validates the options, checks the budgets, simulates.
@@ -132,5 +135,5 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
             (tr, format!("event-driven, {events} events"))
         }
     };
-    Ok(Simulation { sys, trajectory, method, h })
+    Ok(Simulation { sys, trajectory, method, h, steps, every })
 }
