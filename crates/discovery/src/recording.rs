@@ -34,12 +34,18 @@ fn short_last_step(t: &[f64]) -> Option<usize> {
         return None;
     }
     let n = t.len() - 1;
-    let mut d: Vec<f64> = t[..n].windows(2).map(|p| p[1] - p[0]).collect();
-    d.sort_by(f64::total_cmp);
-    let dt = d[d.len() / 2];
-    let regular = d[d.len() - 1] - d[0] <= 0.01 * dt;
+    let (dt, regular) = grid_step(&t[..n]);
     let last = t[n] - t[n - 1];
     (regular && last > 0.0 && last < 0.99 * dt).then_some(n)
+}
+
+/// The median step of time stamps `t` (at least two) and whether they are a regular grid
+/// (every step within 1 % of the median).
+fn grid_step(t: &[f64]) -> (f64, bool) {
+    let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+    d.sort_by(f64::total_cmp);
+    let dt = d[d.len() / 2];
+    (dt, d[d.len() - 1] - d[0] <= 0.01 * dt)
 }
 
 /// The number with the fewest significant decimal digits within `tol` of `dt` (`dt` itself when
@@ -271,13 +277,9 @@ impl Recording {
             r.rows_in_file = t.len();
             return r;
         }
-        let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
-        d.sort_by(f64::total_cmp);
-        let dt = d[d.len() / 2];
-        let (lo, hi) = (d[0], d[d.len() - 1]);
-        let irregular = (hi - lo) > 0.01 * dt;
+        let (dt, regular) = grid_step(t);
         let rows_in_file = t.len();
-        if !irregular {
+        if regular {
             // a difference of two rounded time stamps is the step only up to their rounding
             let t_max = t.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
             let dt = shortest_step(dt, 4.0 * f64::EPSILON * t_max);

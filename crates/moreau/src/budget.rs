@@ -15,6 +15,7 @@
 //! | rows of a recording (`diagnose`) | [`MAX_RECORDING_ROWS`] = 1e6 | [`HARD_MAX_RECORDING_ROWS`] = 5e7 |
 //! | magnitude of a plant entry (`theta`, `simulate`, ...) | [`MAX_PLANT_ENTRY`] = 1e12 | `model::MAX_MAGNITUDE` = 1e100 |
 //! | `theta` state dimension n / backlash dimension p | [`THETA_MAX_N`] / [`THETA_MAX_P`] | - |
+//! | numbers of a model / of input samples built in memory (Python) | - | [`MAX_MODEL_NUMBERS`] / [`MAX_SAMPLE_NUMBERS`] |
 //! | worker threads | the machine's available parallelism (capped with a note) | |
 use anyhow::bail;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -191,6 +192,38 @@ pub fn step(dt: f64, sys: &model::System, t_end: Option<f64>, key: &str) -> anyh
     Ok(())
 }
 
+/// Numbers (matrix and vector entries) of a model built in memory (the Python package's
+/// `System`, `Polytope`, ...): as many as the largest model file the CLI reads holds
+/// ([`model::files::MAX_MODEL_BYTES`], 16 MiB) at 16 bytes a number. A 3000 x 3000 `A` (9e6
+/// numbers, gigabytes once converted) is refused before it is converted. No `--allow-large`
+/// lifts it, as none lifts the model-file limit.
+pub const MAX_MODEL_NUMBERS: u64 = model::files::MAX_MODEL_BYTES / 16;
+/// Numbers of an input given as sample arrays (`t` and `w`): as many as the largest input
+/// CSV ([`model::files::MAX_CSV_BYTES`], 512 MiB) holds at 16 bytes a number.
+pub const MAX_SAMPLE_NUMBERS: u64 = model::files::MAX_CSV_BYTES / 16;
+
+/// Refuses a model of more than [`MAX_MODEL_NUMBERS`] numbers (`detail`: which arrays).
+pub fn model_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    numbers_of_a_file("model", numbers, detail, "model file", model::files::MAX_MODEL_BYTES)
+}
+
+/// Refuses input samples of more than [`MAX_SAMPLE_NUMBERS`] numbers (`detail`: which arrays).
+pub fn sample_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
+    numbers_of_a_file("input samples", numbers, detail, "input CSV", model::files::MAX_CSV_BYTES)
+}
+
+/// Refuses more numbers than the largest `file` (of `bytes`) holds at 16 bytes a number.
+fn numbers_of_a_file(what: &str, numbers: u64, detail: &str, file: &str, bytes: u64) -> anyhow::Result<()> {
+    let limit = bytes / 16;
+    if numbers > limit {
+        bail!(
+            "{what}: {numbers} numbers ({detail}) exceed the limit {limit}, what the largest {file} ({} MiB) holds at 16 bytes a number",
+            bytes >> 20
+        );
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,40 +248,6 @@ mod tests {
         assert!(e.contains("rows: 1000001") && e.contains("--allow-large"), "{e}");
         assert!(threads(100_000).unwrap() >= 1);
     }
-}
-
-// ---- model size of a system built in memory (issue 31 item 8; added by helper Q) ----
-
-/// Numbers (matrix and vector entries) of a model built in memory (the Python package's
-/// `System`, `Polytope`, ...): as many as the largest model file the CLI reads holds
-/// ([`model::files::MAX_MODEL_BYTES`], 16 MiB) at 16 bytes a number. A 3000 x 3000 `A` (9e6
-/// numbers, gigabytes once converted) is refused before it is converted. No `--allow-large`
-/// lifts it, as none lifts the model-file limit.
-pub const MAX_MODEL_NUMBERS: u64 = model::files::MAX_MODEL_BYTES / 16;
-/// Numbers of an input given as sample arrays (`t` and `w`): as many as the largest input
-/// CSV ([`model::files::MAX_CSV_BYTES`], 512 MiB) holds at 16 bytes a number.
-pub const MAX_SAMPLE_NUMBERS: u64 = model::files::MAX_CSV_BYTES / 16;
-
-/// Refuses a model of more than [`MAX_MODEL_NUMBERS`] numbers (`detail`: which arrays).
-pub fn model_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
-    if numbers > MAX_MODEL_NUMBERS {
-        bail!(
-            "model: {numbers} numbers ({detail}) exceed the limit {MAX_MODEL_NUMBERS}, what the largest model file ({} MiB) holds at 16 bytes a number",
-            model::files::MAX_MODEL_BYTES >> 20
-        );
-    }
-    Ok(())
-}
-
-/// Refuses input samples of more than [`MAX_SAMPLE_NUMBERS`] numbers (`detail`: which arrays).
-pub fn sample_numbers(numbers: u64, detail: &str) -> anyhow::Result<()> {
-    if numbers > MAX_SAMPLE_NUMBERS {
-        bail!(
-            "input samples: {numbers} numbers ({detail}) exceed the limit {MAX_SAMPLE_NUMBERS}, what the largest input CSV ({} MiB) holds at 16 bytes a number",
-            model::files::MAX_CSV_BYTES >> 20
-        );
-    }
-    Ok(())
 }
 
 #[cfg(test)]

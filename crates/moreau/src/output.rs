@@ -139,10 +139,8 @@ pub fn check_writable(path: &Path) -> Result<()> {
 /// written, before the work.
 pub fn check_directory_writable(out: &Path) -> Result<()> {
     refuse_non_directory(out)?;
-    if out.is_dir() {
-        return probe_nearest_directory(out, &out.join("probe"));
-    }
-    probe_nearest_directory(out, out)
+    // the nearest existing directory above a file inside `out`: `out` itself when it exists
+    probe_nearest_directory(out, &out.join("probe"))
 }
 
 /// Probes the nearest existing directory above `file` (the writer creates the missing ones
@@ -503,6 +501,10 @@ impl StagedDir {
     /// A staged directory for a fixed set of files (each commit replaces the same names).
     pub fn new(out: &Path) -> Result<Self> {
         refuse_non_directory(out)?;
+        Self::stage_beside(out)
+    }
+    /// The staging directory next to `out` (stale ones of interrupted runs removed first).
+    fn stage_beside(out: &Path) -> Result<Self> {
         let parent = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
         std::fs::create_dir_all(parent).with_context(|| format!("cannot create directory {}", parent.display()))?;
         remove_stale_staging(parent);
@@ -519,7 +521,7 @@ impl StagedDir {
         refuse_non_directory(out)?;
         let created = !out.exists();
         let lock = DirLock::acquire(out, RUN_LOCK, "moreau run")?;
-        let mut staged = Self::new(out)?;
+        let mut staged = Self::stage_beside(out)?;
         staged.lock = Some(lock);
         staged.created = created;
         Ok(staged)

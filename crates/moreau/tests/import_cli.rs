@@ -154,6 +154,11 @@ fn bad_state_space_files_are_named() {
     }
 }
 
+/// `moreau import FILE --interval 0.1 --sine 1.0 --out OUT`.
+fn import_sine(file: &Path, out: &Path) -> std::process::Output {
+    moreau().arg("import").arg(file).args(["--interval", "0.1", "--sine", "1.0", "--out"]).arg(out).output().unwrap()
+}
+
 /// Issue 31 (hostile probe c0634, c0656): a .mat whose declared size does not match its data
 /// panicked in the matrix constructor; a 10 MB JSON value was echoed whole into the error.
 #[test]
@@ -161,13 +166,7 @@ fn damaged_mat_files_and_huge_json_values_are_one_line_errors() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("ss.mat");
     std::fs::write(&mat, mat_v5(&[("A", i32::MAX as usize, i32::MAX as usize, vec![1.0])])).unwrap();
-    let out = moreau()
-        .args(["import"])
-        .arg(&mat)
-        .args(["--interval", "0.1", "--sine", "1.0", "--out"])
-        .arg(dir.path().join("m.toml"))
-        .output()
-        .unwrap();
+    let out = import_sine(&mat, &dir.path().join("m.toml"));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("damaged"), "{err}");
@@ -176,24 +175,12 @@ fn damaged_mat_files_and_huge_json_values_are_one_line_errors() {
     // negative control: the same writer with a consistent size imports
     let one = |name, x| (name, 1, 1, vec![x]);
     std::fs::write(&mat, mat_v5(&[one("A", -1.0), one("B", 1.0), one("C", 1.0), one("E", 0.5)])).unwrap();
-    let ok = moreau()
-        .args(["import"])
-        .arg(&mat)
-        .args(["--interval", "0.1", "--sine", "1.0", "--out"])
-        .arg(dir.path().join("m.toml"))
-        .output()
-        .unwrap();
+    let ok = import_sine(&mat, &dir.path().join("m.toml"));
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
     let json = dir.path().join("ss.json");
     let huge = "v".repeat(10 << 20);
     std::fs::write(&json, format!(r#"{{"A": [[-1.0]], "B": [[1.0]], "C": [[1.0]], "E": "{huge}"}}"#)).unwrap();
-    let out = moreau()
-        .args(["import"])
-        .arg(&json)
-        .args(["--interval", "0.1", "--sine", "1.0", "--out"])
-        .arg(dir.path().join("j.toml"))
-        .output()
-        .unwrap();
+    let out = import_sine(&json, &dir.path().join("j.toml"));
     assert!(!out.status.success());
     assert!(out.stderr.len() < 1000, "{} bytes of error", out.stderr.len());
     assert!(String::from_utf8_lossy(&out.stderr).contains("bytes in all"));
