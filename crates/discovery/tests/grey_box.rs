@@ -86,15 +86,8 @@ fn a_correct_nominal_is_not_refitted_into_another_verdict() {
     for (class, idx) in [("none", 0), ("coulomb_friction", 0)] {
         let case = discovery::bench_gen::generate(class, 11, idx);
         let mut sys = case.nominal.clone();
-        let free = |name: &str, mat, row, col| model::model_file::FreeParam {
-            name: name.into(),
-            matrix: mat,
-            row,
-            col,
-            bounds: None,
-        };
-        use model::model_file::PlantMatrix;
-        sys.fit.free = vec![free("plant.A[1][0]", PlantMatrix::A, 1, 0), free("plant.A[1][1]", PlantMatrix::A, 1, 1)];
+        use model::model_file::{FreeParam, PlantMatrix};
+        sys.fit.free = vec![FreeParam::entry(PlantMatrix::A, 1, 0), FreeParam::entry(PlantMatrix::A, 1, 1)];
         let s = DiagnoseSettings {
             initial_state: Some(discovery::InitialState {
                 x0: case.nominal.x0.iter().copied().collect(),

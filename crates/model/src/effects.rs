@@ -119,6 +119,122 @@ fn positive(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
     Ok(v)
 }
 
+impl Effect {
+    /// One `[[effects]]` table at key `prefix` (e.g. `effects[2]`), checked.
+    fn parse_one(t: &Table, prefix: &str, n: usize, p: usize) -> Result<Self, ModelError> {
+        let prefix = prefix.to_string();
+        let kind = str_at(t, &prefix, "kind")?;
+        let e = match kind {
+            names::BACKLASH => {
+                check_keys(t, &prefix, "kind, width, location")?;
+                let location = match t.get("location").map(|l| l.as_str()) {
+                    None | Some(Some("loop")) => PlayLocation::Loop,
+                    Some(Some("input")) => PlayLocation::Input,
+                    Some(_) => return Err(ModelError::WrongType { key: key(&prefix, "location"), expected: "\"loop\" or \"input\"", found: describe(&t["location"]) }),
+                };
+                Effect::Backlash { width: nonneg(t, &prefix, "width")?, location }
+            }
+            names::GAP_WIDTH => {
+                check_keys(t, &prefix, "kind, relative_change")?;
+                let r = f64_at(t, &prefix, "relative_change")?;
+                if r <= -1.0 {
+                    return Err(ModelError::OutOfRange { key: key(&prefix, "relative_change"), value: r, reason: "must exceed -1" });
+                }
+                Effect::GapWidth { relative_change: r }
+            }
+            names::COULOMB_FRICTION => {
+                check_keys(t, &prefix, "kind, state, level")?;
+                Effect::CoulombFriction { state: state_index(t, &prefix, n)?, level: nonneg(t, &prefix, "level")? }
+            }
+            names::CONSTANT_FORCE => {
+                check_keys(t, &prefix, "kind, state, force")?;
+                Effect::ConstantForce { state: state_index(t, &prefix, n)?, force: f64_at(t, &prefix, "force")? }
+            }
+            names::BACKLASH_INERTIA => {
+                check_keys(t, &prefix, "kind, mass, damping")?;
+                Effect::BacklashInertia { mass: nonneg(t, &prefix, "mass")?, damping: nonneg(t, &prefix, "damping")? }
+            }
+            names::INPUT_DELAY => {
+                check_keys(t, &prefix, "kind, delay")?;
+                Effect::InputDelay { delay: nonneg(t, &prefix, "delay")? }
+            }
+            names::INPUT_SATURATION => {
+                check_keys(t, &prefix, "kind, limit")?;
+                let l = f64_at(t, &prefix, "limit")?;
+                if l <= 0.0 {
+                    return Err(ModelError::OutOfRange { key: key(&prefix, "limit"), value: l, reason: "must be positive" });
+                }
+                Effect::InputSaturation { limit: l }
+            }
+            names::SENSOR_OFFSET => {
+                check_keys(t, &prefix, "kind, offset")?;
+                let o = vec_at(t, &prefix, "offset")?;
+                if o.len() != p {
+                    return Err(ModelError::Dimension { key: key(&prefix, "offset"), expected: format!("length p = {p}"), got: format!("length {}", o.len()) });
+                }
+                Effect::SensorOffset { offset: o }
+            }
+            names::STRIBECK_FRICTION => {
+                check_keys(t, &prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
+                let state = state_index(t, &prefix, n)?;
+                let level = nonneg(t, &prefix, "level")?;
+                let static_level = nonneg(t, &prefix, "static_level")?;
+                if static_level < level {
+                    return Err(ModelError::Invalid {
+                        key: key(&prefix, "static_level"),
+                        value: static_level,
+                        reason: format!("must be at least `level` = {level} (the breakaway level is never below the sliding level)"),
+                    });
+                }
+                let stribeck_velocity = positive(t, &prefix, "stribeck_velocity")?;
+                let viscous = match opt_f64(t, &prefix, "viscous")? {
+                    None => 0.0,
+                    Some(v) if v < 0.0 => {
+                        return Err(ModelError::OutOfRange { key: key(&prefix, "viscous"), value: v, reason: "must be non-negative" })
+                    }
+                    Some(v) => v,
+                };
+                Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous }
+            }
+            names::ASYMMETRIC_COULOMB => {
+                check_keys(t, &prefix, "kind, state, level_positive, level_negative")?;
+                Effect::AsymmetricCoulomb {
+                    state: state_index(t, &prefix, n)?,
+                    level_positive: nonneg(t, &prefix, "level_positive")?,
+                    level_negative: nonneg(t, &prefix, "level_negative")?,
+                }
+            }
+            names::COGGING => {
+                check_keys(t, &prefix, "kind, state, position_state, amplitude, period, phase")?;
+                let state = state_index(t, &prefix, n)?;
+                let position_state = index_at(t, &prefix, "position_state", n)?;
+                if position_state == state {
+                    return Err(ModelError::Invalid {
+                        key: key(&prefix, "position_state"),
+                        value: position_state as f64,
+                        reason: format!("must differ from `state` = {state} (the force acts on the velocity, the period is in the position)"),
+                    });
+                }
+                Effect::Cogging {
+                    state,
+                    position_state,
+                    amplitude: f64_at(t, &prefix, "amplitude")?,
+                    period: positive(t, &prefix, "period")?,
+                    phase: opt_f64(t, &prefix, "phase")?.unwrap_or(0.0),
+                }
+            }
+            other => {
+                return Err(ModelError::WrongType {
+                    key: key(&prefix, "kind"),
+                    expected: "one of backlash, gap_width, coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
+                    found: format!("{other:?}"),
+                })
+            }
+        };
+        Ok(e)
+    }
+}
+
 impl Effects {
     /// Parses `[[effects]]` entries; `n` and `p` are the model's state and output dimensions.
     pub(crate) fn parse(v: Option<&Value>, n: usize, p: usize) -> Result<Self, ModelError> {
@@ -136,115 +252,7 @@ impl Effects {
             let Value::Table(t) = it else {
                 return Err(ModelError::WrongType { key: prefix, expected: "a table", found: describe(it) });
             };
-            let kind = str_at(t, &prefix, "kind")?;
-            let e = match kind {
-                names::BACKLASH => {
-                    check_keys(t, &prefix, "kind, width, location")?;
-                    let location = match t.get("location").map(|l| l.as_str()) {
-                        None | Some(Some("loop")) => PlayLocation::Loop,
-                        Some(Some("input")) => PlayLocation::Input,
-                        Some(_) => return Err(ModelError::WrongType { key: key(&prefix, "location"), expected: "\"loop\" or \"input\"", found: describe(&t["location"]) }),
-                    };
-                    Effect::Backlash { width: nonneg(t, &prefix, "width")?, location }
-                }
-                names::GAP_WIDTH => {
-                    check_keys(t, &prefix, "kind, relative_change")?;
-                    let r = f64_at(t, &prefix, "relative_change")?;
-                    if r <= -1.0 {
-                        return Err(ModelError::OutOfRange { key: key(&prefix, "relative_change"), value: r, reason: "must exceed -1" });
-                    }
-                    Effect::GapWidth { relative_change: r }
-                }
-                names::COULOMB_FRICTION => {
-                    check_keys(t, &prefix, "kind, state, level")?;
-                    Effect::CoulombFriction { state: state_index(t, &prefix, n)?, level: nonneg(t, &prefix, "level")? }
-                }
-                names::CONSTANT_FORCE => {
-                    check_keys(t, &prefix, "kind, state, force")?;
-                    Effect::ConstantForce { state: state_index(t, &prefix, n)?, force: f64_at(t, &prefix, "force")? }
-                }
-                names::BACKLASH_INERTIA => {
-                    check_keys(t, &prefix, "kind, mass, damping")?;
-                    Effect::BacklashInertia { mass: nonneg(t, &prefix, "mass")?, damping: nonneg(t, &prefix, "damping")? }
-                }
-                names::INPUT_DELAY => {
-                    check_keys(t, &prefix, "kind, delay")?;
-                    Effect::InputDelay { delay: nonneg(t, &prefix, "delay")? }
-                }
-                names::INPUT_SATURATION => {
-                    check_keys(t, &prefix, "kind, limit")?;
-                    let l = f64_at(t, &prefix, "limit")?;
-                    if l <= 0.0 {
-                        return Err(ModelError::OutOfRange { key: key(&prefix, "limit"), value: l, reason: "must be positive" });
-                    }
-                    Effect::InputSaturation { limit: l }
-                }
-                names::SENSOR_OFFSET => {
-                    check_keys(t, &prefix, "kind, offset")?;
-                    let o = vec_at(t, &prefix, "offset")?;
-                    if o.len() != p {
-                        return Err(ModelError::Dimension { key: key(&prefix, "offset"), expected: format!("length p = {p}"), got: format!("length {}", o.len()) });
-                    }
-                    Effect::SensorOffset { offset: o }
-                }
-                names::STRIBECK_FRICTION => {
-                    check_keys(t, &prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
-                    let state = state_index(t, &prefix, n)?;
-                    let level = nonneg(t, &prefix, "level")?;
-                    let static_level = nonneg(t, &prefix, "static_level")?;
-                    if static_level < level {
-                        return Err(ModelError::Invalid {
-                            key: key(&prefix, "static_level"),
-                            value: static_level,
-                            reason: format!("must be at least `level` = {level} (the breakaway level is never below the sliding level)"),
-                        });
-                    }
-                    let stribeck_velocity = positive(t, &prefix, "stribeck_velocity")?;
-                    let viscous = match opt_f64(t, &prefix, "viscous")? {
-                        None => 0.0,
-                        Some(v) if v < 0.0 => {
-                            return Err(ModelError::OutOfRange { key: key(&prefix, "viscous"), value: v, reason: "must be non-negative" })
-                        }
-                        Some(v) => v,
-                    };
-                    Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous }
-                }
-                names::ASYMMETRIC_COULOMB => {
-                    check_keys(t, &prefix, "kind, state, level_positive, level_negative")?;
-                    Effect::AsymmetricCoulomb {
-                        state: state_index(t, &prefix, n)?,
-                        level_positive: nonneg(t, &prefix, "level_positive")?,
-                        level_negative: nonneg(t, &prefix, "level_negative")?,
-                    }
-                }
-                names::COGGING => {
-                    check_keys(t, &prefix, "kind, state, position_state, amplitude, period, phase")?;
-                    let state = state_index(t, &prefix, n)?;
-                    let position_state = index_at(t, &prefix, "position_state", n)?;
-                    if position_state == state {
-                        return Err(ModelError::Invalid {
-                            key: key(&prefix, "position_state"),
-                            value: position_state as f64,
-                            reason: format!("must differ from `state` = {state} (the force acts on the velocity, the period is in the position)"),
-                        });
-                    }
-                    Effect::Cogging {
-                        state,
-                        position_state,
-                        amplitude: f64_at(t, &prefix, "amplitude")?,
-                        period: positive(t, &prefix, "period")?,
-                        phase: opt_f64(t, &prefix, "phase")?.unwrap_or(0.0),
-                    }
-                }
-                other => {
-                    return Err(ModelError::WrongType {
-                        key: key(&prefix, "kind"),
-                        expected: "one of backlash, gap_width, coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
-                        found: format!("{other:?}"),
-                    })
-                }
-            };
-            list.push(e);
+            list.push(Effect::parse_one(t, &prefix, n, p)?);
         }
         Ok(Self { list })
     }
@@ -312,6 +320,38 @@ impl Effect {
                 ("phase", f(phase)),
             ],
         }
+    }
+
+    /// The effect with key `key` (element `element` of an array key) set to `x`, checked as
+    /// the parser checks a file's effect (`n`, `p`: the model's state and output dimensions).
+    /// `prefix` names the effect in errors (`effects[2]`).
+    pub fn with_number(
+        &self,
+        prefix: &str,
+        key: &str,
+        element: Option<usize>,
+        x: f64,
+        n: usize,
+        p: usize,
+    ) -> Result<Effect, ModelError> {
+        let mut t = Table::new();
+        t.insert("kind".into(), Value::String(self.kind().into()));
+        for (k, v) in self.fields() {
+            t.insert(k.into(), v);
+        }
+        let slot = match (t.get_mut(key), element) {
+            (Some(Value::Array(a)), Some(e)) => a.get_mut(e),
+            (Some(v), None) => Some(v),
+            _ => None,
+        };
+        match slot {
+            Some(v) => *v = Value::Float(x),
+            None if key == "viscous" && element.is_none() => {
+                t.insert(key.into(), Value::Float(x));
+            }
+            None => return Err(ModelError::Missing { key: format!("{prefix}.{key}") }),
+        }
+        Effect::parse_one(&t, prefix, n, p)
     }
 
     /// The effect in the model file's own words, one line: its `kind` and its keys, e.g.

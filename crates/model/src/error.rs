@@ -49,6 +49,10 @@ pub enum ModelError {
     Invalid { key: String, value: f64, reason: String },
     #[error("key `theta`: the intersection of the balls has an empty interior ({reason}); projections onto it do not converge")]
     EmptyInterior { reason: String },
+    #[error("key `{}`: expression {:?}: {}", clip(key), clip(text), clip(reason))]
+    Expression { key: String, text: String, reason: String },
+    #[error("unknown parameter `{}` (parameters of this model: {})", clip(name), if known.is_empty() { "none" } else { known.as_str() })]
+    UnknownParameter { name: String, known: String },
 }
 
 /// Longest text (a key, a path, a value) an error message echoes in full.

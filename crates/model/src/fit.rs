@@ -1,6 +1,6 @@
 //! `[fit]` of a model file as a domain type: the nominal parameters `moreau diagnose` may
 //! refit ([`FitSpec`], [`FreeParam`] naming an entry `plant.X[row][col]` of a
-//! [`PlantMatrix`]) and the refits recorded in a fitted model ([`FitRecord`]).
+//! [`PlantMatrix`], or a parameter of `[parameters]`) and the refits recorded in a fitted model ([`FitRecord`]).
 //!
 //! Reading and writing a parameter's value in a [`crate::System`] (`FreeParam::get`, `set`,
 //! `System::plant_matrix`) lives with the system in [`crate::system`], which holds a
@@ -26,17 +26,36 @@ impl PlantMatrix {
     }
 }
 
-/// One nominal parameter freed by `[fit] free`: the entry `plant.X[row][col]` (0-based) with
-/// optional bounds `[fit.bounds]`.
+/// One nominal parameter freed by `[fit] free`: an entry `plant.X[row][col]` (0-based) or a
+/// named parameter of `[parameters]`, with optional bounds `[fit.bounds]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FreeParam {
-    /// Canonical name, e.g. `plant.A[1][1]`.
+    /// Canonical name, e.g. `plant.A[1][1]` or `M`.
     pub name: String,
-    pub matrix: PlantMatrix,
-    pub row: usize,
-    pub col: usize,
+    pub target: FreeTarget,
     /// `(lower, upper)`, the nominal value inside.
     pub bounds: Option<(f64, f64)>,
+}
+
+/// What a freed parameter moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FreeTarget {
+    /// One entry of a plant matrix.
+    Entry { matrix: PlantMatrix, row: usize, col: usize },
+    /// The parameter of `[parameters]` named [`FreeParam::name`], and with it every number
+    /// written as an expression of it.
+    Parameter,
+}
+
+impl FreeParam {
+    /// The entry `plant.X[row][col]`, named canonically.
+    pub fn entry(matrix: PlantMatrix, row: usize, col: usize) -> Self {
+        Self {
+            name: format!("plant.{}[{row}][{col}]", matrix.name()),
+            target: FreeTarget::Entry { matrix, row, col },
+            bounds: None,
+        }
+    }
 }
 
 /// A grey-box refit recorded in a fitted model (`[fit.result."plant.A[1][1]"]`): the value

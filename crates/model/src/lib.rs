@@ -6,6 +6,8 @@
 //! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, samples from a CSV).
 //! - [`fit`]: `[fit]`, the nominal parameters a grey-box refit may free ([`FitSpec`]) and the
 //!   refits recorded in a fitted model.
+//! - [`parameters`]: `[parameters]`, named physical constants and the numbers of the file
+//!   written as expressions of them ([`Parameters`]).
 //! - [`signals`]: `[signals]`, units of the recorded signals and tracking references
 //!   ([`Signals`]).
 //! - [`model_file`]: reading and writing model files with errors that name key and value (the
@@ -21,6 +23,7 @@ pub mod files;
 pub mod fit;
 pub mod input;
 pub mod model_file;
+pub mod parameters;
 pub mod signals;
 pub mod system;
 mod toml_access;
@@ -30,6 +33,7 @@ pub use error::ModelError;
 pub use fit::{FitRecord, FitSpec, FreeParam, PlantMatrix};
 pub use input::Input;
 pub use model_file::{load, parse_str, to_toml_string};
+pub use parameters::Parameters;
 pub use signals::Signals;
 pub use system::{check_step, SimDefaults, System, SystemBuilder, MIN_STEPS_PER_PERIOD};
 pub use toml_access::MAX_MAGNITUDE;

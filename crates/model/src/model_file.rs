@@ -29,11 +29,15 @@
 //! `upper`); `point` (`{0}`). Input `csv`: `file` (relative to the model file) with header
 //! `t,w` or `t,w1,...,wm`, optional `period`.
 //!
+//! Numbers in `[plant]`, `[initial]` and `[[effects]]` may be expressions of named
+//! parameters (`[parameters] M = 2.0`, `A = [[0, 1], ["-k/M", "-c/M"]]`): see
+//! [`crate::parameters`].
+//!
 //! Optional tables for `moreau diagnose` (ignored by every other command):
 //!
 //! ```toml
-//! [fit]                       # grey-box refit: nominal parameters freed (0-based indices)
-//! free = ["plant.A[1][1]", "plant.B[1][0]"]
+//! [fit]                       # grey-box refit: parameters or entries freed (0-based indices)
+//! free = ["plant.A[1][1]", "plant.B[1][0]"]   # or names of [parameters]: ["M", "c"]
 //! [fit.bounds]                # optional, per parameter: [lower, upper], the nominal inside
 //! "plant.A[1][1]" = [-10.0, 0.0]
 //! [fit.result."plant.A[1][1]"]  # written by diagnose into fitted.toml (informational)
@@ -46,7 +50,8 @@
 //! t = "s"                     # unit of time (figures' time axes)
 //! reference = "w1"            # output i tracks this input (servo loops): tracking-error metrics
 //! ```
-pub use crate::fit::{parse_param_name, FitRecord, FitSpec, FreeParam, PlantMatrix};
+pub use crate::fit::{parse_param_name, FitRecord, FitSpec, FreeParam, FreeTarget, PlantMatrix};
+use crate::parameters::{Parameters, Place};
 pub use crate::signals::Signals;
 use crate::system::{check_step, SimDefaults, System};
 use crate::toml_access::*;
@@ -290,10 +295,11 @@ pub const MAX_NAME_BYTES: usize = 1000;
 /// Parses model-file text as [`load`] reads a file named `origin` in directory `dir` (`csv`
 /// inputs resolved relative to `dir`): what a file with this text there would give.
 pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, ModelError> {
-    let root: Table = text
+    let mut root: Table = text
         .parse::<Table>()
         .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
-    check_keys(&root, "", "name, plant, theta, input, initial, simulation, effects, fit, signals")?;
+    check_keys(&root, "", "name, parameters, plant, theta, input, initial, simulation, effects, fit, signals")?;
+    let parameters = Parameters::take_from(&mut root)?;
     let name = match root.get("name") {
         Some(Value::String(s)) if s.len() > MAX_NAME_BYTES => {
             return Err(ModelError::TooLong { key: "name".into(), bytes: s.len(), limit: MAX_NAME_BYTES })
@@ -367,6 +373,7 @@ pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, Mo
     let effects = Effects::parse(root.get("effects"), n, p)?;
     let mut sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
     check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
+    sys.parameters = parameters;
     sys.fit = parse_fit(sub("fit")?, &sys)?;
     sys.signals = parse_signals(sub("signals")?, sys.m(), sys.p())?;
     Ok(sys)
@@ -504,6 +511,7 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     if let Some(t) = signals_table(&s.signals) {
         root.insert("signals".into(), Value::Table(t));
     }
+    write_expressions(s, &mut root);
     // sections in the order of the file format (the parser's key list and the examples), not
     // alphabetically as a TOML table would serialise them
     let mut out = String::new();
@@ -524,10 +532,86 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
 /// The top-level keys of a model file in the order files are written (the order of the
 /// examples and of the file-format reference).
 const SECTION_ORDER: &[&str] =
-    &["name", "plant", "theta", "input", "initial", "simulation", "effects", "fit", "signals"];
+    &["name", "parameters", "plant", "theta", "input", "initial", "simulation", "effects", "fit", "signals"];
+
+/// `[parameters]` and, in place of a number, the expression that gives it: where the number
+/// is still the expression's value (a number changed by other means, e.g. a sweep over the
+/// entry, is written as the number).
+fn write_expressions(s: &System, root: &mut Table) {
+    let Some(t) = s.parameters.to_table() else { return };
+    root.insert("parameters".into(), Value::Table(t));
+    for b in &s.parameters.bindings {
+        let Ok(x) = s.parameters.evaluate(b, &s.parameters.values) else { continue };
+        let slot = match &b.place {
+            Place::Plant { matrix, row, col } => root
+                .get_mut("plant")
+                .and_then(|p| p.get_mut(matrix.name()))
+                .and_then(|m| m.get_mut(*row))
+                .and_then(|r| r.get_mut(*col)),
+            Place::Initial { x0, index } => root
+                .get_mut("initial")
+                .and_then(|t| t.get_mut(if *x0 { "x0" } else { "z0" }))
+                .and_then(|v| v.get_mut(*index)),
+            Place::Effect { index, key, element } => {
+                let v = root.get_mut("effects").and_then(|e| e.get_mut(*index)).and_then(|t| t.get_mut(key.as_str()));
+                match element {
+                    Some(e) => v.and_then(|a| a.get_mut(*e)),
+                    None => v,
+                }
+            }
+        };
+        if let Some(v) = slot {
+            if v.as_float() == Some(x) {
+                *v = Value::String(b.text.clone());
+            }
+        }
+    }
+}
 
 const FREE_FORM: &str =
     "a nominal parameter `plant.X[row][col]` with X one of A, B, C, E and 0-based indices, e.g. \"plant.A[1][1]\"";
+const FREE_FORM_OR_PARAMETER: &str =
+    "a parameter of [parameters] or an entry `plant.X[row][col]` (X one of A, B, C, E, 0-based indices)";
+
+/// `[fit] free` entry `s` (at `key`): a parameter of `[parameters]` or a plant entry that no
+/// expression gives (that one moves with its parameters).
+fn free_param(s: &str, key: &str, sys: &System) -> Result<FreeParam, ModelError> {
+    if sys.parameters.value(s.trim()).is_some() {
+        return Ok(FreeParam { name: s.trim().to_string(), target: FreeTarget::Parameter, bounds: None });
+    }
+    let Some((matrix, row, col)) = parse_param_name(s) else {
+        let expected = if sys.parameters.is_empty() { FREE_FORM } else { FREE_FORM_OR_PARAMETER };
+        let known = if sys.parameters.is_empty() {
+            String::new()
+        } else {
+            format!(" (parameters: {})", sys.parameters.names.join(", "))
+        };
+        return Err(ModelError::WrongType { key: key.into(), expected, found: format!("string {s:?}{known}") });
+    };
+    let m = sys.plant_matrix(matrix);
+    if row >= m.nrows() || col >= m.ncols() {
+        return Err(ModelError::Dimension {
+            key: key.into(),
+            expected: format!(
+                "row < {} and column < {} (plant.{} is {}x{}; indices are 0-based)",
+                m.nrows(),
+                m.ncols(),
+                matrix.name(),
+                m.nrows(),
+                m.ncols()
+            ),
+            got: format!("{s:?}"),
+        });
+    }
+    if let Some(b) = sys.parameters.binding_at(&Place::Plant { matrix, row, col }) {
+        return Err(ModelError::Expression {
+            key: key.into(),
+            text: b.text.clone(),
+            reason: format!("{} is written as this expression: free its parameters instead", b.place.key()),
+        });
+    }
+    Ok(FreeParam::entry(matrix, row, col))
+}
 
 fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
     let Some(t) = t else { return Ok(FitSpec::default()) };
@@ -546,43 +630,25 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
             let Value::String(s) = it else {
                 return Err(ModelError::WrongType { key, expected: FREE_FORM, found: describe(it) });
             };
-            let Some((matrix, row, col)) = parse_param_name(s) else {
-                return Err(ModelError::WrongType { key, expected: FREE_FORM, found: describe(it) });
-            };
-            let m = sys.plant_matrix(matrix);
-            if row >= m.nrows() || col >= m.ncols() {
-                return Err(ModelError::Dimension {
-                    key,
-                    expected: format!(
-                        "row < {} and column < {} (plant.{} is {}x{}; indices are 0-based)",
-                        m.nrows(),
-                        m.ncols(),
-                        matrix.name(),
-                        m.nrows(),
-                        m.ncols()
-                    ),
-                    got: format!("{s:?}"),
-                });
-            }
-            let name = format!("plant.{}[{row}][{col}]", matrix.name());
-            if let Some(i) = free.iter().position(|f| f.name == name) {
+            let param = free_param(s, &key, sys)?;
+            if let Some(i) = free.iter().position(|f| f.name == param.name) {
                 return Err(ModelError::WrongType {
                     key,
                     expected: "each parameter at most once",
                     found: format!("{s:?}, already fit.free[{i}]"),
                 });
             }
-            free.push(FreeParam { name, matrix, row, col, bounds: None });
+            free.push(param);
         }
     }
     let lookup = |free: &[FreeParam], key: &str, raw: &str| -> Result<usize, ModelError> {
-        parse_param_name(raw)
-            .and_then(|(m, i, j)| free.iter().position(|f| f.matrix == m && f.row == i && f.col == j))
-            .ok_or_else(|| ModelError::WrongType {
-                key: key.into(),
-                expected: "a parameter listed in fit.free",
-                found: format!("{raw:?} (fit.free: {:?})", free.iter().map(|f| f.name.as_str()).collect::<Vec<_>>()),
-            })
+        let canonical = parse_param_name(raw).map(|(m, i, j)| FreeParam::entry(m, i, j).name);
+        let name = canonical.as_deref().unwrap_or(raw.trim());
+        free.iter().position(|f| f.name == name).ok_or_else(|| ModelError::WrongType {
+            key: key.into(),
+            expected: "a parameter listed in fit.free",
+            found: format!("{raw:?} (fit.free: {:?})", free.iter().map(|f| f.name.as_str()).collect::<Vec<_>>()),
+        })
     };
     if let Some(v) = t.get("bounds") {
         let Value::Table(b) = v else {

@@ -1,8 +1,9 @@
 //! The validated closed-loop system of eqs. (xy), (yz).
 use crate::effects::Effects;
 use crate::error::ModelError;
-use crate::fit::{FitSpec, FreeParam, PlantMatrix};
+use crate::fit::{FitSpec, FreeParam, FreeTarget, PlantMatrix};
 use crate::input::Input;
+use crate::parameters::{Parameters, Place};
 use crate::signals::Signals;
 use geometry::{ConvexSet, Shape};
 use nalgebra::{Complex, DMatrix, DVector};
@@ -68,6 +69,9 @@ pub struct System {
     pub fit: FitSpec,
     /// `[signals]`: units of the recorded signals, for reports (empty: unitless).
     pub signals: Signals,
+    /// `[parameters]`: named constants and the numbers above written as expressions of them
+    /// (empty: plain numbers). Change one with [`System::set_parameter`].
+    pub parameters: Parameters,
 }
 
 fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
@@ -309,6 +313,7 @@ impl System {
             effects,
             fit: Default::default(),
             signals: Default::default(),
+            parameters: Default::default(),
         })
     }
 
@@ -367,14 +372,57 @@ impl System {
     }
 }
 
+/// Parameters of `[parameters]` in a system.
+impl System {
+    /// Sets parameter `name` to `v` and every number written as an expression of it (plant
+    /// entries, initial state, effect keys; `z0 = C x0` where `z0` was not stated). On an error
+    /// (an unknown name, an expression that does not evaluate, an effect key out of its range)
+    /// the system is unchanged.
+    pub fn set_parameter(&mut self, name: &str, v: f64) -> Result<(), ModelError> {
+        let mut params = self.parameters.clone();
+        let values = params.values_with(name, v)?;
+        let mut next = self.clone();
+        let mut effects: Vec<(usize, &str, Option<usize>, f64)> = Vec::new();
+        for (b, x) in params.bindings.iter().zip(values) {
+            match &b.place {
+                Place::Plant { matrix, row, col } => next.plant_matrix_mut(*matrix)[(*row, *col)] = x,
+                Place::Initial { x0: true, index } => next.x0[*index] = x,
+                Place::Initial { x0: false, index } => next.z0[*index] = x,
+                Place::Effect { index, key, element } => effects.push((*index, key, *element, x)),
+            }
+        }
+        if params.z0_follows_x0 && params.bindings.iter().any(|b| matches!(b.place, Place::Initial { x0: true, .. })) {
+            next.z0 = &next.C * &next.x0;
+        }
+        for (index, key, element, x) in effects {
+            let prefix = format!("effects[{index}]");
+            let e = next.effects.list[index].with_number(&prefix, key, element, x, next.n(), next.p())?;
+            next.effects.list[index] = e;
+        }
+        next.parameters = params;
+        *self = next;
+        Ok(())
+    }
+}
+
 /// A freed parameter ([`crate::fit`]) read and written in a system.
 impl FreeParam {
     /// The parameter's value in `sys`.
     pub fn get(&self, sys: &System) -> f64 {
-        sys.plant_matrix(self.matrix)[(self.row, self.col)]
+        match self.target {
+            FreeTarget::Entry { matrix, row, col } => sys.plant_matrix(matrix)[(row, col)],
+            FreeTarget::Parameter => sys.parameters.value(&self.name).unwrap_or(f64::NAN),
+        }
     }
-    /// Sets the parameter in `sys`.
-    pub fn set(&self, sys: &mut System, v: f64) {
-        sys.plant_matrix_mut(self.matrix)[(self.row, self.col)] = v;
+    /// Sets the parameter in `sys` (a named parameter moves every expression written with
+    /// it; an error leaves `sys` unchanged).
+    pub fn set(&self, sys: &mut System, v: f64) -> Result<(), ModelError> {
+        match self.target {
+            FreeTarget::Entry { matrix, row, col } => {
+                sys.plant_matrix_mut(matrix)[(row, col)] = v;
+                Ok(())
+            }
+            FreeTarget::Parameter => sys.set_parameter(&self.name, v),
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! `[fit]` (grey-box refit: freed nominal parameters, bounds, recorded results) and
 //! `[signals]` (units) in model files: parsed, validated with errors naming key and value,
 //! and written back by `to_toml_string`.
-use model::model_file::PlantMatrix;
+use model::model_file::{FreeTarget, PlantMatrix};
 
 const BASE: &str = "name = \"servo\"\n[plant]\nA = [[0.0, 1.0], [-2.0, -0.6]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n";
 
@@ -17,7 +17,8 @@ fn free_parameters_bounds_and_units_are_read_and_written_back() {
     .unwrap();
     assert_eq!(sys.fit.free.len(), 2);
     let a11 = &sys.fit.free[0];
-    assert_eq!((a11.name.as_str(), a11.matrix, a11.row, a11.col), ("plant.A[1][1]", PlantMatrix::A, 1, 1));
+    assert_eq!(a11.name, "plant.A[1][1]");
+    assert_eq!(a11.target, FreeTarget::Entry { matrix: PlantMatrix::A, row: 1, col: 1 });
     assert_eq!(a11.bounds, Some((-10.0, 0.0)));
     assert_eq!(a11.get(&sys), -0.6);
     assert_eq!(sys.fit.free[1].bounds, None);

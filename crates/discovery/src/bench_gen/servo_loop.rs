@@ -90,9 +90,9 @@ pub fn loop_model(name: &str, m: f64, c: f64, kp: f64, kd: f64) -> System {
         .build()
         .expect("the loop model is valid");
     sys.fit.free = vec![
-        FreeParam { name: FREE[0].into(), matrix: PlantMatrix::A, row: 1, col: 0, bounds: None },
-        FreeParam { name: FREE[1].into(), matrix: PlantMatrix::A, row: 1, col: 1, bounds: None },
-        FreeParam { name: FREE[2].into(), matrix: PlantMatrix::B, row: 1, col: 0, bounds: None },
+        FreeParam::entry(PlantMatrix::A, 1, 0),
+        FreeParam::entry(PlantMatrix::A, 1, 1),
+        FreeParam::entry(PlantMatrix::B, 1, 0),
     ];
     sys.signals = Signals { y: vec!["m".into()], w: vec!["m".into()], t: "s".into(), reference: vec![0] };
     sys

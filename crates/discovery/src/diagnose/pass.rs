@@ -145,7 +145,7 @@ impl<'a> Pass<'a> {
         let Some(c) = &selection.chosen else { return false };
         let effects = self.ctx.problem(vec![], c.parts.clone()).effects(&c.params);
         let sys_c = match (c.refit, &data.free_nominal) {
-            (true, Some(f)) => f.system_at(&c.nominal),
+            (true, Some(f)) => f.system_at(&c.nominal).unwrap_or_else(|| data.sys.clone()),
             _ => data.sys.clone(),
         };
         let chk = data.converge_model(&sys_c, &effects, &c.x0, self.hold, self.ctx.substeps);

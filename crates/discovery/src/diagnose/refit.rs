@@ -172,7 +172,10 @@ fn fitted_system(
     // Grey-box refit: the fitted nominal parameters replace the model file's, and each is
     // recorded with its nominal value and uncertainty (`[fit.result]`).
     if let (Some(f), false) = (&data.free_nominal, nominal_refit.is_empty()) {
-        fitted_sys = f.apply(&fitted_sys, &nominal_refit.iter().map(|v| v.value).collect::<Vec<_>>());
+        match f.apply(&fitted_sys, &nominal_refit.iter().map(|v| v.value).collect::<Vec<_>>()) {
+            Ok(s) => fitted_sys = s,
+            Err(e) => notes.push(format!("the refitted parameters are not written to the fitted model: {e}")),
+        }
         fitted_sys.fit.result = nominal_refit
             .iter()
             .map(|v| model::model_file::FitRecord {

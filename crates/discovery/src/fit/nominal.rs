@@ -7,7 +7,7 @@
 //! the modified system (a copy without the model's input) and its exact step maps (`F = A + E C`
 //! changes with the parameters), so the exact discretisation and the hold stay as for the
 //! nominal.
-use model::model_file::FreeParam;
+use model::model_file::{FreeParam, FreeTarget};
 use model::{Input, System};
 
 /// The freed nominal parameters of a diagnosis.
@@ -30,14 +30,9 @@ impl FreeNominal {
         }
         let params = sys.fit.free.clone();
         let nominal: Vec<f64> = params.iter().map(|f| f.get(sys)).collect();
-        let amax = |f: &FreeParam| {
-            let m = match f.matrix {
-                model::model_file::PlantMatrix::A => &sys.A,
-                model::model_file::PlantMatrix::B => &sys.B,
-                model::model_file::PlantMatrix::C => &sys.C,
-                model::model_file::PlantMatrix::E => &sys.E,
-            };
-            m.amax()
+        let amax = |f: &FreeParam| match f.target {
+            FreeTarget::Entry { matrix, .. } => sys.plant_matrix(matrix).amax(),
+            FreeTarget::Parameter => 0.0,
         };
         let scale = params
             .iter()
@@ -64,21 +59,23 @@ impl FreeNominal {
     pub fn names(&self) -> Vec<String> {
         self.params.iter().map(|p| p.name.clone()).collect()
     }
-    /// The model (without its input) at parameter values `v`.
-    pub fn system_at(&self, v: &[f64]) -> System {
+    /// The model (without its input) at parameter values `v` (`None` where an expression of
+    /// a named parameter leaves its range, e.g. a negative friction level).
+    pub fn system_at(&self, v: &[f64]) -> Option<System> {
         let mut s = self.base.clone();
         for (p, x) in self.params.iter().zip(v) {
-            p.set(&mut s, *x);
+            p.set(&mut s, *x).ok()?;
         }
-        s
+        Some(s)
     }
-    /// `sys` (with its input) at parameter values `v`.
-    pub fn apply(&self, sys: &System, v: &[f64]) -> System {
+    /// `sys` (with its input) at parameter values `v`; `sys` itself where an expression of a
+    /// named parameter leaves its range (as [`FreeNominal::system_at`]).
+    pub fn apply(&self, sys: &System, v: &[f64]) -> Result<System, model::ModelError> {
         let mut s = sys.clone();
         for (p, x) in self.params.iter().zip(v) {
-            p.set(&mut s, *x);
+            p.set(&mut s, *x)?;
         }
-        s
+        Ok(s)
     }
     /// Solver coordinates of the bounds (`-inf`, `inf` where unbounded).
     pub fn bounds_scaled(&self) -> (Vec<f64>, Vec<f64>) {

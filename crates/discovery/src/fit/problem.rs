@@ -133,7 +133,10 @@ impl<'a> Problem<'a> {
     /// As [`Problem::simulate`] with freed nominal parameters at `nom`.
     pub fn simulate_with(&self, theta: &[f64], nom: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
         let effects = self.effects(theta);
-        let refitted: Option<System> = self.refit.as_ref().map(|r| r.free.system_at(nom));
+        let refitted: Option<System> = match self.refit.as_ref() {
+            Some(r) => Some(r.free.system_at(nom)?),
+            None => None,
+        };
         let sys = refitted.as_ref().unwrap_or(self.sys);
         let maps = match &refitted {
             None => self.maps.clone(),

@@ -8,7 +8,9 @@
 //! - `theta.scale`: `Theta -> s Theta` (the gap size and `R` scale with `s`; the initial
 //!   `z0 - C x0` is scaled too so that it stays in the set), `theta.R`: the same scaling
 //!   chosen so that the strong-convexity constant `R` of eq. (R) takes the value,
-//!   `theta.half_width`: `Theta = [-delta, delta]` (interval backlash only).
+//!   `theta.half_width`: `Theta = [-delta, delta]` (interval backlash only);
+//! - `parameters.NAME`: a parameter of the model's `[parameters]`, and with it every number
+//!   written as an expression of it.
 use super::SweepError;
 use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, Polytope, Shape};
 use model::{Input, System};
@@ -35,6 +37,8 @@ pub enum Parameter {
     ThetaR,
     /// `Theta = [-delta, delta]`.
     ThetaHalfWidth,
+    /// A parameter of `[parameters]` (the name after `parameters.`).
+    Named(String),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,6 +104,12 @@ impl Parameter {
             }
             return Ok(Parameter::MatrixEntry { matrix, i, j });
         }
+        if let Some(rest) = t.strip_prefix("parameters.") {
+            let mut chars = rest.chars();
+            let ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+            return if ok { Ok(Parameter::Named(rest.to_string())) } else { Err(unknown()) };
+        }
         match t {
             "input.amplitude" | "input.amplitudes" => return Ok(Parameter::InputAmplitude { component: None }),
             "input.omega" => return Ok(Parameter::InputOmega),
@@ -130,6 +140,7 @@ impl Parameter {
             Parameter::ThetaScale => "theta.scale".into(),
             Parameter::ThetaR => "theta.R".into(),
             Parameter::ThetaHalfWidth => "theta.half_width".into(),
+            Parameter::Named(n) => format!("parameters.{n}"),
         }
     }
 
@@ -144,6 +155,8 @@ impl Parameter {
             Parameter::ThetaScale => "$s_\\Theta$".into(),
             Parameter::ThetaR => "$R$".into(),
             Parameter::ThetaHalfWidth => "$\\delta$".into(),
+            Parameter::Named(n) if n.chars().count() == 1 => format!("${n}$"),
+            Parameter::Named(n) => format!("$\\mathrm{{{}}}$", n.replace('_', "\\_")),
         }
     }
 
@@ -185,6 +198,11 @@ impl Parameter {
             Parameter::ThetaHalfWidth => {
                 if !matches!(base.theta, Shape::Interval(_)) {
                     return na("theta.half_width needs an interval Theta");
+                }
+            }
+            Parameter::Named(n) => {
+                if base.parameters.value(n).is_none() {
+                    return Err(SweepError::UnknownModelParameter { name, known: base.parameters.names.join(", ") });
                 }
             }
         }
@@ -237,6 +255,10 @@ impl Parameter {
                 sys.theta = Shape::Interval(iv);
                 // keep z0 inside y0 + Theta: clamp q0 into the new interval
                 sys.z0[0] = (sys.C.row(0) * &sys.x0)[0] + iv.clamp(q0);
+            }
+            Parameter::Named(n) => {
+                self.check_applicable(sys)?;
+                sys.set_parameter(n, value).map_err(|source| SweepError::InvalidPoint { name, value, source })?;
             }
         }
         Ok(())
@@ -299,6 +321,7 @@ pub fn apply_all(base: &System, settings: &[(&Parameter, f64)]) -> Result<System
         .sim(s.sim)
         .effects(s.effects)
         .build()
+        .map(|built| System { parameters: s.parameters, ..built })
         .map_err(|source| SweepError::InvalidPoint { name, value, source })
 }
 

@@ -26,8 +26,10 @@ pub enum SweepError {
     Model { path: PathBuf, source: model::ModelError },
     #[error("the spec has no axes: add at least one [[axis]] with `parameter` and `values` or `range`")]
     NoAxes,
-    #[error("axis `{name}`: unknown parameter (known: plant.A[i][j], plant.B[i][j], plant.C[i][j], plant.E[i][j] (0-based), input.amplitude, input.amplitude[k], input.omega, input.phase, theta.scale, theta.R, theta.half_width)")]
+    #[error("axis `{name}`: unknown parameter (known: plant.A[i][j], plant.B[i][j], plant.C[i][j], plant.E[i][j] (0-based), input.amplitude, input.amplitude[k], input.omega, input.phase, theta.scale, theta.R, theta.half_width, parameters.NAME)")]
     UnknownParameter { name: String },
+    #[error("axis `{name}`: the base model has no such parameter (its [parameters]: {})", if known.is_empty() { "none" } else { known.as_str() })]
+    UnknownModelParameter { name: String, known: String },
     #[error("axis `{name}`: index ({i}, {j}) outside the {rows}x{cols} matrix (indices are 0-based)")]
     IndexOutOfRange { name: String, i: usize, j: usize, rows: usize, cols: usize },
     #[error("axis `{name}`: not applicable to the base model: {reason}")]
