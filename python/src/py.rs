@@ -384,7 +384,7 @@ fn check(
 /// `moreau diagnose`: (report JSON, fitted System or None, p, {t, y, yhat_nominal, yhat_fitted}).
 /// The recording is a path (`data`) or CSV text (`text`, named `source` in messages).
 #[pyfunction]
-#[pyo3(signature = (model, *, data=None, text=None, source_name="<recording>".to_string(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, out=None))]
+#[pyo3(signature = (model, *, data=None, text=None, source_name="<recording>".to_string(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, out=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn diagnose<'py>(
     py: Python<'py>,
@@ -396,6 +396,8 @@ fn diagnose<'py>(
     max_effects: usize,
     input_hold: String,
     estimate_x0: bool,
+    metric: String,
+    no_refit: bool,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>, usize, Bound<'py, PyDict>)> {
     use commands::diagnose::{diagnose, write_outputs, DiagnoseOptions, RecordingSource};
@@ -410,7 +412,19 @@ fn diagnose<'py>(
             "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
         )));
     };
-    let o = DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, ..Default::default() };
+    let Some(metric) = discovery::diagnose::Metric::parse(&metric) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
+        )));
+    };
+    let o = DiagnoseOptions {
+        estimation_fraction,
+        max_effects,
+        input_hold,
+        estimate_x0,
+        metric,
+        refit_nominal: !no_refit,
+    };
     let run = move || -> anyhow::Result<discovery::Report> {
         let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;

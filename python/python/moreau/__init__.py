@@ -5,9 +5,9 @@ Bindings of the Rust workspace (the same numbers as the ``moreau`` command):
 >>> import numpy as np, moreau
 >>> sys = moreau.System(np.array([[0.0, 1.0], [-2.0, -0.6]]), [[0.0], [1.0]], [[1.0, 0.0]], [[0.0], [1.0]],
 ...                     theta=moreau.Interval(0.1), input=moreau.Sine([1.0], omega=1.0))
->>> rep = moreau.theta(sys)            # the dict of `moreau theta FILE --json`
->>> rep["theta"], rep["theta_verified"]  # doctest: +SKIP
-(-0.0172..., True)
+>>> rep = moreau.theta(sys)            # `moreau theta FILE --json`: a dict, keys also attributes
+>>> rep.theta_best, rep["theta_verified"]  # doctest: +SKIP
+(-0.2055..., True)
 
 Every error is a :class:`MoreauError` (a ``ValueError``) carrying the one-line message the
 command prints after ``error:``.
@@ -41,8 +41,10 @@ from ._commands import (
     set_allow_large,
     simulate,
     sweep,
+    sweep_grid,
     theta,
 )
+from ._results import PeriodicResult, Result, ThetaResult
 
 __all__ = [
     "MoreauError",
@@ -68,7 +70,11 @@ __all__ = [
     "check",
     "diagnose",
     "sweep",
+    "sweep_grid",
     "set_allow_large",
+    "Result",
+    "ThetaResult",
+    "PeriodicResult",
     "Trajectory",
     "CheckResult",
     "Diagnosis",

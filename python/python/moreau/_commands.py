@@ -13,6 +13,7 @@ import numpy as np
 from . import _native
 from ._model import PathLike, System, _native_model
 from ._native import MoreauError
+from ._results import PeriodicResult, Result, ThetaResult, _fmt
 
 Model = Union[System, PathLike]
 
@@ -23,8 +24,11 @@ __all__ = [
     "check",
     "diagnose",
     "sweep",
+    "sweep_grid",
     "set_allow_large",
     "Trajectory",
+    "ThetaResult",
+    "PeriodicResult",
     "CheckResult",
     "Diagnosis",
     "SweepResult",
@@ -45,25 +49,69 @@ def _f64(b: bytes, shape: Any) -> np.ndarray:
     return np.frombuffer(b, dtype="<f8").reshape(shape).copy()
 
 
-def theta(model: Model, *, measure: bool = True, stationary: bool = True, guidance: bool = True) -> Dict[str, Any]:
+def theta(model: Model, *, measure: bool = True, stationary: bool = True, guidance: bool = True) -> ThetaResult:
     """The bound theta of eq. (theta) with every quantity: ``moreau theta FILE --json``.
 
-    Returns the command's JSON object as a dict, with exactly its keys (``theta``,
-    ``theta_verified``, ``theta_best``, ``measured_rate``, ``quantities``, ...). As in the CLI,
-    a ``guidance`` key (design guidance: which term blocks, sensitivities, smallest
-    certifying amplitude) is added only when nothing is certified; ``guidance=False`` is
-    ``--no-guidance``. ``measure=False`` is ``--no-measure`` (no simulated pairs),
-    ``stationary=False`` is ``--no-stationary``.
+    Parameters
+    ----------
+    model : System or path-like
+        The system, or the path of a model file.
+    measure : bool, default True
+        Measure the exponent by simulation (``False`` is ``--no-measure``).
+    stationary : bool, default True
+        Certify the stationary point (``False`` is ``--no-stationary``).
+    guidance : bool, default True
+        Add design guidance when nothing is certified (``False`` is ``--no-guidance``).
+
+    Returns
+    -------
+    ThetaResult
+        The command's JSON object (a dict with exactly its keys, also attributes):
+        ``theta_best``, ``theta_best_verified``, ``theta_best_method``, ``theta``,
+        ``theta_verified``, ``measured_rate``, ``measured_rate_ci``, ``quantities``, ...; a
+        ``guidance`` key only when nothing is certified.
+
+    Raises
+    ------
+    MoreauError
+        Bad model (dimensions, F not Hurwitz, Theta not containing 0, ...), with the CLI's
+        one-line message.
     """
-    return json.loads(_native.theta(_native_model(model), measure=measure, stationary=stationary, guidance=guidance))
+    return ThetaResult(
+        json.loads(_native.theta(_native_model(model), measure=measure, stationary=stationary, guidance=guidance))
+    )
 
 
 class Trajectory(Dict[str, np.ndarray]):
     """Samples of a simulation: ``t`` (N,), ``w`` (N, m), ``x`` (N, n), ``y`` (N, p), ``z`` (N, p)
-    and ``q = z - y`` (N, p); ``method`` says how it was simulated, ``h`` the step."""
+    and ``q = z - y`` (N, p), also as attributes (``tr.y``); ``method`` says how it was
+    simulated, ``h`` the step."""
 
     method: str
     h: float
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(f"Trajectory has no column or attribute {name!r} (columns: {', '.join(self)})") from None
+
+    def to_dict(self) -> Dict[str, np.ndarray]:
+        """The columns as a plain dict of numpy arrays (copies).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``t``, ``w``, ``x``, ``y``, ``z``, ``q``.
+        """
+        return {k: v.copy() for k, v in self.items()}
+
+    def __repr__(self) -> str:
+        t = self["t"]
+        span = f"t = {_fmt(t[0])} .. {_fmt(t[-1])}" if len(t) else "empty"
+        return f"Trajectory({len(t)} samples, {span}, h = {_fmt(getattr(self, 'h', None))}, {getattr(self, 'method', '?')})"
 
 
 def simulate(
@@ -77,12 +125,28 @@ def simulate(
 ) -> Trajectory:
     """Simulates the closed loop as ``moreau simulate FILE`` does, returning the samples.
 
-    Periodic inputs run ``periods`` periods (default: the model's ``simulation.periods``) at
-    the step ``T / ceil(T / dt)``; ``t_end`` instead runs to that time (for any input; for
-    non-periodic inputs the default is ``simulation.t_end``, else 100). ``dt`` defaults to
-    ``simulation.dt``. ``integrator`` is ``"catching-up"`` (any Theta; the extended-model
-    simulator for models with effects) or ``"event"`` (the event-driven reference).
-    ``max_rows`` keeps every k-th step (default: every step).
+    Parameters
+    ----------
+    model : System or path-like
+        The system, or the path of a model file.
+    t_end : float, optional
+        Run to this time (any input; default for non-periodic inputs: ``simulation.t_end``,
+        else 100).
+    dt : float, optional
+        Step (default ``simulation.dt``; periodic inputs use ``T / ceil(T / dt)``).
+    periods : int, optional
+        Periods of a periodic input (default ``simulation.periods``).
+    integrator : {"catching-up", "event"}, default "catching-up"
+        The catching-up scheme (any Theta; the extended-model simulator for models with
+        effects) or the event-driven reference.
+    max_rows : int, optional
+        Keep every k-th step so that at most this many rows remain (default: every step).
+
+    Returns
+    -------
+    Trajectory
+        ``t`` (N,), ``w`` (N, m), ``x`` (N, n), ``y`` (N, p), ``z`` (N, p), ``q`` (N, p);
+        ``method`` and ``h``.
     """
     n, m, p, method, h, cols = _native.simulate(
         _native_model(model),
@@ -107,20 +171,45 @@ def simulate(
     return out
 
 
-def periodic(model: Model, *, dt: Optional[float] = None, periods: int = 60, pairs: int = 3) -> Dict[str, Any]:
-    """The periodic regime (Poincare fixed point, residual, (loc) check) and the measured
-    convergence exponent: ``moreau periodic FILE --json`` (same keys)."""
-    return json.loads(
-        _native.periodic(_native_model(model), dt=dt, periods=_count("periods", periods), pairs=_count("pairs", pairs))
+def periodic(model: Model, *, dt: Optional[float] = None, periods: int = 60, pairs: int = 3) -> PeriodicResult:
+    """The periodic regime and the measured convergence exponent: ``moreau periodic FILE --json``.
+
+    Parameters
+    ----------
+    model : System or path-like
+        The system, or the path of a model file.
+    dt : float, optional
+        Step (default ``simulation.dt``).
+    periods : int, default 60
+        Periods simulated per pair of trajectories.
+    pairs : int, default 3
+        Pairs of trajectories whose distance measures the exponent.
+
+    Returns
+    -------
+    PeriodicResult
+        The command's JSON object: ``periodic_regime`` (Poincare fixed point, residual),
+        ``rate`` (``exponent``, ``ci95``, per-pair values), ``localisation`` ((loc) check),
+        ``path_length_per_period``, ...
+    """
+    return PeriodicResult(
+        json.loads(
+            _native.periodic(_native_model(model), dt=dt, periods=_count("periods", periods), pairs=_count("pairs", pairs))
+        )
     )
 
 
-class CheckResult(Dict[str, Any]):
+class CheckResult(Result):
     """``moreau check --json``'s object (``seed``, ``variant``, ``results``); ``passed`` is
     False where the command exits with status 1 (a violated claim, or a negative control
     that produced no counterexample)."""
 
     passed: bool
+
+    def _parts(self) -> List[str]:
+        res = self.get("results", [])
+        viol = sum(int(r.get("violations") or 0) for r in res)
+        return [f"passed={getattr(self, 'passed', '?')}", f"{len(res)} properties", f"{viol} violations", f"variant={self.get('variant')}"]
 
 
 def check(
@@ -133,9 +222,24 @@ def check(
 ) -> CheckResult:
     """The property campaign over the results of the paper: ``moreau check --json``.
 
-    ``only`` selects one property by name (``lemma_a2``) or equation label (``lem1:2``);
-    ``cases`` per property (default: each property's own); deterministic given ``seed`` and
-    ``cases``. Counterexample files are written to ``out`` only when it is given.
+    Parameters
+    ----------
+    only : str, optional
+        One property by name (``"lemma_a2"``) or equation label (``"lem1:2"``); default all.
+    cases : int, optional
+        Cases per property (default: each property's own).
+    seed : int, default 0
+        Seed; the campaign is deterministic given ``seed`` and ``cases``.
+    negative_control : bool, default False
+        Run the negative controls (each must produce a counterexample).
+    out : path-like, optional
+        Folder for counterexample files (none written without it).
+
+    Returns
+    -------
+    CheckResult
+        ``seed``, ``variant``, ``results`` (per property: cases, violations, min_slack, ...)
+        and ``passed``.
     """
     text, bad = _native.check(
         only=only,
@@ -149,13 +253,19 @@ def check(
     return r
 
 
-class Diagnosis(Dict[str, Any]):
+class Diagnosis(Result):
     """``report.json`` of ``moreau diagnose`` as a dict; ``fitted_model`` is the refitted
     :class:`System` (None if none), ``series`` the curves of its figures: ``t`` (N,),
     ``y``, ``yhat_nominal``, ``yhat_fitted`` (N, p)."""
 
     fitted_model: Optional[System]
     series: Dict[str, np.ndarray]
+
+    def _parts(self) -> List[str]:
+        verdict = str(self.get("verdict", ""))
+        if len(verdict) > 100:
+            verdict = verdict[:97] + "..."
+        return [f"verdict={verdict!r}", f"effects={[e.get('kind') for e in self.get('effects', [])]}"]
 
 
 def _recording_text(model: Model, rec: Any) -> str:
@@ -195,17 +305,41 @@ def diagnose(
     max_effects: int = 2,
     input_hold: str = "auto",
     estimate_x0: bool = False,
+    metric: str = "auto",
+    no_refit: bool = False,
     out: Optional[PathLike] = None,
 ) -> Diagnosis:
     """Compares a model with a recording, locates the mismatch, names the missing physics,
     refits and validates: ``moreau diagnose --model M --data R``.
 
-    ``recording`` is the path of a CSV file (header ``t,w,y`` or ``t,w1..wm,y1..yp``,
-    optional ``z``), a pandas DataFrame with those columns, or a 2-D array with columns
-    ``t, w1..wm, y1..yp[, z1..zp]``. ``input_hold`` is ``"auto"``, ``"zoh"`` or ``"foh"``
-    (the input between samples); an initial state the model states (``[initial] x0``, or
-    ``x0=`` of :class:`System`) is taken as known unless ``estimate_x0``. ``out`` writes the
-    CLI's report directory (report.md, report.json, fitted.toml, figures).
+    Parameters
+    ----------
+    model : System or path-like
+        The nominal model (``[fit] free`` parameters are refitted unless ``no_refit``).
+    recording : path-like, str, DataFrame or array
+        A CSV file (header ``t,w,y`` or ``t,w1..wm,y1..yp``, optional ``z``), a pandas
+        DataFrame with those columns, or a 2-D array with columns ``t, w1..wm, y1..yp[, z1..zp]``.
+    estimation_fraction : float, default 0.7
+        Fraction of the record used for estimation (the rest validates).
+    max_effects : int, default 2
+        Greatest number of effects added by forward selection.
+    input_hold : {"auto", "zoh", "foh"}, default "auto"
+        The input between samples.
+    estimate_x0 : bool, default False
+        Estimate the initial state even when the model states it.
+    metric : {"auto", "fit", "rmse"}, default "auto"
+        Headline of the verdict (the CLI's ``--metric``).
+    no_refit : bool, default False
+        Keep the parameters the model frees at their values (the CLI's ``--no-refit``).
+    out : path-like, optional
+        Write the CLI's report folder (report.md, report.json, fitted.toml, figures).
+
+    Returns
+    -------
+    Diagnosis
+        ``report.json`` as a dict (``verdict``, ``effects``, ``fit_before``, ``fit_after``,
+        ``nominal_refit``, ...), with ``fitted_model`` (a :class:`System` or None) and
+        ``series`` (``t``, ``y``, ``yhat_nominal``, ``yhat_fitted``).
     """
     nm = _native_model(model)
     kw: Dict[str, Any] = dict(
@@ -213,6 +347,8 @@ def diagnose(
         max_effects=max_effects,
         input_hold=input_hold,
         estimate_x0=estimate_x0,
+        metric=metric,
+        no_refit=no_refit,
         out=None if out is None else os.fspath(out),
     )
     if isinstance(recording, (str, os.PathLike)):
@@ -229,13 +365,19 @@ def diagnose(
     return d
 
 
-class SweepResult(Dict[str, Any]):
+class SweepResult(Result):
     """``sweep.json`` of ``moreau sweep`` as a dict; ``table`` maps every axis parameter and
     column name to a numpy array over the points (NaN where a point failed), ``files`` are
     the tables written, ``complete`` is False where a point failed (exit status 1)."""
 
     files: List[str]
     complete: bool
+
+    def _parts(self) -> List[str]:
+        axes = [a.get("parameter") for a in self.get("axes", [])]
+        pts = self.get("points", [])
+        failed = sum(1 for pt in pts if pt.get("status") not in (None, "ok"))
+        return [f"axes={axes}", f"{len(pts)} points", f"{failed} failed", f"complete={getattr(self, 'complete', '?')}"]
 
     @property
     def table(self) -> Dict[str, np.ndarray]:
@@ -275,8 +417,30 @@ def sweep(
     fresh: bool = False,
     retry_failed: bool = False,
 ) -> SweepResult:
-    """A parameter sweep from a spec file: ``moreau sweep SPEC --out DIR --quiet`` (the same
-    command: resumable, ``shard="K/N"``, tables in CSV, JSON, Markdown and LaTeX in ``out``)."""
+    """A parameter sweep from a spec file: ``moreau sweep SPEC --out DIR --quiet``.
+
+    Parameters
+    ----------
+    spec : path-like
+        The sweep spec (TOML; see docs/sweep-spec.md). For a grid built in Python use
+        :func:`sweep_grid`.
+    out : path-like
+        Output folder (resumable: finished points are kept).
+    shard : str, optional
+        ``"K/N"``: only the points of shard K of N (a job array).
+    threads : int, optional
+        Worker threads (default: all cores).
+    digits : int, optional
+        Significant digits of the tables.
+    overwrite, fresh, retry_failed : bool, default False
+        The CLI's ``--overwrite``, ``--fresh``, ``--retry-failed``.
+
+    Returns
+    -------
+    SweepResult
+        ``sweep.json`` as a dict, with ``table`` (numpy arrays per axis and column),
+        ``files`` and ``complete``.
+    """
     text, files, ok = _native.sweep(
         os.fspath(spec),
         os.fspath(out),
@@ -293,7 +457,97 @@ def sweep(
     return r
 
 
+def _toml_value(key: str, v: Any) -> str:
+    """A TOML literal of a spec value (string, bool, number, or a list of them)."""
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        x = float(v)
+        if not np.isfinite(x):
+            raise MoreauError(f"`{key}` = {x}: not a finite number")
+        return repr(x)
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_toml_value(key, u) for u in np.asarray(v).tolist()) + "]"
+    raise TypeError(f"`{key}`: expected a string, a bool, a number or a list of them, got {type(v).__name__}")
+
+
+def sweep_grid(
+    model: Model,
+    axes: Dict[str, Any],
+    out: PathLike,
+    *,
+    evaluate: Optional[Dict[str, Any]] = None,
+    columns: Optional[List[str]] = None,
+    name: Optional[str] = None,
+    threads: Optional[int] = None,
+    digits: Optional[int] = None,
+    overwrite: bool = False,
+    fresh: bool = False,
+) -> SweepResult:
+    """A parameter sweep over a grid given in Python: the spec file is written for you.
+
+    Parameters
+    ----------
+    model : System or path-like
+        The base model.
+    axes : dict of str to array-like
+        Axis parameter (``"input.amplitude"``, ``"plant.A[1][0]"``, ``"parameters.M"``, ...;
+        see docs/sweep-spec.md) to its values, in axis order.
+    out : path-like
+        Output folder; the spec (``spec.toml``) and base model (``model.toml``) used are
+        written beside the tables, so the sweep can be rerun with ``moreau sweep``.
+    evaluate : dict, optional
+        The spec's ``[evaluate]`` table, e.g. ``{"measure": False}``.
+    columns : list of str, optional
+        The spec's ``[table] columns``.
+    name : str, optional
+        The sweep's name (default: the model's name).
+    threads, digits : int, optional
+        As for :func:`sweep`.
+    overwrite, fresh : bool, default False
+        As for :func:`sweep`.
+
+    Returns
+    -------
+    SweepResult
+        As :func:`sweep` returns.
+    """
+    if not isinstance(axes, dict) or not axes:
+        raise MoreauError("`axes` must be a non-empty dict of axis parameter to values, e.g. {'input.amplitude': [0.5, 1.0]}")
+    sysm = model if isinstance(model, System) else System.load(model)
+    os.makedirs(out, exist_ok=True)
+    spec_dir = os.path.join(os.fspath(out), "spec")
+    os.makedirs(spec_dir, exist_ok=True)
+    sysm.save(os.path.join(spec_dir, "model.toml"))
+    lines = [f"name = {_toml_value('name', sysm.name if name is None else name)}", 'model = "model.toml"']
+    for param, values in axes.items():
+        vals = np.atleast_1d(np.asarray(values, dtype=float))
+        lines += ["", "[[axis]]", f"parameter = {_toml_value('axes', str(param))}", f"values = {_toml_value(str(param), vals)}"]
+    if evaluate:
+        lines += ["", "[evaluate]"] + [f"{k} = {_toml_value('evaluate.' + k, v)}" for k, v in evaluate.items()]
+    if columns:
+        lines += ["", "[table]", f"columns = {_toml_value('columns', list(columns))}"]
+    spec = os.path.join(spec_dir, "spec.toml")
+    with open(spec, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+    return sweep(spec, out, threads=threads, digits=digits, overwrite=overwrite, fresh=fresh)
+
+
 def set_allow_large(on: bool = True) -> None:
-    """The CLI's ``--allow-large`` for every later call: lifts the soft work limits
-    (integration steps, stored samples, check cases, sweep points, theta's n and p)."""
+    """The CLI's ``--allow-large`` for every later call.
+
+    Parameters
+    ----------
+    on : bool, default True
+        Lift (``True``) or restore (``False``) the soft work limits (integration steps,
+        stored samples, check cases, sweep points, theta's n and p).
+
+    Returns
+    -------
+    None
+    """
     _native.set_allow_large(on)

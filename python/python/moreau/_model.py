@@ -380,12 +380,34 @@ class System:
 
     @classmethod
     def load(cls, path: PathLike) -> "System":
-        """Reads a model file (TOML), as ``moreau validate FILE``."""
+        """Reads a model file (TOML), as ``moreau validate FILE``.
+
+        Parameters
+        ----------
+        path : path-like
+            The model file.
+
+        Returns
+        -------
+        System
+            The validated system; an error names the key and the value (:class:`MoreauError`).
+        """
         return cls._wrap(_native.System.load(os.fspath(path)))
 
     @classmethod
     def from_toml(cls, text: str) -> "System":
-        """Parses model-file text (``csv`` inputs relative to the working directory)."""
+        """Parses model-file text (``csv`` inputs relative to the working directory).
+
+        Parameters
+        ----------
+        text : str
+            The text of a model file.
+
+        Returns
+        -------
+        System
+            The validated system.
+        """
         return cls._wrap(_native.System.from_toml(text))
 
     @classmethod
@@ -397,11 +419,28 @@ class System:
         input: Optional[Input] = None,
         **kwargs: Any,
     ) -> "System":
-        """From a continuous-time state-space model with attributes ``A``, ``B``, ``C`` (and ``D``), such
-        as python-control's ``StateSpace`` (python-control itself is not needed).
+        """From a continuous-time state-space model such as python-control's ``StateSpace``
+        (python-control itself is not needed).
 
         The loop of the paper has no feedthrough: a nonzero ``D`` is an error, and so is a
         discrete-time model (``ss.dt`` other than 0 or None). The name defaults to ``ss.name``.
+
+        Parameters
+        ----------
+        ss : object
+            Anything with attributes ``A``, ``B``, ``C`` (and optionally ``D``, ``dt``, ``name``).
+        E : array-like
+            How the backlash output acts on the state (n x p).
+        theta : Set, optional
+            The backlash set (default {0}).
+        input : Input, optional
+            The input (default zero).
+        **kwargs
+            Further keywords of :class:`System` (``x0``, ``name``, ``dt``, ...).
+
+        Returns
+        -------
+        System
         """
         for k in ("A", "B", "C"):
             if not hasattr(ss, k):
@@ -480,7 +519,13 @@ class System:
         return self._native.mu
 
     def eig_F(self) -> np.ndarray:
-        """Eigenvalues of F by decreasing real part."""
+        """Eigenvalues of F by decreasing real part.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex eigenvalues of ``F = A + E C``, shape (n,).
+        """
         return np.array([complex(re, im) for re, im in self._native.eig_f()])
 
     @property
@@ -498,7 +543,18 @@ class System:
         return self._native.input_kind
 
     def w(self, t: ArrayLike) -> np.ndarray:
-        """The input w(t) at the given times, shape (len(t), m)."""
+        """The input w(t) at the given times.
+
+        Parameters
+        ----------
+        t : array-like
+            Times.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (len(t), m).
+        """
         ts = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
         return np.frombuffer(self._native.input_at([float(x) for x in ts]), dtype="<f8").reshape(len(ts), self.m).copy()
 
@@ -520,13 +576,41 @@ class System:
         return list(self._native.effects)
 
     def to_toml(self) -> str:
-        """The model file of this system (a ``Samples`` input is written as a ``csv`` input naming its source)."""
+        """The model file of this system.
+
+        Returns
+        -------
+        str
+            TOML text (a ``Samples`` input is written as a ``csv`` input naming its source; an
+            ``x0`` or ``z0`` never given is not written, so it reads back as the same default).
+        """
         return self._native.to_toml()
 
     def save(self, path: PathLike) -> None:
-        """Writes the model file (``moreau theta PATH`` then reads the same system)."""
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(self.to_toml())
+        """Writes the model file (``moreau theta PATH`` then reads the same system).
+
+        The file is written beside its target and renamed into place, so an interrupted save
+        leaves no half-written model.
+
+        Parameters
+        ----------
+        path : path-like
+            Where to write.
+
+        Returns
+        -------
+        None
+        """
+        text = self.to_toml()
+        target = os.fspath(path)
+        tmp = f"{target}.{os.getpid()}.tmp"
+        try:
+            with open(tmp, "w", encoding="utf-8") as f:
+                f.write(text)
+            os.replace(tmp, target)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
 
     def __repr__(self) -> str:
         per = "none" if self.period is None else f"{self.period:.6g}"
@@ -537,7 +621,18 @@ class System:
 
 
 def load(path: PathLike) -> System:
-    """Reads a model file (TOML)."""
+    """Reads a model file (TOML), as ``moreau validate FILE``.
+
+    Parameters
+    ----------
+    path : path-like
+        The model file.
+
+    Returns
+    -------
+    System
+        The validated system.
+    """
     return System.load(path)
 
 

@@ -94,6 +94,8 @@ def diagnose(
     max_effects: int = 2,
     input_hold: str = "auto",
     estimate_x0: bool = False,
+    metric: str = "auto",
+    no_refit: bool = False,
     out: Optional[_Path] = None,
 ) -> Tuple[str, Optional[System], int, Dict[str, bytes]]: ...
 def sweep(
