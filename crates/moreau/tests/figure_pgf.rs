@@ -42,19 +42,21 @@ fn latex(tex: &str) -> Option<(tempfile::TempDir, impl Fn(&str) -> std::process:
 }
 
 #[test]
-fn stacked_sweep_figure_as_pgfplots_has_one_axis_per_scale_and_compiles_when_latex_is_present() {
+fn sweep_figure_as_pgfplots_has_one_axis_with_the_spec_labels_and_compiles_when_latex_is_present() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sweeps/amplitude/sweep.json");
     let r = moreau::sweep::SweepResult::read(std::path::Path::new(path)).unwrap();
     let f = moreau::figures::sweep::sweep_figure(&r, None, &["theta", "theta_best", "measured_rate"]).unwrap();
-    assert_eq!(f.below.len(), 1, "theta bounds and the measured rate on separate axes");
+    assert!(f.below.is_empty(), "every bound and the measured exponent on one axis");
     let tex = pgf::to_pgf(&f);
     assert!(tex.is_ascii());
-    assert_eq!(tex.matches("\\begin{axis}").count(), 2);
+    assert_eq!(tex.matches("\\begin{axis}").count(), 1);
     assert_eq!(tex.matches('{').count(), tex.matches('}').count(), "unbalanced braces");
-    // all elements of both panels are drawn, and the CSV carries both panels' data
-    let elements: usize = f.panels().iter().map(|p| p.elements.len()).sum();
-    assert_eq!(tex.matches("\\addplot").count(), elements);
+    assert_eq!(tex.matches("\\addplot").count(), f.elements.len());
     assert!(pgf::to_csv(&f).lines().count() > 3 * 9);
+    // the spec's TeX labels as written, not code names
+    assert!(tex.contains("xlabel={$a$}"), "the axis label of the spec");
+    assert!(tex.contains("\\addlegendentry{$\\theta_{\\mathrm{best}}$}"), "the column's TeX name");
+    assert!(!tex.contains("theta\\_best") && !tex.contains("measured\\_rate"), "code names in the figure");
     latex(&tex);
 }
 
@@ -93,8 +95,8 @@ fn psi_figure_of_a_report_draws_the_sharper_certified_bounds_as_levels() {
     let star = level("θ* =").expect("theta_star level");
     assert!(star.iter().all(|p| p.1 == rep.theta_star) && star[0].0 == 0.0 && star[1].0 > rep.gamma_inf);
     let best = level(match rep.theta_best_method {
-        "theta_engaged" => "θ_eng =",
-        _ => "θ_prof =",
+        "theta_engaged" => "θ_{eng} =",
+        _ => "θ_{prof} =",
     })
     .expect("best-bound level");
     assert!(best.iter().all(|p| p.1 == rep.theta_best) && rep.theta_best < rep.theta_star);
