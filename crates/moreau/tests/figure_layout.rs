@@ -88,6 +88,35 @@ fn every_figure() -> Vec<(String, Figure)> {
     figs
 }
 
+/// The figures of `moreau diagnose` (stacked panels, at their own sizes: `diagnose` has no size
+/// option) on a recording of the BAM servo.
+fn diagnosis_figures() -> Vec<(String, Figure)> {
+    use moreau::commands::diagnose::{diagnose, DiagnoseOptions, RecordingSource};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let run = diagnose(
+        &moreau::commands::Source::File(root.join("examples/real/bam-xl330-kp100.toml")),
+        &RecordingSource::File(root.join("data/bam-servo/xl330-kp100-sin_sin.csv")),
+        &DiagnoseOptions::default(),
+    )
+    .unwrap();
+    moreau::figures::diagnosis::figures(&run.report)
+}
+
+#[test]
+fn the_stacked_diagnosis_figures_have_no_overlapping_or_clipped_text() {
+    let figs = diagnosis_figures();
+    assert!(figs.len() >= 3, "fit, residual and at least one zoom");
+    let mut bad = vec![];
+    for (name, f) in &figs {
+        assert!(!f.below.is_empty(), "{name}: stacked panels");
+        bad.extend(defects(f).into_iter().map(|d| format!("{name}: {d}")));
+        // the x-axis label once, under the bottom panel
+        let boxes = canvas::text_boxes(f).unwrap();
+        assert_eq!(boxes.iter().filter(|b| b.text.trim() == "t (s)").count(), 1, "{name}");
+    }
+    assert!(bad.is_empty(), "{} layout defects:\n{}", bad.len(), bad.join("\n"));
+}
+
 fn sized(f: &Figure, size: (u32, u32)) -> Figure {
     let mut f = f.clone();
     f.size = size;

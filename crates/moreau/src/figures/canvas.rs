@@ -558,7 +558,20 @@ where
         draw_panel(&body, f, None, None)?;
     } else {
         let xr = f.shared_x_range().ok_or_else(|| FigureError::NoData { figure: f.title.clone() })?;
-        let panels = f.panels();
+        // the x-axis label under the bottom panel only
+        let n = f.panels().len();
+        let panels: Vec<Figure> = f
+            .panels()
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let mut p = p.clone();
+                if i + 1 < n {
+                    p.x_label.clear();
+                }
+                p
+            })
+            .collect();
         let areas = body.split_evenly((panels.len(), 1));
         // one left edge for every panel, so their plot areas line up
         let left = panels
@@ -566,7 +579,7 @@ where
             .zip(&areas)
             .filter_map(|(p, a)| Some(PanelLayout::of(p, a.dim_in_pixel(), Some(xr))?.y_area))
             .max();
-        for (area, p) in areas.iter().zip(panels) {
+        for (area, p) in areas.iter().zip(&panels) {
             // an empty panel (no finite data) is left blank rather than failing the figure
             if p.ranges().is_some() {
                 draw_panel(area, p, Some(xr), left)?;
@@ -630,7 +643,7 @@ impl PanelLayout {
         }
         let legend_row = line_h(st.legend) + st.gap / 3;
         let th = line_h(st.tick);
-        let x_area = 2 * st.tick_mark + th + st.gap / 2 + line_h(st.label);
+        let x_area = 2 * st.tick_mark + th + if f.x_label.is_empty() { 0 } else { st.gap / 2 + line_h(st.label) };
         let top = st.gap / 2 + th / 2 + 1;
         let mut ranges = f.ranges()?;
         let mut y_area = 0;
@@ -764,7 +777,7 @@ where
     }
     // the legend in rows below the x-axis label, off the data
     let sw = 2 * st.legend as i32;
-    let mut ly = x_label_top + line_h(st.label) + st.gap / 2;
+    let mut ly = pb + lay.x_area + st.gap / 2;
     for row in &lay.legend {
         let row_w: i32 = row.iter().map(|&i| lay.entry_w[i]).sum::<i32>() + 2 * st.gap * (row.len() as i32 - 1);
         let mut lx = (pl + pr - row_w) / 2;

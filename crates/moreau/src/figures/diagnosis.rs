@@ -188,7 +188,7 @@ pub fn figures(r: &Report) -> Vec<(String, Figure)> {
     };
     let residual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
         panel(
-            "residual y - yhat",
+            "residual y − ŷ",
             &unit,
             &c.t,
             k,
