@@ -199,3 +199,28 @@ fn the_checker_flags_overlapping_and_clipped_text() {
     let d = defects(&f);
     assert!(d.iter().any(|d| d.contains("is not inside")), "clipping not flagged: {d:?}");
 }
+
+#[test]
+fn a_crowded_figure_keeps_its_text_apart_by_wrapping_labels_and_shortening_the_legend() {
+    // 20 labelled curves and axis labels longer than the plot, at column width
+    let mut f = Figure::new("many curves in a column-width figure", "", "");
+    f.x_label = "time since the start of the recording of the servo under test (s)".into();
+    f.y_label = "output of the first joint after the backlash, measured by the encoder (rad)".into();
+    for k in 0..20 {
+        let pts = (0..50).map(|i| (i as f64, (i as f64 * 0.1 + k as f64).sin())).collect();
+        let label = format!("curve number {k} (long label)");
+        f.elements.push(Element::Line { label, pts, color: canvas::palette(k), dashed: false });
+    }
+    for size in [SizePreset::Column.size(), SizePreset::TwoColumn.size(), (360, 240)] {
+        let f = sized(&f, size);
+        let boxes = canvas::text_boxes(&f).unwrap();
+        let d = canvas::layout_defects(&boxes, size);
+        assert!(d.is_empty(), "{size:?}: {d:?}");
+        // at 3.5 in and 360 x 240 the legend does not fit: it says how many entries it leaves out
+        let more = boxes.iter().any(|b| b.text.starts_with("+ ") && b.text.ends_with(" more"));
+        assert_eq!(more, size != SizePreset::TwoColumn.size(), "{size:?}: `+ k more`");
+        if std::env::var_os("MOREAU_FIGURE_DUMP").is_some() {
+            std::fs::write(format!("/tmp/crowded-{}.png", size.0), canvas::to_png_at_dpi(&f, 250.0).unwrap()).unwrap();
+        }
+    }
+}

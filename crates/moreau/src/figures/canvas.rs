@@ -81,7 +81,8 @@ pub struct Figure {
     pub y_label: String,
     pub elements: Vec<Element>,
     pub equal_aspect: bool,
-    /// Pixel size. Default `900 x 600`.
+    /// Size in points (SVG units; the PDF page; PNG pixels at 96 dpi). Default `900 x 600`;
+    /// [`SizePreset`] for column widths.
     pub size: (u32, u32),
     /// Further panels stacked below this one, sharing its x axis (quantities of different
     /// scales, e.g. a bound near -0.02 and a measured rate near -0.3): each panel keeps its own
@@ -601,11 +602,21 @@ struct PanelLayout {
     x_area: i32,
     top: i32,
     right: i32,
+    /// The axis labels broken into lines that fit the plot's width and height.
+    x_lines: Vec<String>,
+    y_lines: Vec<String>,
     /// Legend rows: indices of the elements, left to right.
     legend: Vec<Vec<usize>>,
     legend_row: i32,
     /// Width of each element's legend entry (swatch, gap, label).
     entry_w: Vec<i32>,
+    /// Entries left out of a legend too tall for the panel (said at the end of the last row).
+    more: usize,
+}
+
+/// The text that ends a legend that leaves out `n` entries.
+fn more_text(n: usize) -> String {
+    format!("+ {n} more")
 }
 
 impl PanelLayout {
@@ -627,11 +638,12 @@ impl PanelLayout {
             })
             .collect();
         // the legend flows in rows across the width
+        let row_max = w - 2 * st.gap;
         let mut legend: Vec<Vec<usize>> = vec![];
         let mut row_w = 0;
         for (i, &ew) in entry_w.iter().enumerate().filter(|(_, &ew)| ew > 0) {
             match legend.last_mut() {
-                Some(row) if row_w + 2 * st.gap + ew <= w - 2 * st.gap => {
+                Some(row) if row_w + 2 * st.gap + ew <= row_max => {
                     row.push(i);
                     row_w += 2 * st.gap + ew;
                 }
@@ -643,22 +655,48 @@ impl PanelLayout {
         }
         let legend_row = line_h(st.legend) + st.gap / 3;
         let th = line_h(st.tick);
-        let x_area = 2 * st.tick_mark + th + if f.x_label.is_empty() { 0 } else { st.gap / 2 + line_h(st.label) };
         let top = st.gap / 2 + th / 2 + 1;
+        let x_axis = 2 * st.tick_mark + th;
+        let (lh, gap) = (line_h(st.label), st.gap / 2);
+        let label_h = |lines: &[String]| if lines.is_empty() { 0 } else { gap + lh * lines.len() as i32 };
+        // a legend too tall leaves the plot two fifths of the panel: its last rows are left
+        // out and counted at the end of the last row kept
+        let mut more = 0;
+        let keep = ((h - top - x_axis - label_h(&[String::new()]) - gap - (2 * h / 5).max(3 * th)) / legend_row).max(1);
+        if legend.len() as i32 > keep {
+            for row in legend.drain(keep as usize..) {
+                more += row.len();
+            }
+            if let Some(last) = legend.last_mut() {
+                while !last.is_empty() {
+                    let used: i32 = last.iter().map(|&i| entry_w[i] + 2 * st.gap).sum();
+                    if used + rich_width(&more_text(more + 1), st.legend) <= row_max {
+                        break;
+                    }
+                    last.pop();
+                    more += 1;
+                }
+            }
+        }
+        let legend_h = legend.len() as i32 * legend_row;
         let mut ranges = f.ranges()?;
-        let mut y_area = 0;
-        let mut right = 0;
-        // twice: with equal aspect the ranges follow the plot area, which follows the tick labels
-        for _ in 0..2 {
+        let (mut y_area, mut x_area, mut right) = (0, 0, 0);
+        let (mut x_lines, mut y_lines) = (wrap(&f.x_label, st.label, w), wrap(&f.y_label, st.label, h));
+        // three times: the labels wrap to the plot's size, which follows the labels and the
+        // tick labels; with equal aspect the ranges follow the plot area
+        for _ in 0..3 {
             let ((x0, x1), (y0, y1)) = ranges;
             let (x0, x1) = x_range.unwrap_or((x0, x1));
-            y_area = st.gap / 2 + line_h(st.label) + st.gap / 2 + widest_tick(y0, y1, st.tick) + 2 * st.tick_mark;
-            right = (st.gap / 2).max(widest_tick(x0, x1, st.tick) / 2 + 2);
-            let pw = (w - st.gap / 2 - y_area - right).max(10);
-            let ph = (h - top - x_area - legend.len() as i32 * legend_row - st.gap / 2).max(10);
+            y_area = label_h(&y_lines) + gap + widest_tick(y0, y1, st.tick) + 2 * st.tick_mark;
+            x_area = x_axis + label_h(&x_lines);
+            right = gap.max(widest_tick(x0, x1, st.tick) / 2 + 2);
+            let pw = (w - gap - y_area - right).max(10);
+            let ph = (h - top - x_area - legend_h - gap).max(10);
             ranges = f.ranges_in(pw as f64, ph as f64)?;
+            x_lines = wrap(&f.x_label, st.label, pw);
+            y_lines = wrap(&f.y_label, st.label, ph + top);
         }
-        Some(Self { st, ranges, y_area, x_area, top, right, legend, legend_row, entry_w })
+        Some(Self { st, ranges, y_area, x_area, top, right, x_lines, y_lines, legend, legend_row, entry_w, more })
     }
 }
 
@@ -713,11 +751,18 @@ where
         .axis_style(BLACK.stroke_width((st.line / 2).max(1)))
         .draw()
         .map_err(|e| err(&e))?;
-    // axis labels: the x label centred under the tick labels, the y label left of them
-    let xw = rich_width(&f.x_label, st.label);
+    // axis labels: the x label centred under the tick labels, the y label left of them (each
+    // broken into lines when longer than the plot)
+    let lh = line_h(st.label);
     let x_label_top = pb + 2 * st.tick_mark + line_h(st.tick) + st.gap / 2;
-    draw_rich(root, &f.x_label, ((pl + pr - xw) / 2, x_label_top), st.label).map_err(|e| err(&e))?;
-    draw_rich_vertical(root, &f.y_label, pl - y_area + st.gap / 2, (pt + pb) / 2, st.label).map_err(|e| err(&e))?;
+    for (i, l) in lay.x_lines.iter().enumerate() {
+        let xw = rich_width(l, st.label);
+        draw_rich(root, l, ((pl + pr - xw) / 2, x_label_top + lh * i as i32), st.label).map_err(|e| err(&e))?;
+    }
+    for (i, l) in lay.y_lines.iter().enumerate() {
+        let left = pl - y_area + st.gap / 2 + lh * i as i32;
+        draw_rich_vertical(root, l, left, (pt + pb) / 2, st.label).map_err(|e| err(&e))?;
+    }
     let dash = ((4 * st.line) as f64 * 2.0).max(4.0);
     let mut placed: Vec<(i32, i32, i32, i32)> = vec![];
     for e in &f.elements {
@@ -778,8 +823,13 @@ where
     // the legend in rows below the x-axis label, off the data
     let sw = 2 * st.legend as i32;
     let mut ly = pb + lay.x_area + st.gap / 2;
-    for row in &lay.legend {
-        let row_w: i32 = row.iter().map(|&i| lay.entry_w[i]).sum::<i32>() + 2 * st.gap * (row.len() as i32 - 1);
+    let more = (lay.more > 0).then(|| more_text(lay.more));
+    for (r, row) in lay.legend.iter().enumerate() {
+        // the last row ends with "+ k more" when entries were left out
+        let more = more.as_ref().filter(|_| r + 1 == lay.legend.len());
+        let widths: Vec<i32> =
+            row.iter().map(|&i| lay.entry_w[i]).chain(more.map(|t| rich_width(t, st.legend))).collect();
+        let row_w: i32 = widths.iter().sum::<i32>() + 2 * st.gap * (widths.len() as i32 - 1);
         let mut lx = (pl + pr - row_w) / 2;
         lx = lx.min(root.dim_in_pixel().0 as i32 - st.gap / 2 - row_w).max(st.gap / 2);
         let cy = ly + line_h(st.legend) / 2;
@@ -804,6 +854,9 @@ where
             .map_err(|e| err(&e))?;
             draw_rich(root, label, (lx + sw + st.gap / 2, ly), st.legend).map_err(|e| err(&e))?;
             lx += lay.entry_w[i] + 2 * st.gap;
+        }
+        if let Some(t) = more {
+            draw_rich(root, t, (lx, ly), st.legend).map_err(|e| err(&e))?;
         }
         ly += lay.legend_row;
     }
