@@ -107,3 +107,28 @@ fn psi_figure_of_a_report_draws_the_sharper_certified_bounds_as_levels() {
     let g = psi::from_report(&unverified);
     assert!(g.elements.len() + 2 == f.elements.len(), "{} vs {}", g.elements.len(), f.elements.len());
 }
+
+#[test]
+fn every_figure_kind_as_pgfplots_is_ascii_and_compiles_when_latex_is_present() {
+    let load = |name: &str| {
+        model::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).unwrap()
+    };
+    let mut figs = vec![psi_figure()];
+    for name in ["worked-example.toml", "ellipse-p2.toml"] {
+        let sys = load(name);
+        let s = ThetaSettings::bound_only();
+        let orbit = bounds::orbit::EtaOrbit::new(&sys, &s.orbit).unwrap();
+        let tube = bounds::tube::OutputTube::new(&sys, &s.tube).unwrap();
+        let z = moreau::figures::tube::periodic_z(&sys, 200).unwrap();
+        figs.push(moreau::figures::tube::tube_figure(&sys, &orbit, &tube, &z));
+    }
+    let settings = moreau::figures::trajectory::TrajectorySettings { t_end: Some(10.0), ..Default::default() };
+    let (yz, x) = moreau::figures::trajectory::trajectory_figures(&load("worked-example.toml"), &settings).unwrap();
+    figs.extend([yz, x]);
+    for f in &figs {
+        let tex = pgf::to_pgf(f);
+        assert!(tex.is_ascii() && !tex.contains('?'), "non-ASCII or unmapped character in:\n{tex}");
+        assert_eq!(tex.matches('{').count(), tex.matches('}').count(), "unbalanced braces");
+        latex(&tex);
+    }
+}
