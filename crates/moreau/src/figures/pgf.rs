@@ -10,7 +10,7 @@ use plotters::style::RGBColor;
 /// with TeX math in it (`$\\delta$ (m)`, as a sweep spec's `label` writes it) keeps its math as
 /// written; the text around it is converted.
 pub fn tex_text(s: &str) -> String {
-    if s.contains('$') && s.matches('$').count() % 2 == 0 {
+    if s.contains('$') && s.matches('$').count().is_multiple_of(2) {
         return s
             .split('$')
             .enumerate()

@@ -115,7 +115,7 @@ fn panel(r: &SweepResult, x: Option<&str>, columns: &[&str], colour_from: &mut u
                 cert_idx
                     .is_some_and(|ci| pts.iter().any(|p| p.params[xi] == x && matches!(p.cells[ci], Cell::Flag(true))))
             };
-            let (yes, no): (Vec<(f64, f64)>, Vec<(f64, f64)>) = xy.iter().partition(|(x, _)| certified(*x));
+            let (yes, no): (Vec<_>, Vec<_>) = xy.iter().partition(|(x, _)| certified(*x));
             if cert_idx.is_some() {
                 f.elements.push(Element::Markers {
                     label: String::new(),

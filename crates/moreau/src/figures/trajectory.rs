@@ -92,8 +92,8 @@ pub fn simulation_figure(sys: &System, tr: &Trajectory, method: &str) -> Figure 
         f.elements.push(Element::Line { label, pts: tr.t.iter().copied().zip(y).collect(), color, dashed: false });
     };
     // an input with a unit other than the axis's says it in its legend entry
-    for j in 0..sys.m() {
-        let own = if ws[j] != y_unit && !ws[j].is_empty() { unit(ws[j]) } else { String::new() };
+    for (j, &w) in ws.iter().enumerate() {
+        let own = if w != y_unit && !w.is_empty() { unit(w) } else { String::new() };
         line(format!("w_{}{own}", j + 1), (0..tr.len()).map(|i| tr.w_at(i)[j]).collect());
     }
     for j in 0..sys.p() {

@@ -345,8 +345,7 @@ impl SweepResult {
         let shown = self.shown();
         let failed = self.any_failed();
         let (axes_fmt, cols_fmt) = self.number_formats(&shown, digits);
-        let numeric: Vec<bool> = std::iter::repeat(true)
-            .take(self.axes.len())
+        let numeric: Vec<bool> = std::iter::repeat_n(true, self.axes.len())
             .chain(shown.iter().map(|&k| self.columns[k].kind == ColumnKind::Number))
             .collect();
         let spec: Vec<String> = axes_fmt
