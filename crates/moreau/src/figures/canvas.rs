@@ -1,5 +1,11 @@
 //! A small figure description (lines, dashed lines, bands, filled polygons, markers) and its
-//! rendering with plotters to SVG and PNG. Fonts: [`super::fonts`].
+//! rendering with plotters to SVG (PNG and PDF are made from the SVG). Fonts: [`super::fonts`].
+//!
+//! Layout: sizes are points ([`SizePreset`] for one and two journal columns); the text is 8-9 pt
+//! at column width and scales up to the 900 x 600 default; the legend stands in rows below the
+//! axes; tick counts, label lines and the legend are fitted to the measured text (the embedded
+//! DejaVu Sans), so no text overlaps another or leaves the page, which [`text_boxes`] and
+//! [`layout_defects`] check on the rendered SVG (tests/figure_layout.rs).
 use super::FigureError;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
