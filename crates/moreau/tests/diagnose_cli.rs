@@ -307,14 +307,16 @@ fn bam_report_localises_against_a_null_and_zooms_on_the_windows_with_units() {
     for f in ["fit", "residual", "zoom-1"] {
         assert!(out.join(format!("{f}.png")).is_file(), "{f}.png");
         let texts = svg_texts(&out.join(format!("{f}.svg")));
-        assert!(texts.iter().any(|t| t == "residual y - yhat (rad)"), "{f}: {texts:?}");
+        assert!(texts.iter().any(|t| t == "residual y − ŷ (rad)"), "{f}: {texts:?}");
+        // no negative zero, and minus signs are U+2212, not hyphens
+        let minus = ['-', '\u{2212}'];
         assert!(
-            !texts
-                .iter()
-                .any(|t| t.trim_start_matches('-').trim_matches(|c| c == '0' || c == '.').is_empty()
-                    && t.starts_with('-')),
+            !texts.iter().any(|t| t.trim_start_matches(minus).trim_matches(|c| c == '0' || c == '.').is_empty()
+                && t.starts_with(minus)),
             "{f}: {texts:?}"
         );
+        assert!(texts.iter().any(|t| t.starts_with('\u{2212}')), "{f}: a negative tick label: {texts:?}");
+        assert!(!texts.iter().any(|t| t.starts_with('-') && t[1..].parse::<f64>().is_ok()), "{f}: {texts:?}");
         let svg = std::fs::read_to_string(out.join(format!("{f}.svg"))).unwrap();
         assert!(svg.contains("#0072B2") && svg.contains("#E69F00"), "{f}: Okabe-Ito blue and orange");
     }

@@ -42,19 +42,21 @@ fn latex(tex: &str) -> Option<(tempfile::TempDir, impl Fn(&str) -> std::process:
 }
 
 #[test]
-fn stacked_sweep_figure_as_pgfplots_has_one_axis_per_scale_and_compiles_when_latex_is_present() {
+fn sweep_figure_as_pgfplots_has_one_axis_with_the_spec_labels_and_compiles_when_latex_is_present() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sweeps/amplitude/sweep.json");
     let r = moreau::sweep::SweepResult::read(std::path::Path::new(path)).unwrap();
     let f = moreau::figures::sweep::sweep_figure(&r, None, &["theta", "theta_best", "measured_rate"]).unwrap();
-    assert_eq!(f.below.len(), 1, "theta bounds and the measured rate on separate axes");
+    assert!(f.below.is_empty(), "every bound and the measured exponent on one axis");
     let tex = pgf::to_pgf(&f);
     assert!(tex.is_ascii());
-    assert_eq!(tex.matches("\\begin{axis}").count(), 2);
+    assert_eq!(tex.matches("\\begin{axis}").count(), 1);
     assert_eq!(tex.matches('{').count(), tex.matches('}').count(), "unbalanced braces");
-    // all elements of both panels are drawn, and the CSV carries both panels' data
-    let elements: usize = f.panels().iter().map(|p| p.elements.len()).sum();
-    assert_eq!(tex.matches("\\addplot").count(), elements);
+    assert_eq!(tex.matches("\\addplot").count(), f.elements.len());
     assert!(pgf::to_csv(&f).lines().count() > 3 * 9);
+    // the spec's TeX labels as written, not code names
+    assert!(tex.contains("xlabel={$a$}"), "the axis label of the spec");
+    assert!(tex.contains("\\addlegendentry{$\\theta_{\\mathrm{best}}$}"), "the column's TeX name");
+    assert!(!tex.contains("theta\\_best") && !tex.contains("measured\\_rate"), "code names in the figure");
     latex(&tex);
 }
 
@@ -93,8 +95,8 @@ fn psi_figure_of_a_report_draws_the_sharper_certified_bounds_as_levels() {
     let star = level("θ* =").expect("theta_star level");
     assert!(star.iter().all(|p| p.1 == rep.theta_star) && star[0].0 == 0.0 && star[1].0 > rep.gamma_inf);
     let best = level(match rep.theta_best_method {
-        "theta_engaged" => "θ_eng =",
-        _ => "θ_prof =",
+        "theta_engaged" => "θ_{eng} =",
+        _ => "θ_{prof} =",
     })
     .expect("best-bound level");
     assert!(best.iter().all(|p| p.1 == rep.theta_best) && rep.theta_best < rep.theta_star);
@@ -104,4 +106,29 @@ fn psi_figure_of_a_report_draws_the_sharper_certified_bounds_as_levels() {
     unverified.theta_best_verified = false;
     let g = psi::from_report(&unverified);
     assert!(g.elements.len() + 2 == f.elements.len(), "{} vs {}", g.elements.len(), f.elements.len());
+}
+
+#[test]
+fn every_figure_kind_as_pgfplots_is_ascii_and_compiles_when_latex_is_present() {
+    let load = |name: &str| {
+        model::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples").join(name)).unwrap()
+    };
+    let mut figs = vec![psi_figure()];
+    for name in ["worked-example.toml", "ellipse-p2.toml"] {
+        let sys = load(name);
+        let s = ThetaSettings::bound_only();
+        let orbit = bounds::orbit::EtaOrbit::new(&sys, &s.orbit).unwrap();
+        let tube = bounds::tube::OutputTube::new(&sys, &s.tube).unwrap();
+        let z = moreau::figures::tube::periodic_z(&sys, 200).unwrap();
+        figs.push(moreau::figures::tube::tube_figure(&sys, &orbit, &tube, &z));
+    }
+    let settings = moreau::figures::trajectory::TrajectorySettings { t_end: Some(10.0), ..Default::default() };
+    let (yz, x) = moreau::figures::trajectory::trajectory_figures(&load("worked-example.toml"), &settings).unwrap();
+    figs.extend([yz, x]);
+    for f in &figs {
+        let tex = pgf::to_pgf(f);
+        assert!(tex.is_ascii() && !tex.contains('?'), "non-ASCII or unmapped character in:\n{tex}");
+        assert_eq!(tex.matches('{').count(), tex.matches('}').count(), "unbalanced braces");
+        latex(&tex);
+    }
 }

@@ -87,17 +87,20 @@ fn two_axis_result() -> SweepResult {
 fn sweep_figure_has_one_curve_per_column_and_group() {
     let r = two_axis_result();
     let f = sweep_figure(&r, None, &["theta", "measured_rate"]).unwrap();
-    // theta and the measured rate in stacked panels (their own y axes), one curve per value
-    // of the other axis in each
-    assert_eq!(f.below.len(), 1, "the measured rate in its own panel");
-    let lines: Vec<&Element> =
-        f.panels().into_iter().flat_map(|p| p.elements.iter()).filter(|e| matches!(e, Element::Line { .. })).collect();
+    // theta and the measured rate on one y axis, one curve per value of the other axis, axes
+    // and legend named by the spec's labels
+    assert!(f.below.is_empty(), "one axis");
+    let lines: Vec<&Element> = f.elements.iter().filter(|e| matches!(e, Element::Line { .. })).collect();
     assert_eq!(lines.len(), 4, "2 columns x 2 values of the other axis");
-    assert_eq!(f.elements.iter().filter(|e| matches!(e, Element::Line { .. })).count(), 2, "theta in the top panel");
     if let Element::Line { pts, label, .. } = lines[0] {
         assert_eq!(pts, &vec![(1.0, 10.0), (2.0, 20.0), (3.0, 30.0)]);
-        assert!(label.contains("input.omega = 10"));
+        assert_eq!(label, "t, $w$ = 10");
     }
+    assert_eq!((f.x_label.as_str(), f.y_label.as_str()), ("$a$", "convergence exponent"));
+    // negative control: an axis without a label is named by its parameter
+    let mut unlabelled = r.clone();
+    unlabelled.axes[0].label.clear();
+    assert_eq!(sweep_figure(&unlabelled, None, &["theta"]).unwrap().x_label, "input.amplitude");
     let f = sweep_figure(&r, Some("input.omega"), &["theta"]).unwrap();
     assert_eq!(f.elements.iter().filter(|e| matches!(e, Element::Line { .. })).count(), 3);
     assert!(matches!(sweep_figure(&r, Some("plant.A[0][0]"), &["theta"]), Err(FigureError::UnknownAxis { .. })));

@@ -154,7 +154,7 @@ fn digits_option_changes_only_markdown_and_latex() {
     sweep::run(&spec, &ev, &RunOptions { digits: Some(6), ..opts(&o6) }).unwrap();
     let (a, b) = (read_all(&o3, "sweep"), read_all(&o6, "sweep"));
     assert_eq!(a[1], b[1], "CSV is exact whatever --digits");
-    assert!(a[3].contains("$-2.12$") && b[3].contains("$-2.12346$"));
+    assert!(a[3].contains("\n-2.12 &") && b[3].contains("\n-2.12346 &"), "{}", a[3]);
     assert!(a[2].contains("| -2.12 |") && b[2].contains("| -2.12346 |"));
     assert!(matches!(
         sweep::run(&spec, &ev, &RunOptions { digits: Some(0), ..opts(&tmp.path().join("d0")) }),

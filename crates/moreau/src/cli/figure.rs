@@ -22,7 +22,8 @@ pub enum Kind {
   moreau figure psi examples/worked-example.toml --out out/figs     # fig-psi1.{svg,png,tex,csv}
   moreau figure tube examples/ellipse-p2.toml --out out/figs        # fig-loop
   moreau figure sweep out/amplitude --columns theta,measured_rate --out out/figs
-  moreau figure psi examples/worked-example.toml --format pgf --no-title --out paper/figs")]
+  moreau figure psi examples/worked-example.toml --format pgf --no-title --out paper/figs
+  moreau figure psi examples/worked-example.toml --size column --format pdf --no-title --out paper/figs")]
 pub struct Args {
     /// Which figure.
     #[arg(value_enum)]
@@ -33,7 +34,7 @@ pub struct Args {
     #[arg(long)]
     pub out: PathBuf,
     /// sweep: numeric columns to draw (default: those of theta, theta_best, measured_rate the
-    /// sweep has). The theta bounds share a panel; any other column gets its own, stacked below.
+    /// sweep has), all on one y axis.
     #[arg(long, value_delimiter = ',')]
     pub columns: Vec<String>,
     /// sweep: the axis on the horizontal axis (default: the first).
@@ -51,11 +52,18 @@ pub struct Args {
     /// --width x --height pixels.
     #[arg(allow_negative_numbers = true, long)]
     pub dpi: Option<f64>,
-    /// Width and height in pixels of the SVG and PNG (the pgf code takes the paper's line width).
-    #[arg(long, default_value_t = 900)]
-    pub width: u32,
-    #[arg(long, default_value_t = 600)]
-    pub height: u32,
+    /// Size preset for papers, in points (one SVG unit is a point in the PDF): `column` 252 x
+    /// 216 (3.5 in wide), `two-column` 515 x 258 (7.16 in); text 8-9 pt, the legend below the
+    /// axes. --width and --height override either side.
+    #[arg(long, value_enum)]
+    pub size: Option<figures::canvas::SizePreset>,
+    /// Width of the SVG, PDF (points) and PNG (pixels at 96 dpi). Default 900, or the --size
+    /// preset's (the pgf code takes the paper's line width).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Height, as --width. Default 600, or the --size preset's.
+    #[arg(long)]
+    pub height: Option<u32>,
     /// No title above the plot (a paper's caption replaces it).
     #[arg(long)]
     pub no_title: bool,
@@ -66,14 +74,14 @@ pub struct Args {
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     // options and the output folder are checked before the work
+    let preset = a.size.map_or((900, 600), |s| s.size());
+    let (width, height) = (a.width.unwrap_or(preset.0), a.height.unwrap_or(preset.1));
     anyhow::ensure!(
-        (200..=8000).contains(&a.width) && (150..=8000).contains(&a.height),
-        "--width {} --height {}: must be within 200..8000 x 150..8000 pixels",
-        a.width,
-        a.height
+        (200..=8000).contains(&width) && (150..=8000).contains(&height),
+        "--width {width} --height {height}: must be within 200..8000 x 150..8000 pixels"
     );
     if let Some(dpi) = a.dpi {
-        figures::canvas::png_size((a.width, a.height), dpi).map_err(anyhow::Error::msg)?;
+        figures::canvas::png_size((width, height), dpi).map_err(anyhow::Error::msg)?;
     }
     crate::output::register_input(&a.input);
     crate::output::check_directory_writable(&a.out)?;
@@ -155,7 +163,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let figs: Vec<(String, Figure)> = figs
         .into_iter()
         .map(|(stem, mut f)| {
-            f.size = (a.width, a.height);
+            f.size = (width, height);
             if a.no_title {
                 f.title.clear();
             }

@@ -188,7 +188,7 @@ pub fn figures(r: &Report) -> Vec<(String, Figure)> {
     };
     let residual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
         panel(
-            "residual y - yhat",
+            "residual y − ŷ",
             &unit,
             &c.t,
             k,
@@ -218,25 +218,6 @@ pub fn figures(r: &Report) -> Vec<(String, Figure)> {
         top.size = size;
         for p in &mut panels {
             p.size = size;
-        }
-        // one legend column width for all panels, so their plot areas line up
-        let lw = std::iter::once(&top).chain(&panels).map(|p| p.legend_width()).max().unwrap_or(0);
-        let pad = |f: &mut Figure| {
-            // trailing spaces on the last label widen the legend column (capped at a third of
-            // the width, which `lw` respects)
-            while f.legend_width() < lw {
-                match f.elements.iter_mut().rev().find_map(|e| match e {
-                    Element::Line { label, .. } => Some(label),
-                    _ => None,
-                }) {
-                    Some(label) => label.push(' '),
-                    None => break,
-                }
-            }
-        };
-        pad(&mut top);
-        for p in &mut panels {
-            pad(p);
         }
         top.below = panels;
         top

@@ -6,13 +6,42 @@ use super::canvas::{Element, Figure};
 use plotters::style::RGBColor;
 
 /// Text of a label in LaTeX: Greek letters, sub/superscript digits, minus and infinity to math
-/// mode, specials escaped.
+/// mode, specials escaped; `_X` (one letter, digit or `∞`) and `_{..}` as subscripts. A label
+/// with TeX math in it (`$\\delta$ (m)`, as a sweep spec's `label` writes it) keeps its math as
+/// written; the text around it is converted.
 pub fn tex_text(s: &str) -> String {
+    if s.contains('$') && s.matches('$').count().is_multiple_of(2) {
+        return s
+            .split('$')
+            .enumerate()
+            .map(|(i, seg)| if i % 2 == 1 { format!("${seg}$") } else { plain_tex(seg) })
+            .collect::<String>()
+            .replace("$$", "");
+    }
+    plain_tex(s)
+}
+
+fn plain_tex(s: &str) -> String {
     // "gamma infinity", "Xi infinity" as the labels write them: subscripts
-    let s = s.replace("γ∞", "γ\u{e000}").replace("Ξ∞", "Ξ\u{e000}");
+    let s = s.replace("γ∞", "γ\u{e000}").replace("Ξ∞", "Ξ\u{e000}").replace("_∞", "\u{e000}");
     let mut out = String::new();
     let chars: Vec<char> = s.chars().collect();
-    for (i, &c) in chars.iter().enumerate() {
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        // `theta_{eng}`: a group subscript, upright when it is a word
+        if c == '_' && chars.get(i + 1) == Some(&'{') {
+            if let Some(end) = chars[i + 2..].iter().position(|&x| x == '}') {
+                let body: String = chars[i + 2..i + 2 + end].iter().collect();
+                if body.chars().count() > 1 && body.chars().all(|x| x.is_ascii_alphabetic()) {
+                    out.push_str(&format!("$_{{\\mathrm{{{body}}}}}$"));
+                } else {
+                    out.push_str(&format!("$_{{{}}}$", plain_tex(&body).replace('$', "")));
+                }
+                i += end + 3;
+                continue;
+            }
+        }
         // `eta_T`-style subscripts: `_` before a letter or digit is a math subscript
         // (a single character: `input_amplitude` keeps its underscore)
         let single = |k: usize| {
@@ -20,9 +49,11 @@ pub fn tex_text(s: &str) -> String {
                 && !chars.get(k + 1).is_some_and(|n| n.is_ascii_alphanumeric())
         };
         if c == '_' && single(i + 1) {
+            i += 1;
             continue;
         }
-        if i > 0 && chars[i - 1] == '_' && single(i) {
+        i += 1;
+        if i > 1 && chars[i - 2] == '_' && single(i - 1) {
             out.push_str(&format!("$_{{{c}}}$"));
             continue;
         }
@@ -252,5 +283,10 @@ mod tests {
         assert_eq!(tex_text("50% of a_b & c"), "50\\% of a$_{b}$ \\& c");
         assert_eq!(tex_text("input_amplitude"), "input\\_amplitude");
         assert!(tex_text("‽").is_ascii());
+        assert_eq!(tex_text("θ_{eng} = 1"), "$\\theta_{\\mathrm{eng}}$ = 1");
+        assert_eq!(tex_text("tube C Ξ_∞"), "tube C $\\Xi_\\infty$");
+        // TeX as a sweep spec writes it is kept; the text around it converted
+        assert_eq!(tex_text("$\\delta$ (m)"), "$\\delta$ (m)");
+        assert_eq!(tex_text("$A_{21}$ = −3, 50%"), "$A_{21}$ = $-$3, 50\\%");
     }
 }

@@ -2,8 +2,7 @@
 //! `-lambda`, the value `psi(gamma_inf)` and the chord over `[0, gamma_inf]` whose value at
 //! `gamma_1` is `theta` (eq. (theta)); from a report, also the sharper certified bounds as
 //! levels ([`from_report`]).
-use super::canvas::{Element, Figure, BLUE, GREEN, GREY, ORANGE, PURPLE, RED};
-use crate::sweep::table::sig;
+use super::canvas::{num_text, Element, Figure, BLUE, GREEN, GREY, ORANGE, PURPLE, RED};
 use bounds::{Psi, ThetaReport};
 
 /// Fig. psi1 from the function and the two gammas (`theta` is read off the chord).
@@ -17,7 +16,7 @@ pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
     } else {
         1.0
     };
-    let v = |x: f64| sig(x, 4, false);
+    let v = num_text;
     let k = 400;
     let curve: Vec<(f64, f64)> = (0..=k).map(|i| g_max * i as f64 / k as f64).map(|g| (g, psi.eval(g))).collect();
     let (p0, pinf) = (psi.at_zero(), psi.eval(gamma_inf));
@@ -33,7 +32,7 @@ pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
         dashed: true,
     });
     f.elements.push(Element::Line {
-        label: "chord over [0, γ∞]".into(),
+        label: "chord over [0, γ_∞]".into(),
         pts: vec![(0.0, p0), (gamma_inf, pinf)],
         color: ORANGE,
         dashed: false,
@@ -48,9 +47,9 @@ pub fn psi_figure(psi: &Psi, gamma_1: f64, gamma_inf: f64) -> Figure {
         label: String::new(),
         pts: vec![(0.0, p0), (gamma_inf, pinf)],
         text: if gamma_inf > 0.0 {
-            vec![format!("ψ(0) = {}", v(p0)), format!("ψ(γ∞) = {}", v(pinf))]
+            vec![format!("ψ(0) = {}", v(p0)), format!("ψ(γ_∞) = {}", v(pinf))]
         } else {
-            vec![format!("ψ(0) = ψ(γ∞) = {} (γ∞ = 0)", v(p0)), String::new()]
+            vec![format!("ψ(0) = ψ(γ_∞) = {} (γ_∞ = 0)", v(p0)), String::new()]
         },
         color: BLUE,
     });
@@ -75,15 +74,15 @@ pub fn from_report(r: &ThetaReport) -> Figure {
         Some(Element::Line { pts, .. }) => pts.last().map_or(1.0, |p| p.0),
         _ => 1.0,
     };
-    let v = |x: f64| sig(x, 4, false);
+    let v = num_text;
     let mut levels = vec![];
     if r.theta_star_verified && r.theta_star < r.theta {
         levels.push((format!("θ* = {} with {}", v(r.theta_star), r.path_best_method), r.theta_star, GREEN));
     }
     if r.theta_best_verified && r.theta_best < r.theta.min(r.theta_star) {
         let name = match r.theta_best_method {
-            "theta_profile" => Some("θ_prof"),
-            "theta_engaged" => Some("θ_eng"),
+            "theta_profile" => Some("θ_{prof}"),
+            "theta_engaged" => Some("θ_{eng}"),
             _ => None,
         };
         if let Some(name) = name {

@@ -2,48 +2,38 @@
 //! result file (`moreau sweep`). With several axes, one curve per combination of the others.
 //! When the sweep has the `certified` column, the points where the best verified bound
 //! certifies convergence are drawn in the curve's colour and the others grey.
-//! Columns of different scales get their own panels, stacked with one x axis: the bounds
-//! (`theta`, `theta_star`, `theta_profile`, `theta_engaged`, `theta_best`, about -0.02 on the worked example)
-//! in one, every other column (the measured rate, about -0.3) in its own, so neither is
-//! flattened against the other's range.
-use super::canvas::{palette, Element, Figure, GREY};
+//! Every column shares one y axis: the bounds (`theta`, `theta_best`, ...) and the measured
+//! exponent are rates of the same kind, and their ratio is what a reader compares. Axes and
+//! legend carry the spec's labels (`label = "$\\delta$ (m)"`, the columns' TeX names), drawn
+//! with Greek letters in SVG/PNG/PDF and kept as TeX in pgf.
+use super::canvas::{num_text, palette, Element, Figure, GREY};
 use super::FigureError;
-use crate::sweep::{Cell, ColumnKind, SweepResult};
+use crate::sweep::{Cell, Column, ColumnKind, SweepResult};
 use std::collections::BTreeMap;
 
-/// Which panel a column goes to: the theta bounds share one, any other column has its own.
-fn panel_key(column: &str) -> String {
-    if column.starts_with("theta") {
-        "theta".into()
-    } else {
-        column.into()
+/// Whether a column is a rate exponent (a theta bound or the measured exponent).
+fn is_exponent(column: &str) -> bool {
+    column.starts_with("theta") && !column.ends_with("verified") || column.starts_with("measured_rate")
+}
+
+/// The name of a column in a figure: its TeX label (`$\\theta_{\\mathrm{best}}$`), the
+/// measured rate as "measured exponent".
+fn column_label(c: &Column) -> String {
+    match c.name.as_str() {
+        "measured_rate" => "measured exponent".into(),
+        _ if c.latex.trim().is_empty() => c.name.clone(),
+        _ => c.latex.clone(),
     }
 }
 
-/// Curves of the numeric `columns` against axis `x` (default: the first axis), one stacked
-/// panel per group of comparable columns (see the module doc).
+/// Curves of the numeric `columns` against axis `x` (default: the first axis), all on one y
+/// axis (see the module doc).
 pub fn sweep_figure(r: &SweepResult, x: Option<&str>, columns: &[&str]) -> Result<Figure, FigureError> {
-    let mut groups: Vec<(String, Vec<&str>)> = vec![];
-    for c in columns {
-        let k = panel_key(c);
-        match groups.iter_mut().find(|g| g.0 == k) {
-            Some(g) => g.1.push(c),
-            None => groups.push((k, vec![c])),
-        }
-    }
     let mut colour = 0;
-    let mut panels = vec![];
-    for (_, cols) in &groups {
-        panels.push(panel(r, x, cols, &mut colour)?);
-    }
-    let mut top = panels.remove(0);
+    let mut top = panel(r, x, columns, &mut colour)?;
     // the sweep's own name; the columns are on the axes
     top.title = r.name.clone();
-    for p in &mut panels {
-        p.title.clear();
-    }
-    top.below = panels;
-    if top.panels().iter().all(|p| p.ranges().is_none()) {
+    if top.ranges().is_none() {
         return Err(FigureError::NoData { figure: top.title });
     }
     Ok(top)
@@ -77,8 +67,12 @@ fn panel(r: &SweepResult, x: Option<&str>, columns: &[&str], colour_from: &mut u
             })
         })
         .collect::<Result<_, _>>()?;
-    let xname = &r.axes[xi].name;
-    let mut f = Figure::new(&format!("{}: {} against {xname}", r.name, columns.join(", ")), xname, &columns.join(", "));
+    let axis_label =
+        |a: &crate::sweep::table::AxisInfo| if a.label.trim().is_empty() { a.name.clone() } else { a.label.clone() };
+    let names: Vec<String> = col_idx.iter().map(|&k| column_label(&r.columns[k])).collect();
+    let y_label =
+        if columns.iter().all(|c| is_exponent(c)) { "convergence exponent".to_string() } else { names.join(", ") };
+    let mut f = Figure::new(&r.name, &axis_label(&r.axes[xi]), &y_label);
     let colour = colour_from;
     // group by the other axes' values
     let mut groups: BTreeMap<Vec<u64>, Vec<&crate::sweep::PointRecord>> = BTreeMap::new();
@@ -97,13 +91,13 @@ fn panel(r: &SweepResult, x: Option<&str>, columns: &[&str], colour_from: &mut u
                 .enumerate()
                 .filter(|(k, _)| *k != xi)
                 .zip(key_bits)
-                .map(|((_, a), b)| format!("{} = {}", a.name, f64::from_bits(*b)))
+                .map(|((_, a), b)| format!("{} = {}", axis_label(a), num_text(f64::from_bits(*b))))
                 .collect();
-            format!(" ({})", others.join(", "))
+            format!(", {}", others.join(", "))
         } else {
             String::new()
         };
-        for (&c, name) in col_idx.iter().zip(columns) {
+        for (&c, name) in col_idx.iter().zip(&names) {
             let mut xy: Vec<(f64, f64)> = pts
                 .iter()
                 .filter_map(|p| if let Cell::Num(v) = p.cells[c] { Some((p.params[xi], v)) } else { None })
@@ -121,7 +115,7 @@ fn panel(r: &SweepResult, x: Option<&str>, columns: &[&str], colour_from: &mut u
                 cert_idx
                     .is_some_and(|ci| pts.iter().any(|p| p.params[xi] == x && matches!(p.cells[ci], Cell::Flag(true))))
             };
-            let (yes, no): (Vec<(f64, f64)>, Vec<(f64, f64)>) = xy.iter().partition(|(x, _)| certified(*x));
+            let (yes, no): (Vec<_>, Vec<_>) = xy.iter().partition(|(x, _)| certified(*x));
             if cert_idx.is_some() {
                 f.elements.push(Element::Markers {
                     label: String::new(),

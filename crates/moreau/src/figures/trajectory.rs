@@ -38,11 +38,11 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
     let unit = |u: &str| if u.is_empty() { String::new() } else { format!(" ({u})") };
     let t_label = format!("t{}", unit(&sys.signals.t));
     let mut yz = Figure::new(
-        &format!("Trajectory of `{}`: y = C x and z", sys.name),
+        &format!("Trajectory of {}: y = C x and z", sys.name),
         &t_label,
         &format!("y, z{}", unit(sys.signals.y_common_unit())),
     );
-    let mut xf = Figure::new(&format!("Trajectory of `{}`: state x", sys.name), &t_label, "x");
+    let mut xf = Figure::new(&format!("Trajectory of {}: state x", sys.name), &t_label, "x");
     let ys: Vec<Vec<f64>> = (0..tr.len()).map(|i| tr.y_at(&sys.C, i)).collect();
     let p = sys.p();
     for k in 0..p {
@@ -72,22 +72,75 @@ pub fn trajectory_figures(sys: &System, s: &TrajectorySettings) -> Result<(Figur
 }
 
 /// The plot of `moreau simulate`: the inputs `w1..wm`, then `y_k` and `z_k` per output
-/// against `t`, titled with the model's name and `method` (how it was simulated).
+/// against `t`, titled with the model's name and `method` (how it was simulated; its long
+/// numbers, such as a step `h = 0.016000000000000014`, shortened to 4 significant digits),
+/// axes in the model's `[signals]` units where stated.
 pub fn simulation_figure(sys: &System, tr: &Trajectory, method: &str) -> Figure {
-    let mut f = Figure::new(&format!("{} ({method})", sys.name), "t", "w, y, z");
+    let unit = |u: &str| if u.is_empty() { String::new() } else { format!(" ({u})") };
+    // one unit on the y axis when every plotted signal has it (or the outputs' when no input has one)
+    let ys = sys.signals.y_common_unit();
+    let ws: Vec<&str> = (0..sys.m()).map(|j| sys.signals.w_unit(j)).collect();
+    let y_unit = if ws.iter().all(|w| *w == ys) || ws.iter().all(|w| w.is_empty()) { ys } else { "" };
+    let mut f = Figure::new(
+        &format!("{} ({})", sys.name, short_numbers(method)),
+        &format!("t{}", unit(&sys.signals.t)),
+        &format!("w, y, z{}", unit(y_unit)),
+    );
     f.size = (1000, 600);
     let mut line = |label: String, y: Vec<f64>| {
         let color = palette(f.elements.len());
         f.elements.push(Element::Line { label, pts: tr.t.iter().copied().zip(y).collect(), color, dashed: false });
     };
-    for j in 0..sys.m() {
-        line(format!("w{}", j + 1), (0..tr.len()).map(|i| tr.w_at(i)[j]).collect());
+    // an input with a unit other than the axis's says it in its legend entry
+    for (j, &w) in ws.iter().enumerate() {
+        let own = if w != y_unit && !w.is_empty() { unit(w) } else { String::new() };
+        line(format!("w_{}{own}", j + 1), (0..tr.len()).map(|i| tr.w_at(i)[j]).collect());
     }
     for j in 0..sys.p() {
-        line(format!("y{}", j + 1), (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect());
-        line(format!("z{}", j + 1), (0..tr.len()).map(|i| tr.z_at(i)[j]).collect());
+        line(format!("y_{}", j + 1), (0..tr.len()).map(|i| tr.y_at(&sys.C, i)[j]).collect());
+        line(format!("z_{}", j + 1), (0..tr.len()).map(|i| tr.z_at(i)[j]).collect());
     }
     f
+}
+
+/// `text` with every number of more than 4 significant digits written with 4 (`h =
+/// 0.016000000000000014` -> `h = 0.01600`), minus as U+2212; the rest unchanged.
+pub fn short_numbers(text: &str) -> String {
+    let mut out = String::new();
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let starts = chars[i].is_ascii_digit() && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
+        if !starts {
+            out.push(chars[i]);
+            i += 1;
+            continue;
+        }
+        let mut j = i;
+        while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
+            j += 1;
+        }
+        if j < chars.len() && (chars[j] == 'e' || chars[j] == 'E') {
+            let mut k = j + 1;
+            if k < chars.len() && (chars[k] == '-' || chars[k] == '+') {
+                k += 1;
+            }
+            if k < chars.len() && chars[k].is_ascii_digit() {
+                while k < chars.len() && chars[k].is_ascii_digit() {
+                    k += 1;
+                }
+                j = k;
+            }
+        }
+        let tok: String = chars[i..j].iter().collect();
+        let digits = tok.split(['e', 'E']).next().unwrap_or("").trim_start_matches(['0', '.']).replace('.', "").len();
+        match tok.parse::<f64>() {
+            Ok(v) if digits > 4 => out.push_str(&super::canvas::num_text(v)),
+            _ => out.push_str(&tok),
+        }
+        i = j;
+    }
+    out
 }
 
 #[cfg(test)]
@@ -102,9 +155,21 @@ mod tests {
         let tr = dynamics::trajectory::simulate_model(&sys, 0.01, 300, 1).unwrap();
         let f = simulation_figure(&sys, &tr, "catching-up, h = 1e-2");
         let labels: Vec<&str> = f.elements.iter().map(|e| e.label_and_color().0).collect();
-        assert_eq!(labels, ["w1", "y1", "z1"]);
+        assert_eq!(labels, ["w_1", "y_1", "z_1"]);
         let svg = canvas::to_svg(&f).unwrap();
         assert!(svg.contains("<svg") && svg.contains("<text") && svg.contains("catching-up"));
+        // a long step in the method is shortened; the rest of the text is kept
+        assert_eq!(short_numbers("catching-up, h = 1.6000000000000014e-2"), "catching-up, h = 0.01600");
+        assert_eq!(short_numbers("event-driven, 40 events, p_2 = 0.25"), "event-driven, 40 events, p_2 = 0.25");
+        let f2 = simulation_figure(&sys, &tr, "catching-up, h = 1.6000000000000014e-2");
+        assert_eq!(f2.title, format!("{} (catching-up, h = 0.01600)", sys.name));
+        // [signals] units on the axes
+        let text = std::fs::read_to_string(path).unwrap();
+        let with_units =
+            model::parse_str(&format!("{text}\n[signals]\ny = \"rad\"\nw = \"rad\"\nt = \"s\"\n")).unwrap();
+        let f3 = simulation_figure(&with_units, &tr, "m");
+        assert_eq!((f3.x_label.as_str(), f3.y_label.as_str()), ("t (s)", "w, y, z (rad)"));
+        assert_eq!((f.x_label.as_str(), f.y_label.as_str()), ("t", "w, y, z"), "no unit invented");
         let dir = tempfile::tempdir().unwrap();
         let png = dir.path().join("a.png");
         canvas::write_png(&f, &png).unwrap();

@@ -75,17 +75,24 @@ pub fn support_polygon(p: usize, k: usize, h: impl Fn(&[f64]) -> f64) -> Vec<(f6
 pub fn tube_figure(sys: &System, orbit: &EtaOrbit, tube: &OutputTube, z_periodic: &PeriodicZ) -> Figure {
     let p = sys.p();
     let (tz, z) = (&z_periodic.t, &z_periodic.z);
+    // units from the model's [signals] table where stated
+    let unit = |u: &str| if u.is_empty() { String::new() } else { format!(" ({u})") };
+    let (t_unit, z_unit) = (unit(&sys.signals.t), unit(sys.signals.y_common_unit()));
     let z_label = if z_periodic.converged {
         "z (simulated periodic regime)".to_string()
     } else {
-        format!("z (fixed point NOT converged, residual {:.1e})", z_periodic.residual)
+        format!("z (fixed point NOT converged, residual {})", super::canvas::num_text(z_periodic.residual))
     };
     if p == 1 {
         let up: Vec<f64> = orbit.eta.iter().map(|e| e[0] + tube.support_upper(&[1.0])).collect();
         let lo: Vec<f64> = orbit.eta.iter().map(|e| e[0] - tube.support_upper(&[-1.0])).collect();
-        let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "t (one period)", "output space");
+        let mut f = Figure::new(
+            "Orbit η_T, tube η_T + C Ξ_∞ + Θ and periodic z over one period",
+            &format!("t{t_unit}"),
+            &format!("z, η_T{z_unit}"),
+        );
         f.elements.push(Element::Band {
-            label: "tube η_T + C Ξ∞ + Θ".into(),
+            label: "tube η_T + C Ξ_∞ + Θ".into(),
             x: orbit.t.clone(),
             lo,
             hi: up,
@@ -105,7 +112,11 @@ pub fn tube_figure(sys: &System, orbit: &EtaOrbit, tube: &OutputTube, z_periodic
         });
         return f;
     }
-    let mut f = Figure::new("Orbit η_T, tube η_T + C Ξ∞ + Θ and periodic z", "η₁, z₁", "η₂, z₂");
+    let mut f = Figure::new(
+        "Orbit η_T, tube η_T + C Ξ_∞ + Θ and periodic z",
+        &format!("z_1, η_{{T,1}}{}", unit(sys.signals.y_unit(0))),
+        &format!("z_2, η_{{T,2}}{}", unit(sys.signals.y_unit(1))),
+    );
     f.equal_aspect = true;
     let section = support_polygon(p, 96, |v| tube.support_upper(v));
     let m = orbit.eta.len();
@@ -113,7 +124,7 @@ pub fn tube_figure(sys: &System, orbit: &EtaOrbit, tube: &OutputTube, z_periodic
     for (n, i) in (0..count).map(|j| j * (m - 1) / count.max(1)).enumerate() {
         let e = &orbit.eta[i];
         f.elements.push(Element::Polygon {
-            label: if n == 0 { "cross-sections C Ξ∞ + Θ".into() } else { String::new() },
+            label: if n == 0 { "cross-sections C Ξ_∞ + Θ".into() } else { String::new() },
             pts: section.iter().map(|&(x, y)| (x + e[0], y + e[1])).collect(),
             color: BLUE,
         });

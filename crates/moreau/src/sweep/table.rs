@@ -1,5 +1,6 @@
 //! Sweep results and their tables: JSON (complete, exact, the input of `moreau merge` and of
-//! resumed runs), CSV (complete, exact), Markdown and LaTeX (booktabs; significant digits).
+//! resumed runs), CSV (complete, exact), Markdown and LaTeX (booktabs and siunitx `S` columns;
+//! significant digits, one notation per column: [`ColumnNumbers`]).
 //! Every writer sorts the points by index, so the files do not depend on the thread count.
 use super::eval::{Cell, Column, ColumnKind};
 use super::shard::Shard;
@@ -305,10 +306,11 @@ impl SweepResult {
         );
         s.push_str(&format!("| {} |\n", head.join(" | ")));
         s.push_str(&format!("|{}\n", "---:|".repeat(head.len())));
+        let (axes_fmt, cols_fmt) = self.number_formats(&shown, digits);
         for p in &self.points {
-            let mut row: Vec<String> = p.params.iter().map(|&x| sig(x, digits, false)).collect();
-            row.extend(shown.iter().map(|&k| match &p.cells[k] {
-                Cell::Num(x) => sig(*x, digits, false),
+            let mut row: Vec<String> = p.params.iter().zip(&axes_fmt).map(|(&x, f)| f.text(x)).collect();
+            row.extend(shown.iter().zip(&cols_fmt).map(|(&k, f)| match &p.cells[k] {
+                Cell::Num(x) => f.text(*x),
                 Cell::Flag(b) => (if *b { "yes" } else { "no" }).into(),
                 Cell::Text(t) => t.replace('|', "\\|"),
                 Cell::Empty => "-".into(),
@@ -321,14 +323,48 @@ impl SweepResult {
         s
     }
 
-    /// LaTeX `table` with a booktabs `tabular` (`\usepackage{booktabs}`), `digits`
-    /// significant digits, numbers in math mode.
+    /// Notation of the axes' and the `shown` columns' numbers (text and flag columns: `None`).
+    fn number_formats(&self, shown: &[usize], digits: usize) -> (Vec<ColumnNumbers>, Vec<ColumnNumbers>) {
+        let axes =
+            (0..self.axes.len()).map(|a| ColumnNumbers::of(self.points.iter().map(|p| p.params[a]), digits)).collect();
+        let cols = shown
+            .iter()
+            .map(|&k| {
+                let nums =
+                    self.points.iter().filter_map(|p| if let Cell::Num(x) = p.cells[k] { Some(x) } else { None });
+                ColumnNumbers::of(nums, digits)
+            })
+            .collect();
+        (axes, cols)
+    }
+
+    /// LaTeX `table` with a booktabs `tabular` whose numeric columns are siunitx `S` columns
+    /// (`\usepackage{booktabs,siunitx}`), aligned on the decimal marker with a `table-format`
+    /// from the column's numbers; `digits` significant digits, one notation per column.
     pub fn to_latex(&self, digits: usize) -> String {
         let shown = self.shown();
         let failed = self.any_failed();
-        let ncols = self.axes.len() + shown.len() + failed as usize;
-        let mut head: Vec<String> = self.axes.iter().map(|a| a.label.clone()).collect();
-        head.extend(shown.iter().map(|&k| self.columns[k].latex.clone()));
+        let (axes_fmt, cols_fmt) = self.number_formats(&shown, digits);
+        let numeric: Vec<bool> = std::iter::repeat_n(true, self.axes.len())
+            .chain(shown.iter().map(|&k| self.columns[k].kind == ColumnKind::Number))
+            .collect();
+        let spec: Vec<String> = axes_fmt
+            .iter()
+            .chain(&cols_fmt)
+            .zip(&numeric)
+            .map(|(f, &num)| if num { format!("S[table-format={}]", f.table_format()) } else { "l".into() })
+            .chain(failed.then(|| "l".to_string()))
+            .collect();
+        // headers of S columns in braces (siunitx reads them as text)
+        let mut head: Vec<String> = self.axes.iter().map(|a| format!("{{{}}}", a.label)).collect();
+        head.extend(shown.iter().map(|&k| {
+            let c = &self.columns[k];
+            if c.kind == ColumnKind::Number {
+                format!("{{{}}}", c.latex)
+            } else {
+                c.latex.clone()
+            }
+        }));
         if failed {
             head.push("status".into());
         }
@@ -337,7 +373,7 @@ impl SweepResult {
             self.name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect();
         let mut s = String::new();
         s.push_str(&format!(
-            "% moreau sweep `{}`: spec hash {}, {} of {} points; needs \\usepackage{{booktabs}}\n",
+            "% moreau sweep `{}`: spec hash {}, {} of {} points; needs \\usepackage{{booktabs,siunitx}}\n",
             self.name,
             self.spec_hash,
             self.points.len(),
@@ -345,14 +381,16 @@ impl SweepResult {
         ));
         s.push_str("\\begin{table}[ht]\n\\centering\n");
         s.push_str(&format!("\\caption{{{caption}}}\n\\label{{tab:{label}}}\n"));
-        s.push_str(&format!("\\begin{{tabular}}{{{}}}\n\\toprule\n", "r".repeat(ncols)));
+        s.push_str(&format!("\\begin{{tabular}}{{{}}}\n\\toprule\n", spec.join(" ")));
         s.push_str(&format!("{} \\\\\n\\midrule\n", head.join(" & ")));
         for p in &self.points {
-            let mut row: Vec<String> = p.params.iter().map(|&x| sig(x, digits, true)).collect();
-            row.extend(shown.iter().map(|&k| match &p.cells[k] {
-                Cell::Num(x) => sig(*x, digits, true),
+            let mut row: Vec<String> = p.params.iter().zip(&axes_fmt).map(|(&x, f)| f.latex(x)).collect();
+            row.extend(shown.iter().zip(&cols_fmt).map(|(&k, f)| match &p.cells[k] {
+                Cell::Num(x) => f.latex(*x),
                 Cell::Flag(b) => (if *b { "yes" } else { "no" }).into(),
                 Cell::Text(t) => latex_escape(t),
+                // in an S column text goes in braces
+                Cell::Empty if self.columns[k].kind == ColumnKind::Number => "{--}".into(),
                 Cell::Empty => "--".into(),
             }));
             if failed {
@@ -361,6 +399,81 @@ impl SweepResult {
             s.push_str(&format!("{} \\\\\n", row.join(" & ")));
         }
         s.push_str("\\bottomrule\n\\end{tabular}\n\\end{table}\n");
+        s
+    }
+}
+
+/// The notation of one table column's numbers: `digits` significant digits ([`sig`]), fixed
+/// when every finite value of the column is written fixed by [`sig`], otherwise every value
+/// in scientific notation (`1.06e-5`, `-7.80e-3`), so a column never mixes the two.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColumnNumbers {
+    pub digits: usize,
+    pub scientific: bool,
+    /// For the siunitx `table-format`: a minus sign, integer digits, decimals, a negative
+    /// exponent and exponent digits among the column's values.
+    sign: bool,
+    int: usize,
+    dec: usize,
+    exp_sign: bool,
+    exp: usize,
+}
+
+impl ColumnNumbers {
+    /// The notation of a column of `values` at `digits` significant digits.
+    pub fn of(values: impl Iterator<Item = f64>, digits: usize) -> Self {
+        let values: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+        let scientific = values.iter().any(|&x| sig(x, digits, false).contains('e'));
+        let mut f = Self { digits, scientific, sign: false, int: 1, dec: 0, exp_sign: false, exp: 0 };
+        for &x in &values {
+            let t = f.text(x);
+            let (mant, exp) = t.split_once('e').unwrap_or((&t, ""));
+            f.sign |= mant.starts_with('-');
+            let (i, d) = mant.trim_start_matches('-').split_once('.').unwrap_or((mant.trim_start_matches('-'), ""));
+            f.int = f.int.max(i.len());
+            f.dec = f.dec.max(d.len());
+            f.exp_sign |= exp.starts_with('-');
+            f.exp = f.exp.max(exp.trim_start_matches('-').len());
+        }
+        f
+    }
+
+    /// `x` in this notation, plain text (Markdown; numbers of an `S` column).
+    pub fn text(&self, x: f64) -> String {
+        let digits = self.digits.clamp(1, 17);
+        if self.scientific && x.is_finite() {
+            format!("{:.*e}", digits - 1, x)
+        } else {
+            sig(x, digits, false)
+        }
+    }
+
+    /// `x` as a cell of an siunitx `S` column (non-finite values as braced text).
+    pub fn latex(&self, x: f64) -> String {
+        if x.is_finite() {
+            self.text(x)
+        } else {
+            format!("{{{}}}", sig(x, self.digits, true))
+        }
+    }
+
+    /// The siunitx `table-format` of the column: `-1.3`, `2.2e-1`.
+    pub fn table_format(&self) -> String {
+        let mut s = String::new();
+        if self.sign {
+            s.push('-');
+        }
+        s.push_str(&self.int.to_string());
+        if self.dec > 0 {
+            s.push_str(&format!(".{}", self.dec));
+        }
+        if self.scientific && self.exp > 0 {
+            s.push('e');
+            if self.exp_sign {
+                s.push('-');
+            }
+            s.push_str(&self.exp.to_string());
+        }
         s
     }
 }
@@ -447,6 +560,19 @@ mod tests {
         assert_eq!(sig(1.5e-7, 2, true), "$1.5\\times 10^{-7}$");
         assert_eq!(sig(0.0, 3, false), "0.00");
         assert_eq!(exact(0.1), "0.1");
+        // one notation per column: scientific for all when one value needs it
+        let f = ColumnNumbers::of([1.06e-5, -0.0078, -0.0468].into_iter(), 3);
+        assert!(f.scientific);
+        assert_eq!(
+            (f.text(1.06e-5), f.text(-0.0078), f.text(-0.0468)),
+            ("1.06e-5".into(), "-7.80e-3".into(), "-4.68e-2".into())
+        );
+        assert_eq!(f.table_format(), "-1.2e-1");
+        let g = ColumnNumbers::of([0.196, 65.4, 12.1].into_iter(), 3);
+        assert!(!g.scientific);
+        assert_eq!((g.text(0.196), g.text(65.4)), ("0.196".into(), "65.4".into()));
+        assert_eq!(g.table_format(), "2.3");
+        assert_eq!(g.latex(f64::NAN), "{--}");
         assert_eq!(exact(1e-300).parse::<f64>().unwrap(), 1e-300);
     }
 }
