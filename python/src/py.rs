@@ -514,6 +514,54 @@ fn check_sample_numbers(numbers: u64, detail: &str) -> PyResult<()> {
     moreau::budget::sample_numbers(numbers, detail).map_err(err)
 }
 
+/// `moreau figure KIND INPUT --out DIR ...`: the files written. `kind`, `formats` and `size`
+/// are the CLI's words (`psi`, `svg`, `column`).
+#[pyfunction]
+#[pyo3(signature = (kind, input, out, *, formats=vec!["svg".to_string(), "png".to_string(), "pgf".to_string()], size=None, width=None, height=None, dpi=None, title=true, columns=vec![], x=None, t_end=None, dt=None))]
+#[allow(clippy::too_many_arguments)]
+fn figure(
+    py: Python<'_>,
+    kind: String,
+    input: PathBuf,
+    out: PathBuf,
+    formats: Vec<String>,
+    size: Option<String>,
+    width: Option<u32>,
+    height: Option<u32>,
+    dpi: Option<f64>,
+    title: bool,
+    columns: Vec<String>,
+    x: Option<String>,
+    t_end: Option<f64>,
+    dt: Option<f64>,
+) -> PyResult<Vec<PathBuf>> {
+    use clap::ValueEnum;
+    use moreau::cli::figure::{write, Args, Kind};
+    fn word<T: ValueEnum>(what: &str, s: &str) -> PyResult<T> {
+        T::from_str(s, true).map_err(|_| {
+            let known: Vec<String> =
+                T::value_variants().iter().filter_map(|v| v.to_possible_value()).map(|p| p.get_name().to_string()).collect();
+            MoreauError::new_err(format!("invalid {what} {s:?} (possible values: {})", known.join(", ")))
+        })
+    }
+    let a = Args {
+        kind: word::<Kind>("figure kind", &kind)?,
+        input,
+        out,
+        columns,
+        x,
+        t_end,
+        format: formats.iter().map(|f| word("format", f)).collect::<PyResult<_>>()?,
+        dpi,
+        size: size.map(|s| word("size", &s)).transpose()?,
+        width,
+        height,
+        no_title: !title,
+        dt,
+    };
+    py.detach(move || write(&a)).map_err(err)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MoreauError", m.py().get_type::<MoreauError>())?;
@@ -525,6 +573,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(figure, m)?)?;
     m.add_function(wrap_pyfunction!(set_allow_large, m)?)?;
     m.add_function(wrap_pyfunction!(allow_large, m)?)?;
     m.add_function(wrap_pyfunction!(check_model_numbers, m)?)?;

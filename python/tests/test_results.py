@@ -113,3 +113,18 @@ def test_diagnose_takes_the_cli_metric_and_no_refit():
     assert refit.nominal_refit and not kept.nominal_refit, (refit.nominal_refit, kept.nominal_refit)
     with pytest.raises(moreau.MoreauError, match="possible values: auto, fit, rmse"):
         moreau.diagnose(BAM_MODEL, BAM_DATA, metric="r2")
+
+
+def test_figures_from_python_for_a_system_and_a_sweep(tmp_path):
+    sysm = moreau.load(WORKED)
+    files = moreau.figure("psi", sysm, tmp_path / "figs", size="column", formats="svg", title=False)
+    assert [f.rsplit("/", 1)[-1] for f in files] == ["fig-psi1.svg"]
+    svg = open(files[0], encoding="utf-8").read()
+    assert svg.startswith("<svg") and 'width="252"' in svg
+    grid = moreau.sweep_grid(WORKED, {"input.amplitude": [1.0, 2.0]}, tmp_path / "grid", evaluate={"measure": False})
+    files = moreau.figure("sweep", grid, tmp_path / "figs2", formats=["svg", "pgf"], columns=["theta", "theta_best"])
+    assert sorted(f.rsplit(".", 1)[-1] for f in files) == ["csv", "svg", "tex"]
+    with pytest.raises(moreau.MoreauError, match="possible values: psi, tube, trajectory, sweep"):
+        moreau.figure("psy", sysm, tmp_path / "bad")
+    with pytest.raises(moreau.MoreauError, match="possible values: column, two-column"):
+        moreau.figure("psi", sysm, tmp_path / "bad", size="wide")

@@ -25,6 +25,7 @@ __all__ = [
     "diagnose",
     "sweep",
     "sweep_grid",
+    "figure",
     "set_allow_large",
     "Trajectory",
     "ThetaResult",
@@ -535,6 +536,88 @@ def sweep_grid(
     with open(spec, "w", encoding="utf-8") as f:
         f.write("\n".join(lines) + "\n")
     return sweep(spec, out, threads=threads, digits=digits, overwrite=overwrite, fresh=fresh)
+
+
+def figure(
+    kind: str,
+    source: Union[Model, "SweepResult"],
+    out: PathLike,
+    *,
+    size: Optional[str] = None,
+    formats: Union[str, List[str]] = ("svg", "png", "pgf"),
+    title: bool = True,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    dpi: Optional[float] = None,
+    columns: Optional[List[str]] = None,
+    x: Optional[str] = None,
+    t_end: Optional[float] = None,
+    dt: Optional[float] = None,
+) -> List[str]:
+    """A figure for a paper, as ``moreau figure KIND INPUT --out DIR`` draws it (no matplotlib).
+
+    Parameters
+    ----------
+    kind : {"psi", "tube", "trajectory", "sweep"}
+        Fig. psi1 (psi(gamma) and the chord of eq. (theta)), Fig. loop (the orbit and the
+        tube), y, z and x against time, or columns of a sweep against its parameter.
+    source : System, path-like or SweepResult
+        The model (psi, tube, trajectory), or a sweep: its result, ``sweep.json`` or its folder.
+    out : path-like
+        Output folder.
+    size : {"column", "two-column"}, optional
+        Size preset in points (3.5 in or 7.16 in wide, text 8-9 pt); default 900 x 600.
+    formats : str or list of str, default ("svg", "png", "pgf")
+        Any of ``svg``, ``png``, ``pgf`` (pgfplots .tex + data .csv), ``pdf``.
+    title : bool, default True
+        Draw the title (a paper's caption usually replaces it).
+    width, height : int, optional
+        Override the preset's size (points; pixels at 96 dpi for PNG).
+    dpi : float, optional
+        Rasterise the PNG at this resolution.
+    columns : list of str, optional
+        sweep: the columns to draw (default theta, theta_best, measured_rate).
+    x : str, optional
+        sweep: the axis on the horizontal axis (default the first).
+    t_end, dt : float, optional
+        trajectory: final time and step.
+
+    Returns
+    -------
+    list of str
+        The files written (for ``svg``, read the file for an SVG string).
+    """
+    import tempfile
+
+    fmts = [formats] if isinstance(formats, str) else list(formats)
+    with tempfile.TemporaryDirectory() as tmp:
+        if isinstance(source, SweepResult):
+            src = os.path.join(tmp, "sweep.json")
+            with open(src, "w", encoding="utf-8") as f:
+                json.dump(dict(source), f)
+        elif isinstance(source, System):
+            src = os.path.join(tmp, "model.toml")
+            source.save(src)
+        elif isinstance(source, (str, os.PathLike)):
+            src = os.fspath(source)
+        else:
+            raise TypeError(f"`source` must be a System, a SweepResult or a path, got {type(source).__name__}")
+        files = _native.figure(
+            kind,
+            src,
+            os.fspath(out),
+            formats=fmts,
+            size=size,
+            width=width,
+            height=height,
+            dpi=dpi,
+            title=title,
+            columns=list(columns or []),
+            x=x,
+            t_end=t_end,
+            dt=dt,
+        )
+    return [os.fspath(f) for f in files]
 
 
 def set_allow_large(on: bool = True) -> None:

@@ -98,6 +98,22 @@ def diagnose(
     no_refit: bool = False,
     out: Optional[_Path] = None,
 ) -> Tuple[str, Optional[System], int, Dict[str, bytes]]: ...
+def figure(
+    kind: str,
+    input: _Path,
+    out: _Path,
+    *,
+    formats: List[str] = ...,
+    size: Optional[str] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    dpi: Optional[float] = None,
+    title: bool = True,
+    columns: List[str] = ...,
+    x: Optional[str] = None,
+    t_end: Optional[float] = None,
+    dt: Optional[float] = None,
+) -> List[str]: ...
 def sweep(
     spec: _Path,
     out: _Path,

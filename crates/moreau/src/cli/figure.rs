@@ -73,6 +73,14 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    for f in write(a)? {
+        println!("{}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The figures of `a`, written: the files (what `run` prints; the Python package's `figure`).
+pub fn write(a: &Args) -> anyhow::Result<Vec<PathBuf>> {
     // options and the output folder are checked before the work
     let preset = a.size.map_or((900, 600), |s| s.size());
     let (width, height) = (a.width.unwrap_or(preset.0), a.height.unwrap_or(preset.1));
@@ -170,8 +178,5 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             (stem, f)
         })
         .collect();
-    for f in figures::write_figure_with(&figs, &a.out, &a.format, a.dpi)? {
-        println!("{}", f.display());
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(figures::write_figure_with(&figs, &a.out, &a.format, a.dpi)?)
 }
