@@ -178,3 +178,15 @@ fn backlash_inertia_coasts_as_the_closed_form() {
     let err0 = (z0[ns - 1] - exact((ns - 1) as f64 * dt)).abs();
     assert!(err0 > 0.04, "massless output indistinguishable from the coasting one ({err0})");
 }
+
+#[test]
+fn max_effects_zero_adds_no_effect() {
+    // `--max-effects 0` judged a model as it is (e.g. a model fitted on another recording):
+    // it used to bound only the forward additions, and the best single effect was still added.
+    let case = bench_gen::generate("coulomb_friction", 11, 0);
+    let added = diagnose(&case.nominal, &case.recording, &DiagnoseSettings::default()).unwrap();
+    assert_ne!(added.selected(), "none", "control: the concealed friction is named by default: {}", added.verdict);
+    let s = DiagnoseSettings { max_effects: 0, ..Default::default() };
+    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    assert_eq!(r.selected(), "none", "{}", r.verdict);
+}

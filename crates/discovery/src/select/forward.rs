@@ -45,7 +45,9 @@ pub(crate) fn select_all(
         let base_sse = cv_sse_of(ctx, plan, &nominal_ranked);
         sel.accept_best_single(&mut singles, &nominal_ranked, &base_sse, &mut cv_rejected);
         sel.prefer_simpler_form(&mut singles, &nominal_ranked, &base_sse, &mut cv_rejected);
-        if let Some(best) = singles.iter().find(|r| r.beats_nominal) {
+        // `max_effects` bounds the effects of the selected model, the first one included (0:
+        // the nominal model, refitted where it frees parameters, and nothing added)
+        if let Some(best) = singles.iter().find(|r| r.beats_nominal && r.parts.len() <= plan.max_effects) {
             ties = sel.ties(&singles, best);
             let (cur, tried) = sel.forward(&singles, best.clone(), &base_sse);
             extra = tried;
