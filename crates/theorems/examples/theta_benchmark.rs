@@ -8,6 +8,8 @@
 //! `theta_star`, `theta_profile`, `theta_engaged`, `theta_best`) it reports how many systems it certifies
 //! (verified `< 0`), the median of bound / measured over the certified ones, and violations
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
+//! `THETA_BENCHMARK_INPUT=square` gives every system a square wave of the same amplitudes,
+//! period and phase instead of its sine (issue 29 item 2: the same systems, another input).
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use rayon::prelude::*;
@@ -59,6 +61,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
+    let square = std::env::var("THETA_BENCHMARK_INPUT").is_ok_and(|v| v == "square");
     let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
@@ -78,7 +81,12 @@ fn main() {
             .par_iter()
             .filter(|c| c.n >= 2)
             .filter_map(|c| {
-                let sys = c.build();
+                let mut sys = c.build();
+                if square {
+                    if let model::Input::Sine { amplitudes, omega, phase } = &sys.input {
+                        sys.input = model::Input::Square { amplitudes: amplitudes.clone(), omega: *omega, phase: *phase };
+                    }
+                }
                 let rep = assemble(&sys, &settings).ok()?;
                 let m = rep.measured.clone()?;
                 if m.ci_high >= 0.0 {

@@ -9,10 +9,15 @@
 //! returned with a relative rounding margin `16 n cond(i omega I - F) eps` in the safe direction
 //! (verified up to that margin).
 //!
-//! **Other periodic inputs** (square wave, samples): grid samples from
-//! `dynamics::periodic::linearised`; the sampled diameter is a lower bound of `osc` only if the
-//! samples are exact, and the sampled maximum of `|eta_T'|` is not an upper bound, so both are
-//! reported as estimates (`verified = false`).
+//! **Piecewise-affine inputs** (a square wave; a periodic CSV input, linearly interpolated):
+//! closed form per piece ([`super::piecewise`]); `osc` from below by the samples' diameter and
+//! `||eta_T'||_inf` from above by the samples and the Lipschitz constant of `eta_T'` inside the
+//! pieces, its jumps at the input's edges taken in (verified up to the rounding margin).
+//!
+//! **Other periodic inputs**: grid samples from `dynamics::periodic::linearised`; the sampled
+//! diameter is a lower bound of `osc` only if the samples are exact, and the sampled maximum of
+//! `|eta_T'|` is not an upper bound, so both are reported as estimates (`verified = false`).
+use super::piecewise::Jump;
 use crate::error::BoundsError;
 use dynamics::periodic::linearised::{linearised_periodic, sine_phasor, LinearisedSettings};
 use model::{Input, System};
@@ -51,6 +56,9 @@ pub struct EtaOrbit {
     pub rel_margin: f64,
     /// True when `osc` is a lower and `eta_dot_inf` an upper bound (closed form).
     pub verified: bool,
+    /// Where `eta_T'` jumps between two samples (a piecewise-constant input's edges): its
+    /// values on both sides, which every cell bound takes in.
+    pub jumps: Vec<Jump>,
     /// How they were obtained.
     pub method: &'static str,
 }
@@ -69,6 +77,9 @@ impl EtaOrbit {
                 value: settings.samples as f64,
                 reason: "must be at least 2",
             });
+        }
+        if let Some(o) = super::piecewise::orbit(sys, T, settings.samples) {
+            return Ok(o);
         }
         match &sys.input {
             Input::Sine { amplitudes, omega, phase } => {
@@ -95,6 +106,7 @@ impl EtaOrbit {
                     deta_lipschitz,
                     rel_margin: 0.0,
                     verified: false,
+                    jumps: vec![],
                     method: "grid samples (first-order-hold step map); sampled max of |eta_T'| is not an upper bound",
                 })
             }
@@ -138,8 +150,58 @@ impl EtaOrbit {
             deta_lipschitz: omega * omega * rho * (1.0 + margin),
             rel_margin: margin,
             verified: ok,
+            jumps: vec![],
             method: "closed form (sine input: eta_T is an ellipse, osc = 2 rho, ||eta_T'|| = omega rho)",
         }
+    }
+
+    /// Samples with `osc`, `eta_dot_inf` left to [`EtaOrbit::certify_samples`].
+    pub(super) fn from_samples(
+        period: f64,
+        t: Vec<f64>,
+        eta: Vec<Vec<f64>>,
+        deta: Vec<Vec<f64>>,
+        deta_lipschitz: f64,
+        jumps: Vec<Jump>,
+    ) -> Self {
+        Self {
+            period,
+            t,
+            eta,
+            deta,
+            osc: f64::NAN,
+            eta_dot_inf: f64::NAN,
+            deta_lipschitz,
+            rel_margin: 0.0,
+            verified: false,
+            jumps,
+            method: "",
+        }
+    }
+
+    /// `osc` from below (the samples' diameter less twice their error) and `eta_dot_inf` from
+    /// above (the one-cell bound of [`EtaOrbit::eta_dot_cells`]) for samples within `margin`
+    /// (relative to the largest sample) of the orbit; `rel_margin` is set so that
+    /// `rel_margin osc` and `rel_margin eta_dot_inf` bound the samples' errors, as the sine's.
+    pub(super) fn certify_samples(&mut self, margin: f64, verified: bool) {
+        let big = |v: &[Vec<f64>]| v.iter().map(|x| geometry::linalg::norm(x)).fold(0.0, f64::max);
+        let (e_eta, e_deta) = (margin * big(&self.eta), margin * big(&self.deta));
+        let diam = self.osc_sampled();
+        self.osc = (diam - 2.0 * e_eta) * (1.0 - 1e-12);
+        (self.rel_margin, self.eta_dot_inf) = (0.0, 0.0);
+        let cells = self.eta_dot_cells(1).map_or(f64::INFINITY, |(b, _)| b[0]);
+        self.eta_dot_inf = (cells + 2.0 * e_deta) * (1.0 + 1e-12);
+        self.rel_margin =
+            (e_eta / self.osc.max(f64::MIN_POSITIVE)).max(e_deta / self.eta_dot_inf.max(f64::MIN_POSITIVE));
+        self.verified = verified && self.osc > 0.0 && self.eta_dot_inf.is_finite();
+        if !self.verified {
+            self.rel_margin = 0.0;
+        }
+    }
+
+    /// The jumps of `eta_T'` inside sample intervals `lo..hi`: their one-sided values.
+    fn jump_values(&self, lo: usize, hi: usize) -> impl Iterator<Item = &Vec<f64>> {
+        self.jumps.iter().filter(move |j| (lo..hi).contains(&j.interval)).flat_map(|j| [&j.before, &j.after])
     }
 
     /// Largest distance between two samples: a lower bound of `osc` when the samples are exact
@@ -174,7 +236,11 @@ impl EtaOrbit {
         let slack = 0.5 * dt * self.deta_lipschitz * (1.0 + 1e-12);
         let bounds = (0..cells)
             .map(|c| {
-                let m = (c * per..=(c + 1) * per).map(|k| geometry::linalg::norm(&self.deta[k])).fold(0.0, f64::max);
+                let m = (c * per..=(c + 1) * per)
+                    .map(|k| &self.deta[k])
+                    .chain(self.jump_values(c * per, (c + 1) * per))
+                    .map(|d| geometry::linalg::norm(d))
+                    .fold(0.0, f64::max);
                 (m + slack + 2.0 * self.rel_margin * self.eta_dot_inf) * (1.0 + 1e-12)
             })
             .collect();
@@ -197,7 +263,9 @@ impl EtaOrbit {
         let (mut low, mut high) = (Vec::with_capacity(cells), Vec::with_capacity(cells));
         for c in 0..cells {
             let (lo, hi) = (c * per..=(c + 1) * per)
-                .map(|k| self.deta[k][0])
+                .map(|k| &self.deta[k])
+                .chain(self.jump_values(c * per, (c + 1) * per))
+                .map(|d| d[0])
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
             low.push(lo - slack - 4.0 * f64::EPSILON * lo.abs());
             high.push(hi + slack + 4.0 * f64::EPSILON * hi.abs());
