@@ -9,7 +9,9 @@
 //! and amplitude `10^[0.5, 1.5]`. Everything from a splitmix64 stream of `(seed, ratio, n, k)`.
 //! Per system: the verdict of `bounds::assemble` (bound only, timed: the answer's time), or its
 //! error; `theta_best`; the measured exponent (`dynamics::rate::lyapunov_exponent::measure_rate`,
-//! 2 pairs x 30 periods after 10); bound / measured. Prints Markdown tables.
+//! 2 pairs x 30 periods after 10); bound / measured. Prints Markdown tables. With
+//! `STIFF_DUMP=DIR` the systems are also written to `DIR` as model files (`ratio-n-k.toml`), so
+//! that another build's `moreau theta` can be run on the same family.
 #![allow(non_snake_case)]
 use bounds::{assemble, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
@@ -81,6 +83,15 @@ fn stiff_system(seed: u64, ratio: f64, n: usize, k: usize) -> System {
         .expect("a valid stiff system")
 }
 
+/// CPU time of this thread in seconds (`/proc/thread-self/schedstat`, Linux; NaN elsewhere):
+/// the answer's time without the waiting of a shared machine.
+fn thread_cpu() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse::<f64>().ok()))
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
         return f64::NAN;
@@ -102,6 +113,7 @@ struct Row {
     theta_best: f64,
     measured: f64,
     secs: f64,
+    cpu: f64,
 }
 
 fn main() {
@@ -118,22 +130,29 @@ fn main() {
             }
         }
     }
+    if let Ok(dir) = std::env::var("STIFF_DUMP") {
+        std::fs::create_dir_all(&dir).expect("STIFF_DUMP: a writable folder");
+        for &(ratio, n, k) in &cases {
+            let path = std::path::Path::new(&dir).join(format!("{ratio:e}-{n}-{k}.toml"));
+            std::fs::write(&path, model::to_toml_string(&stiff_system(seed, ratio, n, k))).expect("write a model file");
+        }
+    }
     let start = std::time::Instant::now();
     // the answers one at a time (their times are the point), the measurements in parallel
     let mut rows: Vec<Row> = cases
         .iter()
         .map(|&(ratio, n, k)| {
             let sys = stiff_system(seed, ratio, n, k);
-            let t0 = std::time::Instant::now();
+            let (t0, c0) = (std::time::Instant::now(), thread_cpu());
             let rep = assemble(&sys, &settings);
-            let secs = t0.elapsed().as_secs_f64();
+            let (secs, cpu) = (t0.elapsed().as_secs_f64(), thread_cpu() - c0);
             let (verdict, theta_best) = match &rep {
                 Ok(r) if r.theta_best_verified && r.theta_best < 0.0 => ("certified".to_string(), r.theta_best),
                 Ok(r) if r.theta_best_verified => ("not certified (verified bound >= 0)".to_string(), r.theta_best),
                 Ok(r) => ("not certified (unverified)".to_string(), r.theta_best),
                 Err(e) => (format!("error: {e}"), f64::NAN),
             };
-            Row { ratio, n, k, verdict, theta_best, measured: f64::NAN, secs }
+            Row { ratio, n, k, verdict, theta_best, measured: f64::NAN, secs, cpu }
         })
         .collect();
     let measured: Vec<f64> = cases
@@ -148,18 +167,20 @@ fn main() {
     let total = start.elapsed().as_secs_f64();
     println!("Seed {seed}, {} systems, {total:.0} s in all on this machine.", rows.len());
     println!();
-    println!("| ratio | n | # | verdict | theta_best | measured | bound / measured | time (s) |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("| ratio | n | # | verdict | theta_best | measured | bound / measured | time (s) | CPU (s) |");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for r in &rows {
         let ratio_bm = if r.verdict == "certified" { format!("{:.3}", r.theta_best / r.measured) } else { "-".into() };
         println!(
-            "| {:e} | {} | {} | {} | {:.4e} | {:.4} | {} | {:.3} |",
-            r.ratio, r.n, r.k, r.verdict, r.theta_best, r.measured, ratio_bm, r.secs
+            "| {:e} | {} | {} | {} | {:.4e} | {:.4} | {} | {:.3} | {:.3} |",
+            r.ratio, r.n, r.k, r.verdict, r.theta_best, r.measured, ratio_bm, r.secs, r.cpu
         );
     }
     println!();
-    println!("| ratio | systems | errors | certified | median bound / measured (certified) | median time (s) | max time (s) |");
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "| ratio | systems | errors | certified | median bound / measured (certified) | median time (s) | max time (s) | max CPU (s) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     for ratio in [10.0, 1e2, 1e3, 1e4] {
         let set: Vec<&Row> = rows.iter().filter(|r| r.ratio == ratio).collect();
         let errors = set.iter().filter(|r| r.verdict.starts_with("error")).count();
@@ -167,8 +188,9 @@ fn main() {
         let bm = median(cert.iter().map(|r| r.theta_best / r.measured).collect());
         let times: Vec<f64> = set.iter().map(|r| r.secs).collect();
         let tmax = times.iter().copied().fold(0.0, f64::max);
+        let cmax = set.iter().map(|r| r.cpu).fold(0.0, f64::max);
         println!(
-            "| {ratio:e} | {} | {errors} | {} | {bm:.3} | {:.3} | {tmax:.3} |",
+            "| {ratio:e} | {} | {errors} | {} | {bm:.3} | {:.3} | {tmax:.3} | {cmax:.3} |",
             set.len(),
             cert.len(),
             median(times.clone())

@@ -197,6 +197,36 @@ struct CellWalk<'a> {
     anchor_b: f64,
     g_alt: f64,
     last_m2: f64,
+    /// Stiff plants: the row blocks `W e^{mF}`, `W = [L; fl(L F); fl(fl(L F) F)]`, propagated
+    /// instead of `e^{mF}` (their errors scale with `||L F^k e^{mF}||`, not `||L F^k|| ||e^{mF}||`).
+    rows: Option<Rows>,
+}
+
+/// `Q ~ W e^{mF}` (`3 r x n`) and, per row block `k`, the summed local errors `cum[k]`
+/// (Frobenius) and the error of the block of `W` itself (`init[k]`, against `L F^k`).
+struct Rows {
+    Q: DMatrix<f64>,
+    r: usize,
+    cum: [f64; 3],
+    init: [f64; 3],
+}
+
+impl Rows {
+    /// `||Q_k||_F` rounded up as `frobenius_up` does.
+    fn norm(&self, k: usize) -> f64 {
+        let b = self.Q.rows(k * self.r, self.r);
+        let s: f64 = b.iter().map(|x| x * x).sum();
+        s.sqrt() * (1.0 + 2.0 * gamma(b.len() + 2))
+    }
+    /// `Q <- fl(Q S)` with `e_S >= ||S - e^{hF}||_2`: block `k` gains the local error
+    /// `||Q_k||_F (e_S + gamma_n ||S||_F)` (then carried by the exact semigroup).
+    fn step(&mut self, S: &DMatrix<f64>, eS: f64, gn: f64) {
+        let nS = frob(S);
+        for k in 0..3 {
+            self.cum[k] += self.norm(k) * (eS + gn * nS);
+        }
+        self.Q = &self.Q * S;
+    }
 }
 
 impl<'a> CellWalk<'a> {
@@ -259,6 +289,14 @@ impl<'a> CellWalk<'a> {
             defects: 0.0,
             alt,
             prev_bracket,
+            rows: alt.map(|_| {
+                let r = L.nrows();
+                let mut Q = DMatrix::<f64>::zeros(3 * r, n);
+                Q.rows_mut(0, r).copy_from(L);
+                Q.rows_mut(r, r).copy_from(LF);
+                Q.rows_mut(2 * r, r).copy_from(LF2);
+                Rows { Q, r, cum: [0.0; 3], init: [0.0, e_LF, e_LF2] }
+            }),
             anchors: vec![(0.0, bracket1_at_0)],
             anchor_b: f64::INFINITY,
             g_alt: f64::INFINITY,
@@ -298,9 +336,16 @@ impl<'a> CellWalk<'a> {
                 self.g_alt = f64::INFINITY;
             }
         }
-        self.first_centre(rr);
-        for j in 0..count {
-            self.cell(j, hb, rr, grow, &step, e_step, n_step);
+        if self.rows.is_some() {
+            self.first_centre_rows(rr);
+            for j in 0..count {
+                self.cell_rows(j, hb, rr, grow, &step, e_step);
+            }
+        } else {
+            self.first_centre(rr);
+            for j in 0..count {
+                self.cell(j, hb, rr, grow, &step, e_step, n_step);
+            }
         }
         self.prev_rr = rr;
     }
@@ -324,6 +369,83 @@ impl<'a> CellWalk<'a> {
                 &Pp * &G
             }
         });
+    }
+
+    /// [`Self::first_centre`] for the row blocks: `Q` moves to the first centre of the block.
+    fn first_centre_rows(&mut self, rr: f64) {
+        let g = if self.half.is_empty() && self.t_hi == 0.0 {
+            rr
+        } else {
+            let (g, e) = two_sum(self.prev_rr, rr);
+            self.defects += e.abs();
+            g
+        };
+        let (G, eG) = self.sg.exp_step(g);
+        let gn = self.gn;
+        if let Some(rows) = self.rows.as_mut() {
+            rows.step(&G, eG, gn);
+        }
+        self.advance(g);
+    }
+
+    /// [`Self::cell`] for the row blocks (stiff plants, proofs-notes/tube-quadrature.md): `K`,
+    /// `K'` and the bracket of `M2` from `Q_k ~ L F^k e^{mF}` with the errors
+    /// `d_k = (init_k + cum_k) msup` (Frobenius).
+    fn cell_rows(&mut self, j: usize, hb: f64, rr: f64, grow: f64, step: &DMatrix<f64>, e_step: f64) {
+        let (gn, nE, msup) = (self.gn, self.nE, self.msup);
+        if j > 0 {
+            if let Some(rows) = self.rows.as_mut() {
+                rows.step(step, e_step, gn);
+            }
+            self.advance(hb);
+        }
+        let rows = self.rows.as_ref().expect("row mode");
+        let d = |k: usize| (rows.init[k] + rows.cum[k]) * msup * (1.0 + 1e-10);
+        let (n0, n1, n2) = (rows.norm(0), rows.norm(1), rows.norm(2));
+        let (d0, d1, d2) = (d(0), d(1), d(2));
+        let K = rows.Q.rows(0, rows.r) * self.E;
+        let nK = frob(&K);
+        let e_K = d0 * nE + gn * n0 * nE;
+        let K1 = rows.Q.rows(rows.r, rows.r) * self.E;
+        let nK1 = frob(&K1);
+        let e_K1 = d1 * nE + gn * n1 * nE;
+        let bracket = n2 + d2;
+        let mut M2 = bracket * grow * nE * (1.0 + 1e-12);
+        let ms = self.alt.unwrap_or(f64::INFINITY);
+        let via_prev = self.prev_bracket * ms * nE * (1.0 + 1e-12);
+        let via_prev1 = self.anchor_b * self.g_alt * nE * (1.0 + 1e-12);
+        for v in [via_prev, via_prev1] {
+            if v < M2 || M2.is_nan() {
+                M2 = v;
+            }
+        }
+        self.prev_bracket = bracket;
+        if j == 0 {
+            self.anchors.push((self.t_hi, n1 + d1));
+        }
+        self.last_m2 = M2;
+        self.push_cell(rr, &K, nK, e_K, &K1, nK1, e_K1, M2);
+    }
+
+    /// Stores a cell's matrices `K -+ rr K'`, `K` and adds its norms, errors, remainder and
+    /// `int ||K||` contribution (shared by [`Self::cell`] and [`Self::cell_rows`]).
+    #[allow(clippy::too_many_arguments)]
+    fn push_cell(&mut self, rr: f64, K: &DMatrix<f64>, nK: f64, e_K: f64, K1: &DMatrix<f64>, nK1: f64, e_K1: f64, M2: f64) {
+        let Km = K - K1 * rr;
+        let Kp = K + K1 * rr;
+        let e_pm = e_K + rr * e_K1 + 2.01 * UNIT_ROUNDOFF * (nK + rr * nK1);
+        let acc = &mut self.acc;
+        acc.norm_pm += rr * (frob(&Km) + frob(&Kp));
+        acc.norm_mid += 2.0 * rr * nK;
+        acc.err_pm += 2.0 * rr * e_pm;
+        acc.err_mid += 2.0 * rr * e_K;
+        // M is r x p; store M^T (p x r) row-major, i.e. M column-major.
+        self.minus.extend(Km.iter().copied());
+        self.mid.extend(K.iter().copied());
+        self.plus.extend(Kp.iter().copied());
+        self.half.push(rr);
+        self.remainder += self.d_theta * M2 * rr * rr * rr / 3.0;
+        self.k_l1 += 2.0 * rr * (nK + e_K + rr * (nK1 + e_K1) + 0.5 * rr * rr * M2);
     }
 
     /// Cell `j` of a block (after one step of `hb` unless it is the first): its matrices
@@ -350,42 +472,8 @@ impl<'a> CellWalk<'a> {
         let nK1 = frob(&K1);
         let e_K1 = nLF * e_PE + e_LF * (nPE + e_PE) + gn * nLF * nPE;
         // M2 >= ||L F^2 e^{sF} E|| on the cell (1e-12: libm's exp within 1 ulp).
-        let bracket = frob(&(self.LF2 * &Pc)) + gn * nLF2 * nP + nLF2 * dP + e_LF2 * (nP + dP);
-        let mut M2 = bracket * grow * nE * (1.0 + 1e-12);
-        if let Some(ms) = self.alt {
-            // e^{(m + tau) F} = e^{m' F} e^{(m + tau - m') F}, m + tau - m' >= 0 for the previous
-            // centre m' (proofs-notes/tube-quadrature.md, "stiff plants").
-            // and L F^2 e^{(m + tau) F} = (L F e^{aF}) (F e^{(m + tau - a) F}) for an anchor a.
-            let via_prev = self.prev_bracket * ms * nE * (1.0 + 1e-12);
-            let via_prev1 = self.anchor_b * self.g_alt * nE * (1.0 + 1e-12);
-            for v in [via_prev, via_prev1] {
-                if v < M2 || M2.is_nan() {
-                    M2 = v;
-                }
-            }
-            self.prev_bracket = bracket;
-            if j == 0 {
-                let LFP = self.LF * &Pc;
-                let b = frob(&LFP) + gn * nLF * nP + nLF * dP + e_LF * (nP + dP);
-                self.anchors.push((self.t_hi, b));
-            }
-        }
-        self.last_m2 = M2;
-        let Km = &K - &K1 * rr;
-        let Kp = &K + &K1 * rr;
-        let e_pm = e_K + rr * e_K1 + 2.01 * UNIT_ROUNDOFF * (nK + rr * nK1);
-        let acc = &mut self.acc;
-        acc.norm_pm += rr * (frob(&Km) + frob(&Kp));
-        acc.norm_mid += 2.0 * rr * nK;
-        acc.err_pm += 2.0 * rr * e_pm;
-        acc.err_mid += 2.0 * rr * e_K;
-        // M is r x p; store M^T (p x r) row-major, i.e. M column-major.
-        self.minus.extend(Km.iter().copied());
-        self.mid.extend(K.iter().copied());
-        self.plus.extend(Kp.iter().copied());
-        self.half.push(rr);
-        self.remainder += self.d_theta * M2 * rr * rr * rr / 3.0;
-        self.k_l1 += 2.0 * rr * (nK + e_K + rr * (nK1 + e_K1) + 0.5 * rr * rr * M2);
+        let M2 = (frob(&(self.LF2 * &Pc)) + gn * nLF2 * nP + nLF2 * dP + e_LF2 * (nP + dP)) * grow * nE * (1.0 + 1e-12);
+        self.push_cell(rr, &K, nK, e_K, &K1, nK1, e_K1, M2);
         self.P = Some(Pc);
     }
 

@@ -319,11 +319,15 @@ impl TubeKernel {
     /// the target (its remainder is counted in full), never an error.
     fn adaptive(ops: &Operands, fp: &FpTerms, h0: f64, settings: &TubeSettings) -> Result<(Self, Accum), BoundsError> {
         let tol = settings.tol_abs;
-        let max_cells = settings.max_cells;
+        let max_cells = settings.max_cells.min(ADAPTIVE_MAX_CELLS);
         let m2_0 = frob(ops.LF2) * ops.alt_msup * ops.nE;
         let scale = (fp.d_theta * m2_0).cbrt();
         let mut c = if scale.is_finite() && scale > 0.0 { 0.5 * h0 * scale } else { h0 };
         let mut best: Option<(Self, Accum)> = None;
+        let mut prev: Option<(f64, f64)> = None;
+        let stalled = |prev: Option<(f64, f64)>, (c, rem): (f64, f64)| {
+            prev.is_some_and(|(c0, r0)| rem > 3.0 * r0 * (c / c0).powi(2) && rem > 0.5 * r0)
+        };
         for _ in 0..24 {
             let built = Self::build_adaptive(
                 ops.sg,
@@ -357,17 +361,27 @@ impl TubeKernel {
             if done {
                 break;
             }
-            let f = if rem.is_finite() { (0.4 * tol / rem).sqrt().min(0.66) } else { 0.25 };
-            // the cells grow like 1 / c: stay within the budget
-            let f = f.max(cells as f64 / (0.9 * max_cells as f64));
-            if f >= 0.99 {
+            // hopeless within the budget (the cells needed grow like sqrt(remainder)): keep it
+            if !(cells as f64 * (rem / (0.4 * tol)).sqrt() <= 4.0 * max_cells as f64) {
                 break;
             }
+            let f = if rem.is_finite() { (0.4 * tol / rem).sqrt().min(0.66) } else { 0.25 };
+            // the cells grow like 1 / c: stay within the budget; a remainder that fell by less
+            // than a third of the expected factor is dominated by what refining cannot shrink
+            let f = f.max(cells as f64 / (0.9 * max_cells as f64));
+            if f >= 0.99 || stalled(prev, (c, rem)) {
+                break;
+            }
+            prev = Some((c, rem));
             c *= f;
         }
         best.ok_or(BoundsError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: max_cells })
     }
 }
+
+/// Most cells of the adaptive walk (at most `max_cells`): beyond, the enclosure is kept wider
+/// (its remainder counted in full) so that an answer stays within about a second.
+const ADAPTIVE_MAX_CELLS: usize = 50_000;
 
 /// Graded cells beyond this count switch to the adaptive cells of a stiff plant (when
 /// `sup ||e^{sF}||` is proven).

@@ -114,11 +114,9 @@ fn stiff_plants_get_a_proven_enclosure_not_an_error() {
                 enc.lower <= reference + slack && reference <= enc.upper + slack,
                 "{fast} {horizon:?}: {enc:?} vs {reference}"
             );
-            // useful: within the target tolerance plus the rounding terms (at fast = -20000,
-            // ||C F|| = 2e4 amplifies the errors of the long steps: a looser enclosure), few cells
-            let width = if fast > -10_000.0 { 2e-4 } else { 0.25 };
+            // useful: within the target tolerance plus the rounding terms, few cells
             assert!(
-                enc.upper - enc.lower <= width * (1.0 + reference),
+                enc.upper - enc.lower <= 2e-4 * (1.0 + reference),
                 "{fast} {horizon:?} L = {L}: {enc:?}, remainder {}, tail {}, rounding {}, cells {}",
                 k.remainder_bound(),
                 k.tail_bound(),
