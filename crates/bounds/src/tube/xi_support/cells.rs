@@ -430,7 +430,17 @@ impl<'a> CellWalk<'a> {
     /// Stores a cell's matrices `K -+ rr K'`, `K` and adds its norms, errors, remainder and
     /// `int ||K||` contribution (shared by [`Self::cell`] and [`Self::cell_rows`]).
     #[allow(clippy::too_many_arguments)]
-    fn push_cell(&mut self, rr: f64, K: &DMatrix<f64>, nK: f64, e_K: f64, K1: &DMatrix<f64>, nK1: f64, e_K1: f64, M2: f64) {
+    fn push_cell(
+        &mut self,
+        rr: f64,
+        K: &DMatrix<f64>,
+        nK: f64,
+        e_K: f64,
+        K1: &DMatrix<f64>,
+        nK1: f64,
+        e_K1: f64,
+        M2: f64,
+    ) {
         let Km = K - K1 * rr;
         let Kp = K + K1 * rr;
         let e_pm = e_K + rr * e_K1 + 2.01 * UNIT_ROUNDOFF * (nK + rr * nK1);

@@ -27,8 +27,8 @@ fn exp_step(F: &DMatrix<f64>, h: f64) -> (DMatrix<f64>, f64) {
 
 /// `e^{tF}` for a possibly long time: `(X, err)`, `err >= ||X - e^{tF}||_2`, given
 /// `msup >= sup_{[0, t]} ||e^{sF}||_2` (Gronwall for the rounding of `fl(t F)`). For
-/// `t ||F||_F > 64` and an error bound above `1e-8` (stiff plants: `e^{||tF||}` in the bound)
-/// the squaring of [`exp_long`] is tried as well and the smaller error kept.
+/// `t ||F||_F > 64` and either `t ||F||_F > 1e4` or an error bound above `1e-8` (stiff
+/// plants) the squaring of [`exp_long`] is tried as well and the smaller error kept.
 pub(super) fn exp_at(F: &DMatrix<f64>, t: f64, msup: f64) -> (DMatrix<f64>, f64) {
     let A = F * t;
     let (X, eX) = expm_enclosure(&A);
@@ -39,7 +39,7 @@ pub(super) fn exp_at(F: &DMatrix<f64>, t: f64, msup: f64) -> (DMatrix<f64>, f64)
     let eps = UNIT_ROUNDOFF * nA * (1.0 + 4.0 * UNIT_ROUNDOFF) / t.abs();
     let pert = t.abs() * msup * msup * eps * (msup * eps * t.abs()).exp() * (1.0 + 1e-6);
     let err = eX + pert;
-    if t > 0.0 && nA > 64.0 && msup.is_finite() && !(err <= 1e-8) {
+    if t > 0.0 && nA > 64.0 && msup.is_finite() && (nA > 1e4 || !(err <= 1e-8)) {
         let (Y, eY) = exp_long(F, t, msup);
         if eY < err {
             return (Y, eY);
