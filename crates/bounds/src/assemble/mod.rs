@@ -221,13 +221,26 @@ fn certificate(
     let (gamma_1, gamma_inf) = (gammas.gamma_1, gammas.gamma_inf);
     let al = alpha(C, E);
     let a_low = al.lower;
-    let search = optimise_lambda(
-        F,
-        E,
-        C,
-        |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf),
-        &settings.lambda,
-    )?;
+    let psi = |l: f64, b: f64| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf);
+    let mut search = optimise_lambda(F, E, C, psi, &settings.lambda);
+    // Stiff plants (issue 29 item 1): with ||F|| 1e3-1e4 times |mu| the solver's Pi often
+    // satisfies (ALI) with too small a margin to be proven; the search is repeated with the
+    // margin imposed in the SDP raised to 1e-3, then 1e-2 (relative), which only enlarges the
+    // certified beta (every certificate is verified as before).
+    for margin in [1e-3, 1e-2] {
+        if !matches!(search, Err(LmiError::NoCertificate { .. })) || settings.lambda.beta.tol_ali_margin_rel >= margin {
+            break;
+        }
+        let mut retry = settings.lambda.clone();
+        retry.beta.tol_ali_margin_rel = margin;
+        search = optimise_lambda(F, E, C, psi, &retry);
+        if search.is_ok() {
+            notes.push(format!(
+                "lambda search: no certificate with the default (ALI) margin; certified with the margin raised to {margin:e} (stiff F: a larger beta)"
+            ));
+        }
+    }
+    let search = search?;
     let curve: Vec<(f64, f64, f64)> =
         search.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta, v.theta))).collect();
     if !search.gaps.is_empty() {

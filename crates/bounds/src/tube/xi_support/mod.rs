@@ -239,7 +239,18 @@ impl TubeKernel {
         };
         let h_cap = 1.0 / nF.max(1e-300);
         let mut h0 = (0.05_f64).min(0.5 * h_cap);
+        let fp = FpTerms { d_theta, tail_unit, f_term, zero_in_theta, s_max, r };
+        // Stiff plants (proofs-notes/tube-quadrature.md, "stiff plants"): when the graded cells
+        // would exceed GRADED_MAX_CELLS and sup ||e^{sF}|| is proven, adaptive widths.
+        let alt_msup = sg.bounds.as_ref().ok().map(|b| b.sup).filter(|m| m.is_finite());
         loop {
+            if let Some(ms) = alt_msup {
+                if Self::graded_cells(s_max, h0, grade, h_cap, GRADED_MAX_CELLS) > GRADED_MAX_CELLS {
+                    let ops = Operands { sg, L, LF: &LF, LF2: &LF2, F, E, theta, nF, nE, msup, alt_msup: ms };
+                    let (k, acc) = Self::adaptive(&ops, &fp, h0, settings)?;
+                    return Ok(Self::complete(k, acc, &fp));
+                }
+            }
             let k = Self::build(
                 sg,
                 L,
@@ -268,25 +279,136 @@ impl TubeKernel {
                 });
             };
             if k.remainder <= 0.5 * tol || k.cells() == 0 {
-                // Floating-point terms (proofs-notes/tube-quadrature.md), per unit |v|. D_Theta as a Lipschitz constant
-                // of sigma_Theta, enlarged by 1e-9 (numerical deviations of some shapes).
-                let lip = d_theta * (1.0 + 1e-9);
-                let n_terms = 2 * k.cells() + 8;
-                let gr = gamma(r) * 1.01;
-                let sums = gamma(n_terms) * 1.01 * lip;
-                let small = gamma(8) * (k.remainder + tail_unit);
-                let rounding_up =
-                    (lip * (acc.err_pm + gr * acc.norm_pm + acc.tiling) + sums * acc.norm_pm + f_term + small)
-                        * (1.0 + 1e-6);
-                // Lower sums evaluate sigma_Theta to nearest: allowance 1e-12 D_Theta |w|.
-                let rounding_lo = (lip * (acc.err_mid + (gr + 1e-12) * acc.norm_mid + acc.tiling)
-                    + sums * acc.norm_mid
-                    + f_term
-                    + small)
-                    * (1.0 + 1e-6);
-                return Ok(Self { tail: tail_unit, zero_in_theta, s_max, rounding_up, rounding_lo, ..k });
+                return Ok(Self::complete(k, acc, &fp));
             }
             h0 /= (k.remainder / (0.4 * tol)).sqrt().max(1.5);
         }
     }
+
+    /// The kernel with its floating-point terms (proofs-notes/tube-quadrature.md), per unit
+    /// `|v|`. `D_Theta` as a Lipschitz constant of `sigma_Theta`, enlarged by 1e-9 (numerical
+    /// deviations of some shapes). A remainder that is not a number is replaced by `+inf`.
+    fn complete(k: Self, acc: Accum, fp: &FpTerms) -> Self {
+        let remainder = if k.remainder.is_nan() { f64::INFINITY } else { k.remainder };
+        let lip = fp.d_theta * (1.0 + 1e-9);
+        let n_terms = 2 * k.cells() + 8;
+        let gr = gamma(fp.r) * 1.01;
+        let sums = gamma(n_terms) * 1.01 * lip;
+        let small = gamma(8) * (remainder + fp.tail_unit);
+        let rounding_up = (lip * (acc.err_pm + gr * acc.norm_pm + acc.tiling) + sums * acc.norm_pm + fp.f_term + small)
+            * (1.0 + 1e-6);
+        // Lower sums evaluate sigma_Theta to nearest: allowance 1e-12 D_Theta |w|.
+        let rounding_lo =
+            (lip * (acc.err_mid + (gr + 1e-12) * acc.norm_mid + acc.tiling) + sums * acc.norm_mid + fp.f_term + small)
+                * (1.0 + 1e-6);
+        Self {
+            tail: fp.tail_unit,
+            zero_in_theta: fp.zero_in_theta,
+            s_max: fp.s_max,
+            rounding_up,
+            rounding_lo,
+            remainder,
+            ..k
+        }
+    }
+
+    /// The adaptive cells of a stiff plant ([`Self::build_adaptive`]): the scale `c` of the
+    /// widths starts from the first width `h0` and shrinks (remainder `~ c^2`) until the summed
+    /// remainders are below `tol / 2`, or until the next refinement would not fit in
+    /// `max_cells`: then the last kernel is kept, a proven enclosure that is only wider than
+    /// the target (its remainder is counted in full), never an error.
+    fn adaptive(ops: &Operands, fp: &FpTerms, h0: f64, settings: &TubeSettings) -> Result<(Self, Accum), BoundsError> {
+        let tol = settings.tol_abs;
+        let max_cells = settings.max_cells.min(ADAPTIVE_MAX_CELLS);
+        let m2_0 = frob(ops.LF2) * ops.alt_msup * ops.nE;
+        let scale = (fp.d_theta * m2_0).cbrt();
+        let mut c = if scale.is_finite() && scale > 0.0 { 0.5 * h0 * scale } else { h0 };
+        let mut best: Option<(Self, Accum)> = None;
+        let mut prev: Option<(f64, f64)> = None;
+        let stalled = |prev: Option<(f64, f64)>, (c, rem): (f64, f64)| {
+            prev.is_some_and(|(c0, r0)| rem > 3.0 * r0 * (c / c0).powi(2) && rem > 0.5 * r0)
+        };
+        for _ in 0..24 {
+            let built = Self::build_adaptive(
+                ops.sg,
+                ops.L,
+                ops.LF,
+                ops.LF2,
+                ops.F,
+                ops.E,
+                ops.theta,
+                fp.s_max,
+                c,
+                fp.d_theta,
+                ops.nF,
+                ops.nE,
+                ops.msup,
+                ops.alt_msup,
+                fp.r,
+                ops.E.ncols(),
+                max_cells,
+            );
+            let Some((k, acc)) = built else {
+                if best.is_some() {
+                    break;
+                }
+                c *= 4.0;
+                continue;
+            };
+            let (rem, cells) = (k.remainder, k.cells());
+            let done = rem <= 0.5 * tol || cells == 0;
+            best = Some((k, acc));
+            if done {
+                break;
+            }
+            // hopeless within the budget (the cells needed grow like sqrt(remainder)): keep it
+            if !(cells as f64 * (rem / (0.4 * tol)).sqrt() <= 4.0 * max_cells as f64) {
+                break;
+            }
+            let f = if rem.is_finite() { (0.4 * tol / rem).sqrt().min(0.66) } else { 0.25 };
+            // the cells grow like 1 / c: stay within the budget; a remainder that fell by less
+            // than a third of the expected factor is dominated by what refining cannot shrink
+            let f = f.max(cells as f64 / (0.9 * max_cells as f64));
+            if f >= 0.99 || stalled(prev, (c, rem)) {
+                break;
+            }
+            prev = Some((c, rem));
+            c *= f;
+        }
+        best.ok_or(BoundsError::QuadratureBudget { error_bound: f64::INFINITY, tol, nodes: max_cells })
+    }
+}
+
+/// Most cells of the adaptive walk (at most `max_cells`): beyond, the enclosure is kept wider
+/// (its remainder counted in full) so that an answer stays within about a second.
+const ADAPTIVE_MAX_CELLS: usize = 50_000;
+
+/// Graded cells beyond this count switch to the adaptive cells of a stiff plant (when
+/// `sup ||e^{sF}||` is proven).
+const GRADED_MAX_CELLS: usize = 20_000;
+
+/// What [`TubeKernel::complete`] adds to the cells: `D_Theta`, the tail and rounded-`F` terms
+/// per unit `|v|`, whether `0 in Theta`, the truncation point and the directions' dimension.
+struct FpTerms {
+    d_theta: f64,
+    tail_unit: f64,
+    f_term: f64,
+    zero_in_theta: bool,
+    s_max: f64,
+    r: usize,
+}
+
+/// The matrices and norms of a kernel's walk ([`TubeKernel::adaptive`]).
+struct Operands<'a> {
+    sg: &'a SemigroupData,
+    L: &'a DMatrix<f64>,
+    LF: &'a DMatrix<f64>,
+    LF2: &'a DMatrix<f64>,
+    F: &'a DMatrix<f64>,
+    E: &'a DMatrix<f64>,
+    theta: &'a Shape,
+    nF: f64,
+    nE: f64,
+    msup: f64,
+    alt_msup: f64,
 }
