@@ -45,6 +45,9 @@ pub struct Generators {
     /// `C` as a row (`p = 1`).
     pub C: Vec<f64>,
     exact: [IMat; 3],
+    /// Per phase kind, a real (block-)eigenbasis of the generator for the flow, see
+    /// [`Basis`]; `None` where it is ill-conditioned (the flow is then enclosed directly).
+    basis: [Option<Basis>; 3],
     mid: [DMatrix<f64>; 3],
     error: [f64; 3],
 }
@@ -119,7 +122,8 @@ impl Generators {
             // a Frobenius bound from the largest entry
             dim as f64 * w * (1.0 + 1e-12)
         });
-        Self { n, dim, lo, hi, omega, C: C.row(0).iter().copied().collect(), exact, mid, error }
+        let basis = [0, 1, 2].map(|k: usize| Basis::new(&exact[k]));
+        Self { n, dim, lo, hi, omega, C: C.row(0).iter().copied().collect(), exact, mid, error, basis }
     }
 
     /// The (midpoint) generator of a phase and the bound on its distance to the exact one.
@@ -134,6 +138,9 @@ impl Generators {
 
     /// The enclosure of `e^{h G}` of a phase for every `h` in `h`.
     pub fn flow(&self, kind: PhaseKind, h: Ival) -> IMat {
+        if let Some(b) = &self.basis[index(kind)] {
+            return b.V.mul(&expm_interval(&b.Gmid, b.gerr, h)).mul(&b.Vinv);
+        }
         let (G, err) = self.of(kind);
         expm_interval(G, err, h)
     }
@@ -168,6 +175,102 @@ impl Generators {
         let r = self.ydot_row(kind);
         let g = &self.exact[index(kind)];
         (0..self.dim).map(|j| (0..self.dim).fold(Ival::point(0.0), |s, i| s.add(r[i].mul(g.at(i, j))))).collect()
+    }
+}
+
+/// A real basis `V` in which the generator is nearly block diagonal (real eigenvectors, and
+/// `(Re v, Im v)` for a complex pair), so that the interval squarings of [`expm_interval`]
+/// wrap little: `e^{hG} = V e^{h G'} V^{-1}` exactly for `G' = V^{-1} G V`. `V^{-1}` is
+/// enclosed as `(I - R)^{-1} W`, `W ~ V^{-1}`, `R = I - W V` (interval), `||(I - R)^{-1} - I||_inf
+/// <= ||R||_inf / (1 - ||R||_inf) = eps`, so `V^{-1} = W + Z W` with `|(Z W)_ij| <= eps max_l
+/// |W_lj|`; `G'` is enclosed from it and from the enclosed `G`, and its flow enclosed with the
+/// distance of its midpoint to every matrix of the enclosure as the generator error.
+#[derive(Debug, Clone)]
+struct Basis {
+    V: IMat,
+    Vinv: IMat,
+    Gmid: DMatrix<f64>,
+    gerr: f64,
+}
+
+impl Basis {
+    fn new(G: &IMat) -> Option<Self> {
+        use nalgebra::Complex;
+        let d = G.rows;
+        let Gm = G.mid();
+        let lam = Gm.clone().complex_eigenvalues();
+        let scale = 1.0 + Gm.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let tol = 1e-7 * scale;
+        let mut cols: Vec<nalgebra::DVector<f64>> = Vec::new();
+        let mut done = vec![false; d];
+        for i in 0..d {
+            if done[i] || lam[i].im < -tol {
+                continue;
+            }
+            // the cluster of (numerically) equal eigenvalues
+            let cluster: Vec<usize> = (0..d).filter(|&j| (lam[j] - lam[i]).norm() <= tol).collect();
+            for &j in &cluster {
+                done[j] = true;
+            }
+            let m = cluster.len();
+            if lam[i].im.abs() <= tol {
+                let Ai = &Gm - DMatrix::<f64>::identity(d, d) * lam[i].re;
+                let svd = Ai.svd(false, true);
+                let vt = svd.v_t?;
+                let mut idx: Vec<usize> = (0..d).collect();
+                idx.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
+                for &r in idx.iter().take(m) {
+                    cols.push(vt.row(r).transpose());
+                }
+            } else {
+                let Gc: DMatrix<Complex<f64>> = Gm.map(|v| Complex::new(v, 0.0));
+                let Ai = Gc - DMatrix::<Complex<f64>>::identity(d, d) * lam[i];
+                let svd = Ai.svd(false, true);
+                let vt = svd.v_t?;
+                let mut idx: Vec<usize> = (0..d).collect();
+                idx.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));
+                for &r in idx.iter().take(m) {
+                    let v: Vec<Complex<f64>> = vt.row(r).iter().map(|z| z.conj()).collect();
+                    cols.push(nalgebra::DVector::from_iterator(d, v.iter().map(|z| z.re)));
+                    cols.push(nalgebra::DVector::from_iterator(d, v.iter().map(|z| z.im)));
+                }
+            }
+        }
+        if cols.len() != d {
+            return None;
+        }
+        let Vm = DMatrix::from_columns(&cols);
+        let W = Vm.clone().try_inverse()?;
+        let V = IMat::from_f64(&Vm);
+        let Wi = IMat::from_f64(&W);
+        let R = IMat::identity(d).sub(&Wi.mul(&V));
+        let r = (0..d).map(|i| (0..d).fold(0.0f64, |s, j| add_up(s, R.at(i, j).mag()))).fold(0.0f64, f64::max);
+        if !(r < 0.25) {
+            return None;
+        }
+        // V^{-1} = (I - R)^{-1} W = W + R W + R^2 (I - R)^{-1} W
+        let eps2 = Ival::point(r).sqr().div(Ival::point(1.0).sub(Ival::point(r))).hi;
+        let mut Vinv = Wi.add(&R.mul(&Wi));
+        for j in 0..d {
+            let colmax = (0..d).map(|l| W[(l, j)].abs()).fold(0.0, f64::max);
+            let e = Ival::point(eps2).mul(Ival::point(colmax)).hi;
+            for i in 0..d {
+                Vinv.set(i, j, Vinv.at(i, j).add(Ival::sym(e)));
+            }
+        }
+        let Gp = Vinv.mul(G).mul(&V);
+        let Gmid = Gp.mid();
+        // Frobenius norm of the radius matrix, rounded up
+        let mut w2 = 0.0f64;
+        for i in 0..d {
+            for j in 0..d {
+                let (e, m) = (Gp.at(i, j), Gmid[(i, j)]);
+                let rad = add_up(e.hi, -m).max(add_up(m, -e.lo));
+                w2 = add_up(w2, Ival::point(rad).sqr().hi);
+            }
+        }
+        let gerr = Ival::point(w2).sqrt().hi * (1.0 + 1e-12);
+        gerr.is_finite().then_some(Self { V, Vinv, Gmid, gerr })
     }
 }
 

@@ -31,7 +31,7 @@ use geometry::Shape;
 use model::{Input, System};
 use period_map::{KrawczykVerdict, Shooting};
 pub use phases::PhaseStructure;
-use rounding::Ival;
+pub use rounding::Ival;
 use serde::Serialize;
 
 /// Settings of the enclosure.

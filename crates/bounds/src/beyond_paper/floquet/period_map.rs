@@ -188,7 +188,10 @@ impl<'a> Shooting<'a> {
             }
         }
         let ev = self.evaluate(&u.iter().map(|v| Ival::point(*v)).collect::<Vec<_>>(), false)?;
-        let ok = ev.durations.iter().all(|h| h.lo > 0.0) && ev.f.iter().all(|v| v.mag() < 1e-9);
+        // converged: the midpoint residual small against the state's scale (the enclosure's
+        // width is the flows' error, judged by the Krawczyk test, not here)
+        let scale = 1.0 + u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let ok = ev.durations.iter().all(|h| h.lo > 0.0) && ev.f.iter().all(|v| v.mid().abs() < 1e-9 * scale);
         ok.then_some(u)
     }
 

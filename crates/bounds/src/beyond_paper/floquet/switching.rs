@@ -35,13 +35,44 @@ pub struct PhaseFailure {
     pub what: &'static str,
 }
 
-/// A condition on `X(t)` over a piece.
-type Cond<'c> = &'c dyn Fn(&IMat) -> bool;
+/// The range of a linear function `r . X(t)` over a piece of times, in the centred (mean
+/// value) form `r . X(t_c) + [a - t_c, b - t_c] (r G) . X([a, b])`, intersected with the direct
+/// enclosure `r . X([a, b])`: the crude enclosure of the whole piece enters only through the
+/// derivative, so the range is tight to second order in the piece length.
+pub struct Piece<'p> {
+    G: &'p IMat,
+    Xc: IMat,
+    Xr: IMat,
+    dt: Ival,
+}
+
+impl Piece<'_> {
+    pub fn range(&self, row: &[Ival]) -> Ival {
+        let d = row.len();
+        let rG: Vec<Ival> =
+            (0..d).map(|j| (0..d).fold(Ival::point(0.0), |s, i| s.add(row[i].mul(self.G.at(i, j))))).collect();
+        let centred = dot(row, &self.Xc).add(self.dt.mul(dot(&rG, &self.Xr)));
+        let direct = dot(row, &self.Xr);
+        centred.intersect(&direct).unwrap_or(centred)
+    }
+    fn valid(&self) -> bool {
+        self.Xc.is_valid() && self.Xr.is_valid()
+    }
+}
+
+/// A condition on the linear functions of `X(t)` over a piece.
+type Cond<'c> = &'c dyn Fn(&Piece) -> bool;
 
 /// `cond` on `e^{t G} X` for all `t` in `[a, b]` (with bisection).
 fn holds(g: &Generators, kind: PhaseKind, X: &IMat, a: f64, b: f64, cond: Cond, depth: usize) -> bool {
-    let Xt = g.flow(kind, Ival::new(a, b)).mul(X);
-    if Xt.is_valid() && cond(&Xt) {
+    let tc = 0.5 * (a + b);
+    let piece = Piece {
+        G: g.generator(kind),
+        Xc: g.flow(kind, Ival::point(tc)).mul(X),
+        Xr: g.flow(kind, Ival::new(a, b)).mul(X),
+        dt: Ival::new(a, b).sub(Ival::point(tc)),
+    };
+    if piece.valid() && cond(&piece) {
         return true;
     }
     if depth >= MAX_DEPTH || !(b > a) {
@@ -90,19 +121,19 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
                 let s = if face == Face::Hi { -1.0 } else { 1.0 };
                 if j < k {
                     // release at the end: s y'' < 0 on a last piece
-                    let c = |X: &IMat| dot(&r2, X).scale(s).is_negative();
+                    let c = |P: &Piece| P.range(&r2).scale(s).is_negative();
                     let e = end_piece(g, kind, Xe, eps, -1.0, &c)
                         .ok_or(PhaseFailure { phase: j, what: "release not transversal (y'' sign)" })?;
                     t_b = h.hi - e;
                 }
-                let c = |X: &IMat| dot(&r1, X).scale(s).is_positive();
+                let c = |P: &Piece| P.range(&r1).scale(s).is_positive();
                 if !piecewise(g, kind, Xs, t_a, t_b, &c) {
                     return Err(PhaseFailure { phase: j, what: "engaged phase: y' does not keep pushing" });
                 }
             }
             PhaseKind::Resting => {
-                let inside = |X: &IMat| {
-                    let q = dot(&qr, X);
+                let inside = |P: &Piece| {
+                    let q = P.range(&qr);
                     q.lo > lo && q.hi < hi
                 };
                 if j > 0 {
@@ -110,9 +141,9 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
                         return Err(PhaseFailure { phase: j, what: "two resting phases in a row" });
                     };
                     let s = if from == Face::Hi { 1.0 } else { -1.0 };
-                    let c = |X: &IMat| {
-                        let q = dot(&qr, X);
-                        dot(&r2, X).scale(s).is_positive() && if from == Face::Hi { q.lo > lo } else { q.hi < hi }
+                    let c = |P: &Piece| {
+                        let q = P.range(&qr);
+                        P.range(&r2).scale(s).is_positive() && if from == Face::Hi { q.lo > lo } else { q.hi < hi }
                     };
                     t_a = end_piece(g, kind, Xs, eps, 1.0, &c).ok_or(PhaseFailure {
                         phase: j,
@@ -124,9 +155,9 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
                         return Err(PhaseFailure { phase: j, what: "two resting phases in a row" });
                     };
                     let s = if to == Face::Lo { 1.0 } else { -1.0 };
-                    let c = |X: &IMat| {
-                        let q = dot(&qr, X);
-                        dot(&r1, X).scale(s).is_positive() && if to == Face::Lo { q.hi < hi } else { q.lo > lo }
+                    let c = |P: &Piece| {
+                        let q = P.range(&qr);
+                        P.range(&r1).scale(s).is_positive() && if to == Face::Lo { q.hi < hi } else { q.lo > lo }
                     };
                     let e = end_piece(g, kind, Xe, eps, -1.0, &c)
                         .ok_or(PhaseFailure { phase: j, what: "contact not transversal (y' sign)" })?;
