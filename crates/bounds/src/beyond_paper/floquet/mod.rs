@@ -155,6 +155,12 @@ fn generators(sys: &System) -> Result<(Generators, f64, f64), FloquetError> {
     Ok((Generators::new(&sys.A, &sys.B, &a, &sys.C, &sys.E, lo, hi, omega), omega, phase))
 }
 
+/// Whether the enclosure applies to `sys` (p = 1, `Theta` an interval, sine input, no
+/// `[[effects]]`); elsewhere [`floquet_enclosure`] returns the reason.
+pub fn applies(sys: &System) -> bool {
+    supported(sys).is_ok()
+}
+
 /// The whole pipeline: structure from simulation, then the proof. Never panics; a failure of
 /// a stage is the result's `reason`.
 pub fn floquet_enclosure(sys: &System, settings: &FloquetSettings) -> FloquetEnclosure {
