@@ -198,6 +198,9 @@ impl Basis {
         use nalgebra::Complex;
         let d = G.rows;
         let Gm = G.mid();
+        if !Gm.iter().all(|v| v.is_finite()) {
+            return None;
+        }
         let lam = Gm.clone().complex_eigenvalues();
         let scale = 1.0 + Gm.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let tol = 1e-7 * scale;

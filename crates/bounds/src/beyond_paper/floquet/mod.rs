@@ -202,6 +202,10 @@ fn prove(sys: &System, st: &PhaseStructure, settings: &FloquetSettings) -> Resul
     let point: Vec<Ival> = uhat.iter().map(|v| Ival::point(*v)).collect();
     let ev0 = sh.evaluate(&point, false).ok_or((FloquetError::Newton, None))?;
     let M0 = monodromy::monodromy(&ev0.flows, &st.kinds, &g.C);
+    if !M0.is_valid() {
+        // (an eigen-solver on a non-finite matrix need not return)
+        return Err((FloquetError::Spectrum { what: "non-finite monodromy" }, None));
+    }
     let T = sh.T;
     let rho0 = M0.mid().complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
     let estimate = rho0.ln() / T.mid();

@@ -173,6 +173,9 @@ impl<'a> Shooting<'a> {
         for _ in 0..max_iter {
             let ev = self.evaluate(&u.iter().map(|v| Ival::point(*v)).collect::<Vec<_>>(), true)?;
             let J = ev.J?.mid();
+            if !J.iter().all(|v| v.is_finite()) {
+                return None;
+            }
             let f = nalgebra::DVector::from_iterator(N, ev.f.iter().map(|v| v.mid()));
             let step = J.lu().solve(&f)?;
             let mut size = 0.0f64;
