@@ -41,45 +41,56 @@ pub struct PhaseFailure {
 /// derivative, so the range is tight to second order in the piece length.
 pub struct Piece<'p> {
     G: &'p IMat,
-    Xc: IMat,
+    /// `X(t_c)`; `None`: the direct enclosure alone.
+    Xc: Option<IMat>,
     Xr: IMat,
     dt: Ival,
 }
 
 impl Piece<'_> {
     pub fn range(&self, row: &[Ival]) -> Ival {
+        let direct = dot(row, &self.Xr);
+        let Some(Xc) = &self.Xc else { return direct };
         let d = row.len();
         let rG: Vec<Ival> =
             (0..d).map(|j| (0..d).fold(Ival::point(0.0), |s, i| s.add(row[i].mul(self.G.at(i, j))))).collect();
-        let centred = dot(row, &self.Xc).add(self.dt.mul(dot(&rG, &self.Xr)));
-        let direct = dot(row, &self.Xr);
+        let centred = dot(row, Xc).add(self.dt.mul(dot(&rG, &self.Xr)));
         centred.intersect(&direct).unwrap_or(centred)
     }
     fn valid(&self) -> bool {
-        self.Xc.is_valid() && self.Xr.is_valid()
+        self.Xr.is_valid() && self.Xc.as_ref().is_none_or(|x| x.is_valid())
     }
 }
 
 /// A condition on the linear functions of `X(t)` over a piece.
 type Cond<'c> = &'c dyn Fn(&Piece) -> bool;
 
-/// `cond` on `e^{t G} X` for all `t` in `[a, b]` (with bisection).
-fn holds(g: &Generators, kind: PhaseKind, X: &IMat, a: f64, b: f64, cond: Cond, depth: usize) -> bool {
+/// `cond` on `X(t)` for all `t` in `[a, b]` (with bisection), from the state `X = X(tx)` at a
+/// reference time `tx` (an end of the piece, so the flows are short): first on the direct
+/// enclosure (one flow), then in the centred form; the right half of a bisection starts from
+/// `X(t_c)`.
+#[allow(clippy::too_many_arguments)]
+fn holds(g: &Generators, kind: PhaseKind, X: &IMat, tx: f64, a: f64, b: f64, cond: Cond, depth: usize) -> bool {
     let tc = 0.5 * (a + b);
-    let piece = Piece {
+    let rel = |t: Ival| t.sub(Ival::point(tx));
+    let mut piece = Piece {
         G: g.generator(kind),
-        Xc: g.flow(kind, Ival::point(tc)).mul(X),
-        Xr: g.flow(kind, Ival::new(a, b)).mul(X),
+        Xc: None,
+        Xr: g.flow_apply(kind, rel(Ival::new(a, b)), X),
         dt: Ival::new(a, b).sub(Ival::point(tc)),
     };
     if piece.valid() && cond(&piece) {
         return true;
     }
-    if depth >= MAX_DEPTH || !(b > a) {
+    let Xc = g.flow_apply(kind, rel(Ival::point(tc)), X);
+    piece.Xc = Some(Xc.clone());
+    if piece.valid() && cond(&piece) {
+        return true;
+    }
+    if depth >= MAX_DEPTH || !(b > a) || !Xc.is_valid() {
         return false;
     }
-    let m = 0.5 * (a + b);
-    holds(g, kind, X, a, m, cond, depth + 1) && holds(g, kind, X, m, b, cond, depth + 1)
+    holds(g, kind, X, tx, a, tc, cond, depth + 1) && holds(g, kind, &Xc, tc, tc, b, cond, depth + 1)
 }
 
 /// An end piece `[0, eps]` (forward from `X`, or backward with `sign = -1`) on which `cond`
@@ -88,9 +99,9 @@ fn end_piece(g: &Generators, kind: PhaseKind, X: &IMat, eps: f64, sign: f64, con
     let mut e = eps;
     for _ in 0..=MAX_DEPTH {
         let ok = if sign > 0.0 {
-            holds(g, kind, X, 0.0, e, cond, MAX_DEPTH)
+            holds(g, kind, X, 0.0, 0.0, e, cond, MAX_DEPTH)
         } else {
-            holds(g, kind, X, -e, 0.0, cond, MAX_DEPTH)
+            holds(g, kind, X, 0.0, -e, 0.0, cond, MAX_DEPTH)
         };
         if ok {
             return Some(e);
@@ -180,6 +191,7 @@ fn piecewise(g: &Generators, kind: PhaseKind, X: &IMat, a: f64, b: f64, cond: Co
     let step = (b - a) / PIECES as f64;
     (0..PIECES).all(|i| {
         let (s, e) = (a + i as f64 * step, if i + 1 == PIECES { b } else { a + (i + 1) as f64 * step });
-        holds(g, kind, X, s, e, cond, 0)
+        let Xs = g.flow_apply(kind, Ival::point(s), X);
+        Xs.is_valid() && holds(g, kind, &Xs, s, s, e, cond, 0)
     })
 }
