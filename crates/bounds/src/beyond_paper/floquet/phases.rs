@@ -56,7 +56,10 @@ pub fn simulate_structure(
     let T = 2.0 * std::f64::consts::PI / omega;
     let ps = PoincareSettings { dt: T / 2000.0, tol_residual: 1e-9, max_periods, ..Default::default() };
     let reg = periodic_regime(sys, &ps).map_err(|e| FloquetError::Simulation { what: e.to_string() })?;
-    if reg.status != FixedPointStatus::Converged {
+    // the fixed point only seeds the structure: an iteration stalled by the catching-up's own
+    // jitter near the regime is good enough (Newton and Krawczyk decide); far from it is not
+    let scale = 1.0 + reg.x0.iter().chain(&reg.z0).fold(0.0f64, |a, v| a.max(v.abs()));
+    if reg.status != FixedPointStatus::Converged && !(reg.residual <= 1e-4 * scale) {
         return Err(FloquetError::NoRegime { periods: reg.iterations });
     }
     let mut s2 = sys.clone();

@@ -67,8 +67,8 @@ type Cond<'c> = &'c dyn Fn(&Piece) -> bool;
 
 /// `cond` on `X(t)` for all `t` in `[a, b]` (with bisection), from the state `X = X(tx)` at a
 /// reference time `tx` (an end of the piece, so the flows are short): first on the direct
-/// enclosure (one flow), then in the centred form; the right half of a bisection starts from
-/// `X(t_c)`.
+/// enclosure (one flow), then in the centred form; both halves of a bisection keep the
+/// reference.
 #[allow(clippy::too_many_arguments)]
 fn holds(g: &Generators, kind: PhaseKind, X: &IMat, tx: f64, a: f64, b: f64, cond: Cond, depth: usize) -> bool {
     let tc = 0.5 * (a + b);
@@ -90,7 +90,9 @@ fn holds(g: &Generators, kind: PhaseKind, X: &IMat, tx: f64, a: f64, b: f64, con
     if depth >= MAX_DEPTH || !(b > a) || !Xc.is_valid() {
         return false;
     }
-    holds(g, kind, X, tx, a, tc, cond, depth + 1) && holds(g, kind, &Xc, tc, tc, b, cond, depth + 1)
+    // both halves from the same reference state (chaining the states would compound the
+    // wrapping of the basis change at every level)
+    holds(g, kind, X, tx, a, tc, cond, depth + 1) && holds(g, kind, X, tx, tc, b, cond, depth + 1)
 }
 
 /// An end piece `[0, eps]` (forward from `X`, or backward with `sign = -1`) on which `cond`
