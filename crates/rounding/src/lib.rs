@@ -15,7 +15,8 @@
 //!   - operations rounded upward or downward, exact when the nearest result is (checked with
 //!     TwoSum or an FMA residual): [`add_up`], [`mul_up`], [`div_up`], [`sqrt_up`], [`sqrt_down`];
 //!   - relative margins with an absolute floor: [`pad_up`], [`pad_down`], [`scale_up`];
-//! - [`enclosure`]: [`Enclosure`], a real number known to lie in `[lower, upper]`.
+//! - [`enclosure`]: [`Enclosure`], a real number known to lie in `[lower, upper]`;
+//! - [`interval`]: [`Ival`], interval arithmetic rounded outward (verified numerics).
 //!
 //! Every primitive has a test that checks its enclosure exactly (dyadic integer arithmetic on
 //! many seeded random inputs, `exact` in the tests) and a negative control: the naive version
@@ -27,6 +28,7 @@
 
 pub mod directed;
 pub mod enclosure;
+pub mod interval;
 pub mod roundoff;
 pub mod two_sum;
 
@@ -35,5 +37,6 @@ pub(crate) mod exact;
 
 pub use directed::{add_up, div_up, mul_up, pad_down, pad_up, scale_up, sqrt_down, sqrt_up, ulp_down_nonzero, ulp_up};
 pub use enclosure::Enclosure;
+pub use interval::Ival;
 pub use roundoff::{gamma, UNIT_ROUNDOFF};
 pub use two_sum::two_sum;

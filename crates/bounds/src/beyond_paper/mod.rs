@@ -6,6 +6,9 @@
 //!   from the pinned speed (proofs-notes/theta-star.md);
 //! - `theta_profile`: the chord argument of eq. (theta) resolved in time over the cells of a
 //!   speed profile ([`speed_profile`], proofs-notes/theta-profile.md);
+//! - `floquet` (p = 1): a verified enclosure of the periodic regime and its Floquet exponent, the
+//!   local exponent that brackets the true one from the other side of `theta_best`
+//!   (proofs-notes/floquet-enclosure.md);
 //! - `theta_engaged` (p = 1): `theta_profile` with speed floors on the cells where the backlash
 //!   is provably engaged (proofs-notes/theta-engaged.md).
 //!
@@ -15,6 +18,7 @@
 //! engaged history, [`EngagedHistory`], from the paper's tube kernels of [`crate::tube`]).
 pub mod engaged_speed;
 pub mod extensions;
+pub mod floquet;
 pub mod speed_profile;
 
 pub use engaged_speed::{EngagedHistory, EngagedSpeed};

@@ -134,15 +134,69 @@ pub fn render_verdict(rep: &ThetaReport) -> String {
     s
 }
 
-/// The readable report: the header, the verdict block ([`render_verdict`]), the table of every
-/// quantity, the stationary set and the notes.
-pub fn render(rep: &ThetaReport, theta_desc: &str) -> String {
+/// `x` rounded down (`up = false`) or up to 7 decimals, so that a printed enclosure still
+/// contains the computed one.
+fn directed_7(x: f64, up: bool) -> String {
+    let s = 1e7;
+    let mut v = if up { (x * s).ceil() / s } else { (x * s).floor() / s };
+    if up && v < x {
+        v += 1.0 / s;
+    } else if !up && v > x {
+        v -= 1.0 / s;
+    }
+    format!("{v:.7}")
+}
+
+/// The line of the verified Floquet exponent (issue 30): `floquet_exponent [lo, hi] (verified)`
+/// (printed outward to 7 decimals), with the bracket `[floquet_lo, theta_best]` of the
+/// convergence exponent when both are proven; otherwise why not, with the floating-point
+/// estimate when there is one.
+pub fn render_floquet(rep: &ThetaReport, f: &bounds::beyond_paper::floquet::FloquetEnclosure) -> String {
+    let [lo, hi] = f.floquet_exponent;
+    let text = if f.verified {
+        let bracket = if rep.theta_best_verified && rep.theta_best < 0.0 && rep.effects.is_empty() {
+            format!(
+                "; the convergence exponent lies in [floquet_lo, theta_best] = [{}, {}]",
+                directed_7(lo, false),
+                fmt_value(rep.theta_best)
+            )
+        } else {
+            String::new()
+        };
+        format!("floquet_exponent [{}, {}] (verified{bracket})", directed_7(lo, false), directed_7(hi, true))
+    } else {
+        let reason = f.reason.as_deref().unwrap_or("unknown");
+        if f.estimate.is_finite() {
+            format!(
+                "floquet_exponent [{e}, {e}] (not verified: {reason}; floating-point estimate)",
+                e = fmt_value(f.estimate)
+            )
+        } else {
+            format!("floquet_exponent n/a (not verified: {reason})")
+        }
+    };
+    let mut s = String::new();
+    push_wrapped(&mut s, "", &text);
+    s
+}
+
+/// The readable report: the header, the verdict block ([`render_verdict`]) and the Floquet line
+/// ([`render_floquet`], when computed), the table of every quantity, the stationary set and the
+/// notes.
+pub fn render(
+    rep: &ThetaReport,
+    theta_desc: &str,
+    floquet: Option<&bounds::beyond_paper::floquet::FloquetEnclosure>,
+) -> String {
     let mut s = String::new();
     s.push_str(&format!(
         "moreau theta: {}\n  n = {}, m = {}, p = {}, T = {:.6}, Theta = {}\n\n",
         rep.name, rep.n, rep.m, rep.p, rep.period, theta_desc
     ));
     s.push_str(&render_verdict(rep));
+    if let Some(f) = floquet {
+        s.push_str(&render_floquet(rep, f));
+    }
     s.push('\n');
     s.push_str(&render_table(&rep.quantities()));
     s.push('\n');
@@ -205,8 +259,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         println!("{json}");
     } else if a.brief {
         print!("{}", render_verdict(&run.report));
+        if let Some(f) = &run.floquet {
+            print!("{}", render_floquet(&run.report, f));
+        }
     } else {
-        print!("{}", render(&run.report, &run.sys.theta.describe()));
+        print!("{}", render(&run.report, &run.sys.theta.describe(), run.floquet.as_ref()));
         if let Some(g) = &run.guidance {
             print!("{}", g.render());
         }

@@ -3,6 +3,7 @@
 use super::Source;
 use crate::guidance::Guidance;
 use anyhow::Context;
+use bounds::beyond_paper::floquet::{self, FloquetEnclosure, FloquetSettings};
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use model::System;
 
@@ -23,11 +24,15 @@ impl Default for ThetaOptions {
     }
 }
 
-/// The result of `theta`: the system, its report and the guidance (when computed).
+/// The result of `theta`: the system, its report, the guidance (when computed) and the verified
+/// Floquet enclosure of the regime (p = 1, interval, sine input; computed with the measured
+/// side, since its phase structure is read from a simulation; issue 30,
+/// proofs-notes/floquet-enclosure.md).
 pub struct ThetaRun {
     pub sys: System,
     pub report: ThetaReport,
     pub guidance: Option<Guidance>,
+    pub floquet: Option<FloquetEnclosure>,
 }
 
 impl ThetaRun {
@@ -36,6 +41,14 @@ impl ThetaRun {
         let mut obj = self.report.to_json();
         if let (Some(g), Some(m)) = (&self.guidance, obj.as_object_mut()) {
             m.insert("guidance".into(), serde_json::to_value(g)?);
+        }
+        if let (Some(f), Some(m)) = (&self.floquet, obj.as_object_mut()) {
+            let ends = f.floquet_exponent;
+            let value =
+                if ends.iter().all(|v| v.is_finite()) { serde_json::json!(ends) } else { serde_json::Value::Null };
+            m.insert("floquet_exponent".into(), value);
+            m.insert("floquet_exponent_verified".into(), serde_json::json!(f.verified));
+            m.insert("floquet_reason".into(), serde_json::json!(f.reason));
         }
         Ok(obj)
     }
@@ -67,5 +80,7 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
     };
     let guidance = (o.guidance && !report.convergence_guaranteed && report.effects.is_empty())
         .then(|| crate::guidance::guidance(&sys, &report, &Default::default()));
-    Ok(ThetaRun { sys, report, guidance })
+    let floquet =
+        (o.measure && floquet::applies(&sys)).then(|| floquet::floquet_enclosure(&sys, &FloquetSettings::default()));
+    Ok(ThetaRun { sys, report, guidance, floquet })
 }
