@@ -179,7 +179,8 @@ impl<'a> Pass<'a> {
     }
 
     /// The selected model's gain over the nominal, both refitted at [`FINER_STEPPING`] times
-    /// the sub-steps (issue 27 item 3). A gain that is physics stays; one the effect bought by
+    /// the sub-steps (issue 27 item 3; at least twice, within the sub-step budget of
+    /// [`super::setup::SUBSTEP_BUDGET`]). A gain that is physics stays; one the effect bought by
     /// absorbing the simulator's stepping error shrinks with the step (as the error's square,
     /// or as the error where the effect absorbs part of it). With `g` the gain at `k` and `g_f`
     /// at the finer stepping, the part of `g_f` still owed to stepping is at most
@@ -190,7 +191,11 @@ impl<'a> Pass<'a> {
         let c = selection.chosen.as_ref()?;
         let s = data.s;
         let k = self.ctx.substeps;
-        let kf = FINER_STEPPING * k;
+        // Within the sub-step budget (at least twice the sub-steps; none left: no check).
+        let kf = (FINER_STEPPING * k).min((2 * k).max(super::setup::SUBSTEP_BUDGET / data.n_samp.max(1)));
+        if kf <= k {
+            return None;
+        }
         let ctx_f = data.context(self.hold, kf, data.x_scale.clone());
         let nom_f = fit::fit(&ctx_f.problem(vec![], vec![]), &self.nom.x0, &ctx_f.x_scale, None, &s.fit);
         let warm = FitSettings { max_iter: 20, ..s.fit.clone() };
@@ -199,7 +204,7 @@ impl<'a> Pass<'a> {
         let k_c = c.params.len() + if c.refit { c.nominal.len() } else { 0 };
         let g = select::bic(self.nom.sse, n, nx) - c.bic;
         let g_f = select::bic(nom_f.sse, n, nx) - select::bic(c_f.sse, n, nx + k_c);
-        let owed = ((g - g_f) / (FINER_STEPPING - 1) as f64).max(0.0);
+        let owed = ((g - g_f) / ((kf / k) - 1) as f64).max(0.0);
         self.finer_check = Some((kf, g, g_f));
         if g_f - owed >= s.select.margin_bic {
             return None;

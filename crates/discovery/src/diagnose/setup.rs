@@ -20,6 +20,11 @@ pub(super) const BEYOND_MAX_SUBSTEPS: usize = 16;
 /// See [`BEYOND_MAX_SUBSTEPS`] (a play's catching-up projection, first order in the step, can
 /// need a few hundred sub-steps to bring its error under a low noise level).
 pub(super) const MIN_SUBSTEPS_CAP: usize = 256;
+/// Samples times sub-steps that the extension past `max_substeps` may reach (the cost of 64
+/// sub-steps on a 3000-sample record): on a long or noiseless record the stepping error stays
+/// above the noise, stated as not converged, and the selection margin grows by what it can
+/// buy.
+pub(super) const SUBSTEP_BUDGET: usize = 200_000;
 
 /// The model, the recording and the settings, with everything derived from them once.
 pub(super) struct Setup<'a> {
@@ -184,8 +189,9 @@ impl<'a> Setup<'a> {
     /// `hold`, doubling from `k_from` up to `max_substeps` until the change is within the
     /// tolerance; where that leaves a remaining stepping error above the noise level (a cap
     /// reached, or a tolerance set above half the noise), on up to [`BEYOND_MAX_SUBSTEPS`]
-    /// times `max_substeps` (at least [`MIN_SUBSTEPS_CAP`]) with the change held to half the noise (a stated error above the
-    /// noise is not accepted while more sub-steps can bring it down).
+    /// times `max_substeps` (at least [`MIN_SUBSTEPS_CAP`], within [`SUBSTEP_BUDGET`]) with
+    /// the change held to half the noise (a stated error above the noise is not accepted
+    /// while more sub-steps can bring it down).
     pub(super) fn converge_model(
         &self,
         sys_c: &System,
@@ -206,7 +212,10 @@ impl<'a> Setup<'a> {
         }
         // The error is twice the last change: a change of half the noise level at most.
         let tol = self.tol.min(0.5 * self.noise_w);
-        let cap = (BEYOND_MAX_SUBSTEPS * self.max_sub).max(MIN_SUBSTEPS_CAP);
+        let cap = (BEYOND_MAX_SUBSTEPS * self.max_sub).max(MIN_SUBSTEPS_CAP).min(SUBSTEP_BUDGET / self.n_samp.max(1));
+        if cap <= chk.substeps {
+            return chk;
+        }
         let mut more = discretisation::converge(&sim, chk.substeps, cap, &self.weights, tol);
         let mut ladder = chk.ladder;
         ladder.extend(more.ladder.into_iter().skip(1));
