@@ -25,12 +25,19 @@ pub struct CaseResult {
     pub correct: bool,
     /// The truth is the selected effect or one reported as tied with it.
     pub correct_or_tied: bool,
-    /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right.
+    /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right
+    /// (an input delay: its reading under the generator's hold convention, which the report
+    /// states beside the one of the hold used).
     pub param_error: Option<f64>,
     /// The same for every parameter of a friction-library effect ([`all_params`]).
     pub param_errors: Vec<(String, f64)>,
     pub true_param: Option<f64>,
+    /// The reported estimate (an input delay: under the hold the diagnosis used).
     pub est_param: Option<f64>,
+    /// An input delay's reading under the other hold (report's `other_hold`).
+    pub est_param_other_hold: Option<f64>,
+    /// The hold the diagnosis used (`zoh` or `foh`).
+    pub hold_used: String,
     /// Reported 1-sigma uncertainty of the estimate: the statistical part (Gauss-Newton or
     /// coloured-residual sandwich, the larger) combined with the fold jackknife's model-error
     /// spread (see [`crate::fit::jackknife`]).
@@ -114,6 +121,8 @@ pub fn run_case_with(
         param_errors: vec![],
         true_param: case.truth.as_ref().map(main_param),
         est_param: None,
+        est_param_other_hold: None,
+        hold_used: String::new(),
         est_std: None,
         est_std_statistical: None,
         est_std_jackknife: None,
@@ -128,6 +137,7 @@ pub fn run_case_with(
             let fitted = rep.fitted_model.as_ref().map(|m| m.effects.list.clone()).unwrap_or_default();
             out.predicted = rep.effects.first().map(|e| e.kind.clone()).unwrap_or_else(|| "none".into());
             out.selected = rep.selected();
+            out.hold_used = rep.hold.chosen.to_string();
             out.ties = rep.ties.clone();
             out.correct = out.predicted == class;
             out.correct_or_tied = out.correct || rep.ties.iter().any(|t| t.split('(').next() == Some(class));
@@ -147,22 +157,25 @@ pub fn run_case_with(
                 if let (Some(t), Some(e)) =
                     (case.truth.as_ref(), case.truth.as_ref().and_then(|t| fitted.iter().find(|e| same(t, e))))
                 {
-                    let (tv, mut ev) = (main_param(t), main_param(e));
-                    // A delay is scored in the generator's hold convention (the report gives it
-                    // under both holds: the recording cannot tell them apart when it has a delay).
-                    let truth_hold = if case.conditions.hold == "zoh" { "zoh" } else { "foh" };
-                    if let Some(v) = rep
+                    // An input delay: the report states it under the hold used and, with
+                    // `other_hold`, under the other. The parameter error compares like with
+                    // like (the reading under the generator's convention: `foh` for the
+                    // continuous signal, `zoh` for held samples); the coverage (`est_param`
+                    // against `est_std`) scores the reported reading whatever hold the tool
+                    // used (the hold is never passed to it: where the data cannot tell the
+                    // holds apart, the delay's interval must cover both readings).
+                    let (tv, ev) = (main_param(t), main_param(e));
+                    let other = rep
                         .effects
                         .iter()
                         .find(|f| f.kind == names::INPUT_DELAY)
                         .and_then(|f| f.other_hold.as_ref())
-                        .filter(|o| matches!(t, Effect::InputDelay { .. }) && o.0 == truth_hold)
-                        .map(|o| o.1[0].1)
-                    {
-                        ev = v;
-                    }
+                        .filter(|_| matches!(t, Effect::InputDelay { .. }));
+                    let truth_hold = if case.conditions.hold == "zoh" { "zoh" } else { "foh" };
+                    let ev_convention = other.filter(|o| o.0 == truth_hold).map_or(ev, |o| o.1[0].1);
+                    out.est_param_other_hold = other.map(|o| o.1[0].1);
                     out.est_param = Some(ev);
-                    out.param_error = Some((ev - tv).abs() / tv.abs().max(1e-300));
+                    out.param_error = Some((ev_convention - tv).abs() / tv.abs().max(1e-300));
                     if let Some(truth_params) = physics::every_parameter(t) {
                         out.param_errors = truth_params
                             .iter()

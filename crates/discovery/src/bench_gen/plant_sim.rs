@@ -85,9 +85,25 @@ pub fn simulate(
         if k + 1 == ns {
             break;
         }
-        for jf in 0..FINE {
-            let t = k as f64 * dt + jf as f64 * h;
-            deriv(&x, input(t), z, &mut k1);
+        // The fine grid of this sample interval, with the delayed held input's switching
+        // instant added where it falls between grid points (the midpoint rule then sees a
+        // constant input on every piece: the delay is integrated exactly, not rounded to h).
+        let t_k = k as f64 * dt;
+        let mut pieces: Vec<(f64, f64)> = (0..FINE).map(|jf| (t_k + jf as f64 * h, h)).collect();
+        let split = zoh && delay > 0.0;
+        if split {
+            let off = (delay / dt).fract() * dt;
+            let j = ((off / h).floor() as usize).min(FINE - 1);
+            let a = off - j as f64 * h;
+            if a > 1e-9 * h && a < h * (1.0 - 1e-9) {
+                let t = pieces[j].0;
+                pieces.splice(j..=j, [(t, a), (t + a, h - a)]);
+            }
+        }
+        for (t, h) in pieces {
+            // Held and delayed: the input is constant on each piece (its midpoint's value).
+            let u1 = if split { input(t + 0.5 * h) } else { input(t) };
+            deriv(&x, u1, z, &mut k1);
             for i in 0..n {
                 xm[i] = x[i] + 0.5 * h * k1[i];
             }

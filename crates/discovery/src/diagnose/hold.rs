@@ -7,13 +7,19 @@
 //!
 //! Second look ([`overturned_by_effects`], `auto` only, once): the nominal's preference can be
 //! an artefact of the missing effect, so the best few single effects are refitted under the
-//! other hold; where one beats the best effect of this hold by the tie margin (by any margin
-//! for an input delay, with which the hold is confounded), the hold is switched and the
-//! diagnosis is redone.
+//! other hold; where one beats the best effect of this hold by the tie margin (an input
+//! delay too), the hold is switched and the diagnosis is redone.
+//!
+//! Delay under an unknown hold ([`delay_under_both_holds`], `auto` only): a selected input
+//! delay is refitted under the other hold; where the two fits differ by less than the tie
+//! margin the recording cannot tell "zero-order hold + tau" from "first-order hold + tau +
+//! h/2", and the delay's 1-sigma is widened by half the distance between the two readings (so
+//! that its 2-sigma interval reaches the other reading and that reading's own 1-sigma).
 use super::report::HoldReport;
 use super::settings::HoldChoice;
 use super::setup::Setup;
 use crate::discretisation::SubstepCheck;
+use crate::fit::input_effects::InputOp;
 use crate::fit::{self, FitResult};
 use crate::hypothesis::Kind;
 use crate::select::{self, candidate, FitContext, Ranked};
@@ -39,6 +45,9 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                 decisive: false,
                 effect_delta_bic: None,
                 switched: false,
+                delay_delta_bic: None,
+                delay_other_hold: vec![],
+                delay_ambiguous: false,
             },
         ),
         HoldChoice::Auto => {
@@ -58,6 +67,9 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                     decisive: d >= s.select.tie_bic,
                     effect_delta_bic: None,
                     switched: false,
+                    delay_delta_bic: None,
+                    delay_other_hold: vec![],
+                    delay_ambiguous: false,
                 },
             )
         }
@@ -103,14 +115,12 @@ pub(super) fn overturned_by_effects(
         if i == 0 {
             report.effect_delta_bic = Some(d);
         }
-        // With an input delay, hold and delay are confounded (a zero-order hold acts like
-        // a first-order hold delayed by h/2): the nominal's preference says nothing and
-        // the effect's comparison decides, by any margin.
-        let has_delay = c.parts.iter().any(|h| {
-            matches!(h.kind, Kind::InputDelay | Kind::InputOn { op: crate::fit::input_effects::InputOp::Delay, .. })
-        });
-        let threshold = if has_delay { 0.0 } else { s.select.tie_bic };
-        if d > threshold {
+        // The tie margin for every effect, an input delay included: with a delay, hold and
+        // delay are confounded (a zero-order hold acts like a first-order hold delayed by
+        // h/2) and the two fits differ by a fraction of a BIC unit; switching on that would
+        // override the nominal's preference on noise (issue 27 item 1). Where the delay
+        // cannot tell the holds apart, [`delay_under_both_holds`] widens its interval.
+        if d > s.select.tie_bic {
             let note = format!(
                 "Input hold: the nominal model preferred {} (by {:.1} in BIC), but {} fitted with {} beats the best effect with {} by {d:.1} in BIC: the missing effect had biased the nominal's choice; the diagnosis was redone with {}.",
                 hold.name(),
@@ -148,4 +158,78 @@ pub(super) fn note(report: &HoldReport, hold: InputHold, tie_bic: f64) -> Option
         )),
         _ => Some(format!("Input hold: {} (as requested).", hold.name())),
     }
+}
+
+/// Offsets of the delay parameters of `c` (a delay of the input as a whole or of one input).
+fn delay_offsets(c: &Ranked) -> Vec<usize> {
+    let mut off = 0;
+    let mut at = Vec::new();
+    for h in &c.parts {
+        if matches!(h.kind, Kind::InputDelay | Kind::InputOn { op: InputOp::Delay, .. }) {
+            at.push(off);
+        }
+        off += h.k();
+    }
+    at
+}
+
+/// Auto hold and a selected input delay: the selected model refitted under the other hold
+/// (its delays started shifted by -+h/2). Records `BIC(other) - BIC(this)` in
+/// `report.delay_delta_bic` and the other reading of each delay in `report.delay_other_hold`;
+/// where the difference is within the tie margin (`report.delay_ambiguous`) the delays'
+/// 1-sigma in `chosen.std` grows by half the distance between the readings, and the note
+/// that says so is returned. Call after the uncertainty is combined (it widens the final
+/// sigma).
+pub(super) fn delay_under_both_holds(
+    data: &Setup,
+    ctx: &FitContext,
+    hold: InputHold,
+    chosen: Option<&mut Ranked>,
+    report: &mut HoldReport,
+) -> Option<String> {
+    let s = data.s;
+    let c = chosen?;
+    if s.input_hold != HoldChoice::Auto {
+        return None;
+    }
+    let at = delay_offsets(c);
+    if at.is_empty() {
+        return None;
+    }
+    let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
+    let shift = if hold == InputHold::Zoh { 0.5 * data.dt } else { -0.5 * data.dt };
+    let ctx_o = data.context(other, ctx.substeps, ctx.x_scale.clone());
+    let mut start = c.params.clone();
+    for &i in &at {
+        start[i] = (start[i] + shift).max(0.0);
+    }
+    let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&start), &s.fit);
+    let d = select::bic(r_o.sse, data.n_res, 0) - select::bic(c.sse_estimation, data.n_res, 0);
+    report.delay_delta_bic = Some(d);
+    report.delay_other_hold = at.iter().map(|&i| r_o.theta.get(i).copied().unwrap_or(f64::NAN)).collect();
+    if !(d.is_finite() && d.abs() < s.select.tie_bic) {
+        return None;
+    }
+    report.delay_ambiguous = true;
+    let mut widened = Vec::new();
+    for (j, &i) in at.iter().enumerate() {
+        let gap = (report.delay_other_hold[j] - c.params[i]).abs();
+        if gap.is_finite() {
+            c.std[i] += 0.5 * gap;
+            widened.push(format!(
+                "{:.4e} s (this hold) and {:.4e} s ({})",
+                c.params[i],
+                report.delay_other_hold[j],
+                other.name()
+            ));
+        }
+    }
+    Some(format!(
+        "Input hold and delay: the delay model fits the {} and the {} hold alike ({:+.1} in BIC, within the tie margin {}): the recording cannot tell which hold the plant saw, and the delay reads {}. Its reported 1-sigma is widened by half the distance between the readings, so that +-2 sigma covers both; use --input-hold if the hold is known.",
+        hold.name(),
+        other.name(),
+        d,
+        s.select.tie_bic,
+        widened.join("; ")
+    ))
 }

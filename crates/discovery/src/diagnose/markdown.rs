@@ -1,7 +1,6 @@
 //! `report.md`: the report rendered for reading ([`Report::to_markdown`]), one function per
 //! section, and the number formats shared with the verdict.
 use super::report::Report;
-use super::settings::HoldChoice;
 use crate::localise;
 use crate::metrics;
 use crate::select::NOMINAL_REFIT;
@@ -39,10 +38,7 @@ impl Report {
         s += &format!(
             "Input hold: **{}**{}. Sub-steps by convergence: {} (changes k -> 2k: {}; tolerance {:.2e}, i.e. {} of the noise level; remaining discretisation error {:.2e}{}, worth at most {:.1} in BIC, added to the selection margin). Noise level (difference estimator): {}. Initial state: {}{}.\n\n",
             self.hold.chosen,
-            match (self.hold.requested, self.hold.delta_bic) {
-                (HoldChoice::Auto, Some(d)) => format!(" (auto: the nominal model fits better by {d:.1} in BIC than with the other hold{})", if self.hold.decisive { "" } else { "; below the tie margin, not decisive" }),
-                _ => " (as requested)".into(),
-            },
+            self.hold.header(),
             self.substeps,
             self.discretisation.ladder.iter().map(|(k, c)| format!("{k}: {c:.2e}")).collect::<Vec<_>>().join(", "),
             self.discretisation.tolerance,

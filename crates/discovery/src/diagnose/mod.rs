@@ -21,8 +21,9 @@
 //!    cross-validation ([`crate::select`]); the pass is redone where the best effects overturn
 //!    an `auto` hold or the selected model needs more sub-steps.
 //! 4. Conclusion (here): recorded columns the model leaves out, the initial state.
-//! 5. `refit`: the selected model's uncertainty (jackknife) and the fitted model
-//!    (`fitted.toml`).
+//! 5. `refit`: the selected model's uncertainty (jackknife), an input delay's reading under
+//!    the other hold (`hold`: its interval covers both where the data cannot tell the holds
+//!    apart), and the fitted model (`fitted.toml`).
 //! 6. Report: `verdict` (headline and text), `notes`, [`report`] (the types of
 //!    `report.json`) and `markdown` (`report.md`, [`Report::to_markdown`]).
 pub mod report;
@@ -67,8 +68,23 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
     notes::selection(&data, &pass, nominal.delta_bic_disc, &outcome.cv_rejected, &mut notes);
     // Refit: the selected model's uncertainty and the fitted model.
     let unc = refit::uncertainty(&data, &pass.ctx, outcome.chosen.as_mut());
+    // An input delay under an `auto` hold: its reading under the other hold, and its
+    // interval widened to cover both where the recording cannot tell the holds apart.
+    if let Some(note) =
+        hold::delay_under_both_holds(&data, &pass.ctx, pass.hold, outcome.chosen.as_mut(), &mut pass.hold_report)
+    {
+        notes.push(note);
+    }
     let chosen = outcome.chosen.as_ref();
-    let fitted = refit::fitted(&data, &pass.ctx, pass.hold, &pass.nom, &nominal.nom_sim, chosen, &unc, &mut notes);
+    let mut fitted = refit::fitted(&data, &pass.ctx, pass.hold, &pass.nom, &nominal.nom_sim, chosen, &unc, &mut notes);
+    // The delay under the other hold as refitted (not the h/2 shift alone), where it was.
+    if let Some(&v) = pass.hold_report.delay_other_hold.first() {
+        for e in fitted.effects.iter_mut() {
+            if let Some(o) = e.other_hold.as_mut().filter(|_| v.is_finite()) {
+                o.1[0].1 = v;
+            }
+        }
+    }
     // Report: headline, verdict, notes.
     let headline = verdict::headline(&data, &outcome.fit_before, &fitted.fit_after, &mut notes);
     let verdict = verdict::verdict(

@@ -131,9 +131,10 @@ fn input_delay_note(data: &Setup, hold: InputHold, hold_report: &HoldReport, fit
         hold.name(),
         if hold == InputHold::Zoh { "foh" } else { "zoh" },
         fitted.effects.iter().filter_map(|e| e.other_hold.as_ref()).map(|o| format!("{:.4e} s", o.1[0].1)).collect::<Vec<_>>().join(", "),
-        match hold_report.effect_delta_bic {
-            Some(d) if d.abs() < data.s.select.tie_bic => format!(" The delay model fits both holds alike ({:.1} in BIC): the recording cannot tell which; use --input-hold if the hold is known.", d.abs()),
-            _ => String::new(),
+        match hold_report.delay_delta_bic {
+            Some(_) if hold_report.delay_ambiguous => " The recording cannot tell the holds apart with this delay: its sigma covers both readings (see the note on the input hold and delay).".to_string(),
+            Some(d) => format!(" The delay model fits the {} hold better by {:.1} in BIC.", if d > 0.0 { hold.name() } else if hold == InputHold::Zoh { "foh" } else { "zoh" }, d.abs()),
+            None => String::new(),
         }
     )
 }

@@ -29,11 +29,46 @@ pub struct HoldReport {
     /// `auto` only: `BIC(best single effect, chosen hold) - BIC(same effect refitted with
     /// the other hold)` (negative: the effect confirms the hold). The nominal's preference can
     /// be an artefact of the missing effect; where the best effect prefers the other hold by
-    /// the tie margin (by any margin when it is an input delay, with which the hold is
+    /// the tie margin (an input delay too: with it the hold is
     /// confounded), the hold is switched and the diagnosis redone.
     pub effect_delta_bic: Option<f64>,
     /// Whether the hold was switched by that check.
     pub switched: bool,
+    /// `auto` with a selected input delay: `BIC(selected model refitted under the other
+    /// hold) - BIC(selected model)`.
+    pub delay_delta_bic: Option<f64>,
+    /// The selected delays as refitted under the other hold (empty without).
+    pub delay_other_hold: Vec<f64>,
+    /// Whether the delay model fits both holds within the tie margin: the recording cannot
+    /// tell them apart, and each delay's sigma covers both readings.
+    pub delay_ambiguous: bool,
+}
+
+impl HoldReport {
+    /// How the hold actually used was reached, for the report's header (after `Input hold:
+    /// **zoh**`): requested, the nominal's preference, or switched by the effects; and whether
+    /// a selected delay can tell the holds apart.
+    pub fn header(&self) -> String {
+        let other = if self.chosen == "zoh" { "foh" } else { "zoh" };
+        let how = match (self.requested, self.delta_bic) {
+            (HoldChoice::Auto, Some(d)) if self.switched => format!(
+                " (auto: the nominal model preferred {other} by {d:.1} in BIC, but the best effect fits better with {} by {:.1}: switched to it)",
+                self.chosen,
+                self.effect_delta_bic.unwrap_or(f64::NAN)
+            ),
+            (HoldChoice::Auto, Some(d)) => format!(
+                " (auto: the nominal model fits better by {d:.1} in BIC than with {other}{})",
+                if self.decisive { "" } else { "; below the tie margin, not decisive" }
+            ),
+            _ => " (as requested)".into(),
+        };
+        match self.delay_delta_bic {
+            Some(d) if self.delay_ambiguous => format!(
+                "{how}; with the selected input delay the two holds fit alike ({d:+.1} in BIC): the hold is not known from the data, and the delay's sigma covers its reading under either"
+            ),
+            _ => how,
+        }
+    }
 }
 
 /// The initial state used.

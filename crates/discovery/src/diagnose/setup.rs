@@ -13,6 +13,19 @@ use dynamics::extended::{ExtendedModel, InputHold, StepMaps};
 use model::effects::Effect;
 use model::System;
 
+/// How far beyond `max_substeps` the sub-steps may go where the remaining stepping error at
+/// `max_substeps` is still above the noise level (issue 27 item 3): this many times
+/// `max_substeps`, and at least [`MIN_SUBSTEPS_CAP`].
+pub(super) const BEYOND_MAX_SUBSTEPS: usize = 16;
+/// See [`BEYOND_MAX_SUBSTEPS`] (a play's catching-up projection, first order in the step, can
+/// need a few hundred sub-steps to bring its error under a low noise level).
+pub(super) const MIN_SUBSTEPS_CAP: usize = 256;
+/// Samples times sub-steps that the extension past `max_substeps` may reach (the cost of 64
+/// sub-steps on a 3000-sample record): on a long or noiseless record the stepping error stays
+/// above the noise, stated as not converged, and the selection margin grows by what it can
+/// buy.
+pub(super) const SUBSTEP_BUDGET: usize = 200_000;
+
 /// The model, the recording and the settings, with everything derived from them once.
 pub(super) struct Setup<'a> {
     pub sys: &'a System,
@@ -45,6 +58,9 @@ pub(super) struct Setup<'a> {
     pub weights: Vec<f64>,
     pub noise: Vec<f64>,
     pub tol: f64,
+    /// The weighted noise level (RMS over the outputs of noise times weight): a remaining
+    /// stepping error above it is never accepted ([`Setup::converge_nominal`]).
+    pub noise_w: f64,
     /// Initial state: fixed at the model file's, or estimated from `x0_init`.
     pub x0_fixed: bool,
     pub x0_init: Vec<f64>,
@@ -77,7 +93,8 @@ impl<'a> Setup<'a> {
         let max_sub = s.max_substeps.max(1);
         let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
         let k0 = if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, max_sub) } else { 1 };
-        let scales = signal_scales(&w, &y, m, p, tau_slow, dt, rec.duration());
+        let mut scales = signal_scales(&w, &y, m, p, tau_slow, dt, rec.duration());
+        scales.w_absmax_est = w[..(k_est * m).min(w.len())].iter().map(|v| v.abs()).fold(0.0, f64::max);
         let weights = output_weights(&y, n_samp, p);
         let noise = discretisation::noise_level(&y, p);
         let noise_w = ((0..p).map(|i| (noise[i] * weights[i]).powi(2)).sum::<f64>() / p as f64).sqrt().max(1e-6);
@@ -123,6 +140,7 @@ impl<'a> Setup<'a> {
             weights,
             noise,
             tol,
+            noise_w,
             x0_fixed,
             x0_init,
             z0,
@@ -164,17 +182,16 @@ impl<'a> Setup<'a> {
 
     /// Sub-step convergence of the nominal model under `hold`, doubling from `k_from`.
     pub(super) fn converge_nominal(&self, hold: InputHold, k_from: usize) -> SubstepCheck {
-        let (sys, dt) = (self.sys, self.dt);
-        let sim = |k: usize| -> Option<Vec<f64>> {
-            let ext = ExtendedModel::new(sys, &[], dt, k).ok()?.with_hold(hold);
-            let o = ext.simulate_from(&self.w, dt, &self.x0_init, self.z0.as_deref());
-            o.finite.then_some(o.y)
-        };
-        discretisation::converge(sim, k_from, self.max_sub, &self.weights, self.tol)
+        self.converge_model(self.sys, &[], &self.x0_init, hold, k_from)
     }
 
     /// Sub-step convergence of a fitted model (`sys_c` with `effects`, from `x0`) under
-    /// `hold`, doubling from `k_from`.
+    /// `hold`, doubling from `k_from` up to `max_substeps` until the change is within the
+    /// tolerance; where that leaves a remaining stepping error above the noise level (a cap
+    /// reached, or a tolerance set above half the noise), on up to [`BEYOND_MAX_SUBSTEPS`]
+    /// times `max_substeps` (at least [`MIN_SUBSTEPS_CAP`], within [`SUBSTEP_BUDGET`]) with
+    /// the change held to half the noise (a stated error above the noise is not accepted
+    /// while more sub-steps can bring it down).
     pub(super) fn converge_model(
         &self,
         sys_c: &System,
@@ -189,7 +206,21 @@ impl<'a> Setup<'a> {
             let o = ext.simulate_from(&self.w, dt, x0, self.z0.as_deref());
             o.finite.then_some(o.y)
         };
-        discretisation::converge(sim, k_from, self.max_sub, &self.weights, self.tol)
+        let chk = discretisation::converge(&sim, k_from, self.max_sub, &self.weights, self.tol);
+        if chk.error_rms <= self.noise_w {
+            return chk;
+        }
+        // The error is twice the last change: a change of half the noise level at most.
+        let tol = self.tol.min(0.5 * self.noise_w);
+        let cap = (BEYOND_MAX_SUBSTEPS * self.max_sub).max(MIN_SUBSTEPS_CAP).min(SUBSTEP_BUDGET / self.n_samp.max(1));
+        if cap <= chk.substeps {
+            return chk;
+        }
+        let mut more = discretisation::converge(&sim, chk.substeps, cap, &self.weights, tol);
+        let mut ladder = chk.ladder;
+        ladder.extend(more.ladder.into_iter().skip(1));
+        more.ladder = ladder;
+        more
     }
 
     /// Residual tests of a residual `e` (time-major) against the inputs `w`.

@@ -5,7 +5,8 @@
 //!
 //! Bounds: a delay in `[0, min(tau_slow, T/20)]` (at least 5 samples, [`delay_bound`]), a
 //! saturation limit in `[0.2, 1] max|w|` (1 = no clipping) started down to 0.1 % below
-//! `max |w|` ([`SATURATION_STARTS`]); per input `j`, a play of width `[0, range(w_j)/2]`, a
+//! the estimation segment's `max |w|` ([`SATURATION_STARTS`]: a start above it clips nothing
+//! where the fit runs); per input `j`, a play of width `[0, range(w_j)/2]`, a
 //! limit in `[0.2, 1] max |w_j|` and a delay in the bound of the global delay, with the
 //! global hypotheses' starts. A model file's effects act on every input alike, so an effect
 //! on one input is applied to the recorded input by [`crate::fit::input_effects`].
@@ -79,10 +80,13 @@ pub fn delay_bound(s: &Scales) -> f64 {
     s.tau_slow.min(s.duration / 20.0).max(5.0 * s.dt)
 }
 
-/// A saturation limit in `[0.2, 1] absmax`, started at [`SATURATION_STARTS`] of `absmax`.
-fn saturation_hypothesis(kind: Kind, absmax: f64) -> Hypothesis {
+/// A saturation limit in `[0.2, 1] absmax`, started at [`SATURATION_STARTS`] of `from`: the
+/// largest `|w|` where the fit runs (the estimation segment; a limit above it clips nothing
+/// there and the fit cannot move), within the bounds.
+fn saturation_hypothesis(kind: Kind, absmax: f64, from: f64) -> Hypothesis {
     let h = linear(kind, 0.2 * absmax, absmax, LIMIT);
-    let at: Vec<f64> = SATURATION_STARTS.iter().map(|f| f * absmax).collect();
+    let from = if from > 0.0 { from.min(absmax) } else { absmax };
+    let at: Vec<f64> = SATURATION_STARTS.iter().map(|f| (f * from).max(0.2 * absmax)).collect();
     h.starts_at(&at)
 }
 
@@ -95,13 +99,13 @@ impl Family for InputOps {
         match *site {
             Site::Input => vec![
                 level(Kind::InputDelay, delay_bound(s), DELAY),
-                saturation_hypothesis(Kind::InputSaturation, s.w_absmax),
+                saturation_hypothesis(Kind::InputSaturation, s.w_absmax, s.w_absmax_est),
             ],
             Site::OneInput { input, absmax, range } => {
                 let on = |op| Kind::InputOn { op, input };
                 vec![
                     level(on(InputOp::Play), 0.5 * range, WIDTH),
-                    saturation_hypothesis(on(InputOp::Saturation), absmax),
+                    saturation_hypothesis(on(InputOp::Saturation), absmax, 0.0),
                     level(on(InputOp::Delay), delay_bound(s), DELAY),
                 ]
             }

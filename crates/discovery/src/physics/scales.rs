@@ -8,6 +8,10 @@ pub struct Scales {
     pub y_range: Vec<f64>,
     pub w_range: Vec<f64>,
     pub w_absmax: f64,
+    /// `max |w|` over the estimation segment alone, where the fits run (0: unknown, take
+    /// `w_absmax`). A saturation limit started above it clips nothing there: a fit with zero
+    /// gradient, stuck where the effect cannot act (issue 27 item 3).
+    pub w_absmax_est: f64,
     /// Slowest time constant `1 / |mu|` of the nominal `F`.
     pub tau_slow: f64,
     pub dt: f64,

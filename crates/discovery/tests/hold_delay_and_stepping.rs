@@ -1,0 +1,220 @@
+//! Issue 27 items 1 and 3: a delay under an unknown input hold (its interval covers both
+//! readings where the recording cannot tell the holds apart; the report's header states the
+//! hold used) and a discretisation converged before judging (the generator's delayed held
+//! input integrated exactly; an effect whose gain is the simulator's stepping error is not
+//! reported; a stated stepping error above the noise is not accepted).
+use discovery::bench;
+use discovery::bench_gen::plant_sim;
+use discovery::bench_gen::{self, Profile};
+use discovery::bench_gen::{Plant, Signal};
+use discovery::diagnose::{HoldChoice, HoldReport};
+use discovery::{diagnose, DiagnoseSettings, InitialState};
+use dynamics::extended::{ExtendedModel, InputHold};
+use model::effects::Effect;
+use nalgebra::DMatrix;
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+/// A damped oscillator without play, as the generator and as a model file.
+fn oscillator() -> (Plant, model::System) {
+    let pl = Plant {
+        A: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -25.0, -3.0]),
+        B: DMatrix::from_row_slice(2, 1, &[0.0, 25.0]),
+        C: DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+        E: DMatrix::from_row_slice(2, 1, &[0.0, 0.0]),
+        half_width: 0.0,
+        vel: 1,
+        omega0: 5.0,
+        zeta: 0.3,
+    };
+    let text = "name = \"osc\"\n[plant]\nA = [[0.0, 1.0], [-25.0, -3.0]]\nB = [[0.0], [25.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+    (pl, model::parse_str(text).unwrap())
+}
+
+#[test]
+fn the_generator_integrates_a_delayed_held_input_exactly() {
+    // The benchmark's truth for a delay under a zero-order hold: the held input switches at
+    // k h + tau, between the generator's fine grid points. Reference: the exact ZOH
+    // discretisation with the delay split at the switching instant (dynamics::extended, exact
+    // to rounding, tests/hold_and_discretisation.rs).
+    let (pl, sys) = oscillator();
+    let sig = Signal::Multisine { a: vec![1.0, 0.4, 0.2], omega: vec![1.3, 4.1, 9.7], phi: vec![0.0, 1.0, 2.0] };
+    let dt = 0.01;
+    let ns = 1500;
+    let w: Vec<f64> = (0..ns).map(|k| sig.eval(k as f64 * dt)).collect();
+    let y_range = {
+        let y = ExtendedModel::new(&sys, &[], dt, 1).unwrap().with_hold(InputHold::Zoh).simulate(&w, dt, &[0.0, 0.0]).y;
+        y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min)
+    };
+    for frac in [0.013, 0.37, 0.61] {
+        let delay = (3.0 + frac) * dt;
+        let eff = Effect::InputDelay { delay };
+        let gen = plant_sim::simulate(&pl, 0.0, Some(&eff), &sig, &[0.0, 0.0], dt, ns, true);
+        let exact = ExtendedModel::new(&sys, &[eff.clone()], dt, 1)
+            .unwrap()
+            .with_hold(InputHold::Zoh)
+            .simulate(&w, dt, &[0.0, 0.0])
+            .y;
+        let d = max_abs_diff(&gen, &exact) / y_range;
+        // RK2 on a grid of h/20 with the switching instant on the grid: O((omega h/20)^2).
+        assert!(d < 2e-5, "delay {frac} h into the sample: generator off the exact response by {d:.2e} of the range");
+        // Negative control: the same delay off by a quarter of the generator's fine step
+        // (before, the switching instant was rounded to that grid: up to half a step off) is
+        // visibly another response.
+        let off = Effect::InputDelay { delay: delay + 0.25 * dt / 20.0 };
+        let yr =
+            ExtendedModel::new(&sys, &[off], dt, 1).unwrap().with_hold(InputHold::Zoh).simulate(&w, dt, &[0.0, 0.0]).y;
+        let dr = max_abs_diff(&yr, &exact) / y_range;
+        eprintln!("delay {frac}: generator {d:.2e}, shifted {dr:.2e}");
+        assert!(dr > 10.0 * d, "a delay off by h/80 went unnoticed: {dr:.2e} against {d:.2e}");
+    }
+}
+
+#[test]
+fn a_delay_under_an_unknown_hold_is_covered_by_its_interval() {
+    // Seed 2701 case 2 of the digital profile: a zero-order-held command sampled at 2.65 ms,
+    // an input delay of 2.48 ms, the hold not passed to the tool. Before: the hold was
+    // switched to foh on a BIC difference below the tie margin (the nominal preferred zoh),
+    // the delay read 3.79 ms +- 0.066 ms (20 sigma off, the h/2 of the other hold).
+    let s = DiagnoseSettings::default();
+    let case = bench_gen::generate_profile("input_delay", 2701, 2, Profile::Digital);
+    let r = bench::run_case_with("input_delay", 2701, 2, Profile::Digital, &s);
+    assert_eq!(r.predicted, "input_delay", "{r:?}");
+    let (e, t, sd) = (r.est_param.unwrap(), r.true_param.unwrap(), r.est_std.unwrap());
+    assert!(
+        (e - t).abs() <= 2.0 * sd,
+        "delay {e:.4e} +- {sd:.2e} against the truth {t:.4e}: {:.1} sigma",
+        (e - t).abs() / sd
+    );
+    // The report's header states the hold used, and whether the delay tells the holds apart.
+    let known = InitialState {
+        x0: case.nominal.x0.iter().copied().collect(),
+        z0: Some(case.nominal.z0.iter().copied().collect()),
+    };
+    let rep = diagnose(&case.nominal, &case.recording, &DiagnoseSettings { initial_state: Some(known), ..s }).unwrap();
+    let md = rep.to_markdown(&[]);
+    assert!(md.contains(&format!("Input hold: **{}**", rep.hold.chosen)), "{md}");
+    assert!(rep.hold.delay_delta_bic.is_some(), "{:?}", rep.hold);
+    if rep.hold.delay_ambiguous {
+        assert!(md.contains("the hold is not known from the data"), "{md}");
+        let other = rep.hold.delay_other_hold[0];
+        // The interval covers the other reading too.
+        assert!((other - e).abs() <= 2.0 * sd, "other reading {other:.4e} outside {e:.4e} +- 2 x {sd:.2e}");
+    }
+}
+
+#[test]
+fn the_header_states_the_hold_used_after_a_switch() {
+    let h = HoldReport {
+        requested: HoldChoice::Auto,
+        chosen: "foh",
+        sse_zoh: Some(1.0),
+        sse_foh: Some(2.0),
+        delta_bic: Some(1234.5),
+        decisive: true,
+        effect_delta_bic: Some(8.0),
+        switched: true,
+        delay_delta_bic: None,
+        delay_other_hold: vec![],
+        delay_ambiguous: false,
+    };
+    let text = h.header();
+    assert!(text.contains("preferred zoh by 1234.5") && text.contains("switched"), "{text}");
+    // Negative control: without the switch the nominal's preference is the reason given.
+    let kept = HoldReport { switched: false, chosen: "zoh", ..h };
+    assert!(!kept.header().contains("switched") && kept.header().contains("than with foh"), "{}", kept.header());
+}
+
+#[test]
+fn a_stepping_error_above_the_noise_is_not_accepted() {
+    // A wide play in the loop (the catching-up projection is first order in the step),
+    // recorded with noise at 0.1 % of the output's spread, and a cap of one sub-step per
+    // sample. Before: the cap stood, with a stated stepping error several times the noise.
+    let text = "name = \"play\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [4.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [-4.0]]\n[theta]\nshape = \"interval\"\nhalf_width = 0.3\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+    let sys = model::parse_str(text).unwrap();
+    let (dt, n) = (0.05, 600);
+    let w: Vec<f64> = (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.4 * (2.7 * k as f64 * dt).sin()).collect();
+    let clean = ExtendedModel::new(&sys, &[], dt, 256).unwrap().simulate(&w, dt, &[0.0, 0.0]).y;
+    let m = clean.iter().sum::<f64>() / n as f64;
+    let sd = (clean.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n as f64).sqrt();
+    let y: Vec<Vec<f64>> = clean
+        .iter()
+        .enumerate()
+        .map(|(k, v)| vec![v + 1e-3 * sd * 3f64.sqrt() * 2.0 * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)])
+        .collect();
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    let rec = discovery::Recording::from_samples("play", &t, w.iter().map(|v| vec![*v]).collect(), y, None);
+    let s = DiagnoseSettings {
+        initial_state: Some(InitialState { x0: vec![0.0, 0.0], z0: Some(vec![0.0]) }),
+        input_hold: HoldChoice::Fixed(InputHold::Foh),
+        max_substeps: 1,
+        ..Default::default()
+    };
+    let r = diagnose(&sys, &rec, &s).unwrap();
+    // The weighted noise level (the fit's units: output standard deviations).
+    let y_sd = {
+        let m = rec.y.iter().map(|v| v[0]).sum::<f64>() / n as f64;
+        (rec.y.iter().map(|v| (v[0] - m).powi(2)).sum::<f64>() / n as f64).sqrt()
+    };
+    let noise_w = r.noise_level[0] / y_sd;
+    let d = &r.discretisation;
+    assert!(d.ladder[0].1 > noise_w, "negative control: one sub-step is already within the noise: {d:?}");
+    assert!(
+        r.substeps > 1 && d.error_rms <= noise_w,
+        "stated stepping error {:.2e} above the noise {noise_w:.2e} accepted: {d:?}",
+        d.error_rms
+    );
+}
+
+#[test]
+fn a_saturation_fit_starts_where_the_effect_can_act() {
+    // Seed 2704 case 0 of the digital profile (a fresh seed of the measurement below): the
+    // command's largest values fall in the validation segment, so every start of the limit
+    // (fractions of the whole record's max |w|) clipped nothing in the estimation segment: zero
+    // gradient, the fit stuck, "nothing added" with the nominal at 78 % fit. The starts now
+    // derive from the estimation segment's max |w|.
+    let r = bench::run_case_with("input_saturation", 2704, 0, Profile::Digital, &DiagnoseSettings::default());
+    assert_eq!(r.predicted, "input_saturation", "{r:?}");
+    let (e, t, sd) = (r.est_param.unwrap(), r.true_param.unwrap(), r.est_std.unwrap());
+    assert!((e - t).abs() <= 2.0 * sd && (e - t).abs() <= 0.15 * t, "limit {e} +- {sd} against {t}");
+}
+
+/// The measurement behind BENCHMARKS.md's "diagnose: hold/delay and discretisation" section
+/// (not a check: it prints and writes what it finds). Environment: `BENCH_SEED` (default
+/// 2701), `BENCH_CASES` (per class, default 4), `BENCH_PROFILE` (`classic` or `digital`),
+/// `BENCH_CLASSES` (a class set of [`discovery::bench::class_set`], default `input_delay`),
+/// `BENCH_JSON` (where to write the cases as JSON). The hold is never passed to the tool.
+/// `BENCH_PROFILE=digital BENCH_CLASSES=classic cargo test --release -p discovery --test
+/// hold_delay_and_stepping -- --ignored --nocapture`.
+#[test]
+#[ignore = "minutes: the hold/delay and discretisation measurement"]
+fn hold_delay_and_stepping_benchmark() {
+    let env = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
+    let seed: u64 = env("BENCH_SEED", "2701").parse().unwrap();
+    let cases: usize = env("BENCH_CASES", "4").parse().unwrap();
+    let profile = discovery::bench_gen::Profile::parse(&env("BENCH_PROFILE", "digital")).unwrap();
+    let classes = discovery::bench::class_set(&env("BENCH_CLASSES", "input_delay")).unwrap();
+    let json = std::env::var("BENCH_JSON").ok();
+    let mut done: Vec<discovery::bench::CaseResult> = Vec::new();
+    let r = discovery::bench::run_classes(&classes, cases, seed, profile, &Default::default(), |c| {
+        eprintln!(
+            "{} {}: {} (truth {:?}, estimate {:?} +- {:?}, hold used {}, {})",
+            c.class,
+            c.index,
+            c.selected,
+            c.true_param,
+            c.est_param,
+            c.est_std,
+            c.hold_used,
+            c.conditions.short()
+        );
+        // Written after every case: a run cut short still leaves what it measured.
+        done.push(c.clone());
+        if let Some(p) = &json {
+            std::fs::write(p, serde_json::json!({ "cases": done }).to_string()).unwrap();
+        }
+    });
+    println!("{}", r.to_text());
+}
