@@ -417,14 +417,8 @@ fn diagnose<'py>(
             "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
         )));
     };
-    let o = DiagnoseOptions {
-        estimation_fraction,
-        max_effects,
-        input_hold,
-        estimate_x0,
-        metric,
-        refit_nominal: !no_refit,
-    };
+    let o =
+        DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, metric, refit_nominal: !no_refit };
     let run = move || -> anyhow::Result<discovery::Report> {
         let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;
@@ -539,8 +533,11 @@ fn figure(
     use moreau::cli::figure::{write, Args, Kind};
     fn word<T: ValueEnum>(what: &str, s: &str) -> PyResult<T> {
         T::from_str(s, true).map_err(|_| {
-            let known: Vec<String> =
-                T::value_variants().iter().filter_map(|v| v.to_possible_value()).map(|p| p.get_name().to_string()).collect();
+            let known: Vec<String> = T::value_variants()
+                .iter()
+                .filter_map(|v| v.to_possible_value())
+                .map(|p| p.get_name().to_string())
+                .collect();
             MoreauError::new_err(format!("invalid {what} {s:?} (possible values: {})", known.join(", ")))
         })
     }

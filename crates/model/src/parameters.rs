@@ -312,21 +312,31 @@ impl Parameters {
         Ok(x)
     }
 
-    /// The value of every binding with parameter `name` at `v` (the others unchanged), in the
-    /// order of [`Parameters::bindings`]; `self` is updated only when every expression
-    /// evaluates.
-    pub(crate) fn values_with(&mut self, name: &str, v: f64) -> Result<Vec<f64>, ModelError> {
-        let i = self
-            .names
-            .iter()
-            .position(|n| n == name)
-            .ok_or_else(|| ModelError::UnknownParameter { name: name.to_string(), known: self.names.join(", ") })?;
+    /// The value of every binding with the parameters `set` (name, value) changed and the
+    /// others unchanged, in the order of [`Parameters::bindings`]; `self` is updated only when
+    /// every expression evaluates.
+    pub(crate) fn values_with(&mut self, set: &[(&str, f64)]) -> Result<Vec<f64>, ModelError> {
         let mut values = self.values.clone();
-        values[i] = v;
+        for (name, v) in set {
+            let i = self
+                .names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| ModelError::UnknownParameter { name: name.to_string(), known: self.names.join(", ") })?;
+            values[i] = *v;
+        }
         let ctx = context(&self.names, &values);
         let out = self.bindings.iter().map(|b| self.evaluate_in(b, &ctx)).collect::<Result<Vec<_>, _>>()?;
         self.values = values;
         Ok(out)
+    }
+
+    /// Whether `name` can name a parameter: letters, digits and `_`, starting with a letter or
+    /// `_` (the sweep's `parameters.NAME` axes use the same rule).
+    pub fn is_name(name: &str) -> bool {
+        let mut chars = name.chars();
+        chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
     }
 
     /// The expression of `place`, if one gives it.
@@ -342,10 +352,7 @@ impl Parameters {
 }
 
 fn check_name(name: &str, key: &str) -> Result<(), ModelError> {
-    let mut chars = name.chars();
-    let ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if !ok {
+    if !Parameters::is_name(name) {
         return Err(ModelError::WrongType {
             key: key.into(),
             expected: "a parameter name of letters, digits and '_' starting with a letter",

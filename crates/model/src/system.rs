@@ -379,8 +379,14 @@ impl System {
     /// (an unknown name, an expression that does not evaluate, an effect key out of its range)
     /// the system is unchanged.
     pub fn set_parameter(&mut self, name: &str, v: f64) -> Result<(), ModelError> {
+        self.set_parameters(&[(name, v)])
+    }
+
+    /// [`System::set_parameter`] for several parameters at once (one evaluation of the
+    /// expressions).
+    pub fn set_parameters(&mut self, set: &[(&str, f64)]) -> Result<(), ModelError> {
         let mut params = self.parameters.clone();
-        let values = params.values_with(name, v)?;
+        let values = params.values_with(set)?;
         let mut next = self.clone();
         let mut effects: Vec<(usize, &str, Option<usize>, f64)> = Vec::new();
         for (b, x) in params.bindings.iter().zip(values) {

@@ -3,10 +3,26 @@
 //! headline is the RMSE in the output's units, `fitted.toml` records the refit and runs under
 //! `moreau simulate`; a bad `[fit]` name is a one-line error naming key and value.
 use discovery::bench_gen::servo_loop;
-use std::process::Command;
+use std::path::Path;
+use std::process::{Command, Output};
 
 fn moreau() -> Command {
     Command::new(env!("CARGO_BIN_EXE_moreau"))
+}
+
+/// `moreau diagnose [extra] --model MODEL --data DATA --out OUT`.
+fn diagnose(extra: &[&str], model: &Path, data: &Path, out: &Path) -> Output {
+    moreau()
+        .arg("diagnose")
+        .args(extra)
+        .arg("--model")
+        .arg(model)
+        .arg("--data")
+        .arg(data)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
 }
 
 #[test]
@@ -18,16 +34,7 @@ fn grey_box_refit_through_the_cli() {
     let data = dir.path().join("servo.csv");
     std::fs::write(&data, case.recording.to_csv_string()).unwrap();
     let out = dir.path().join("out");
-    let o = moreau()
-        .arg("diagnose")
-        .arg("--model")
-        .arg(&model)
-        .arg("--data")
-        .arg(&data)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = diagnose(&[], &model, &data, &out);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}\n{stdout}", String::from_utf8_lossy(&o.stderr));
     let first = stdout.lines().next().unwrap();
@@ -48,15 +55,7 @@ fn grey_box_refit_through_the_cli() {
 
     // --metric fit: the classic headline; --no-refit: the nominal stands.
     let out2 = dir.path().join("out2");
-    let o = moreau()
-        .args(["diagnose", "--metric", "fit", "--no-refit", "--model"])
-        .arg(&model)
-        .arg("--data")
-        .arg(&data)
-        .arg("--out")
-        .arg(&out2)
-        .output()
-        .unwrap();
+    let o = diagnose(&["--metric", "fit", "--no-refit"], &model, &data, &out2);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!stdout.contains("plant's parameters were off") && stdout.contains("validation fit %"), "{stdout}");
@@ -72,16 +71,7 @@ fn a_bad_fit_table_is_a_one_line_error() {
     let data = dir.path().join("servo.csv");
     std::fs::write(&data, case.recording.to_csv_string()).unwrap();
     let out = dir.path().join("out");
-    let o = moreau()
-        .arg("diagnose")
-        .arg("--model")
-        .arg(&model)
-        .arg("--data")
-        .arg(&data)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = diagnose(&[], &model, &data, &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -112,16 +102,7 @@ fn physical_parameters_are_refitted_as_such() {
     let data = dir.path().join("servo.csv");
     std::fs::write(&data, case.recording.to_csv_string()).unwrap();
     let out = dir.path().join("out");
-    let o = moreau()
-        .arg("diagnose")
-        .arg("--model")
-        .arg(&model)
-        .arg("--data")
-        .arg(&data)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = diagnose(&[], &model, &data, &out);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}\n{stdout}", String::from_utf8_lossy(&o.stderr));
     assert!(stdout.lines().next().unwrap().starts_with("the plant's parameters were off"), "{stdout}");

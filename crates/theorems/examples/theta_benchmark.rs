@@ -57,6 +57,65 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// One drawn system assembled with its measured side: a row if it converges (measured 95 %
+/// interval below 0); with `square`, under the square wave of its sine's amplitudes, period
+/// and phase.
+fn measure_system(
+    c: &theorems::strategies::systems::SystemParams,
+    settings: &ThetaSettings,
+    square: bool,
+) -> Option<Row> {
+    let mut sys = c.build();
+    if square {
+        if let model::Input::Sine { amplitudes, omega, phase } = &sys.input {
+            sys.input = model::Input::Square { amplitudes: amplitudes.clone(), omega: *omega, phase: *phase };
+        }
+    }
+    let rep = assemble(&sys, settings).ok()?;
+    let m = rep.measured.clone()?;
+    if m.ci_high >= 0.0 {
+        return None;
+    }
+    // the ceiling's own lambda search (each point: the smallest certified beta at that
+    // lambda, so the minimum over lambda of eq. (theta) with exact inputs)
+    let ceiling = (rep.theta_verified && rep.theta < 0.0 && m.limsup_zdot > 0.0)
+        .then(|| {
+            let (g1, ginf) = (m.path_length_per_period / (rep.period * rep.R), m.limsup_zdot / rep.R);
+            let psi = |l: f64, b: f64| bounds::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf);
+            let own = lmi::optimise_lambda(&sys.F(), &sys.E, &sys.C, psi, &settings.lambda).ok()?;
+            own.curve
+                .iter()
+                .filter_map(|c| c.value.as_ref().ok().map(|v| psi(v.lambda, v.beta)))
+                .chain(rep.curve.iter().map(|&(l, b, _)| psi(l, b)))
+                .filter(|t| t.is_finite())
+                .min_by(f64::total_cmp)
+        })
+        .flatten();
+    Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling })
+}
+
+/// Every row of table A (`THETA_BENCHMARK_ROWS`).
+fn print_rows(rows: &[&Row]) {
+    println!("| # | n | p | Theta | measured | theta | theta* | theta_profile | theta_engaged | best |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for (i, r) in rows.iter().enumerate() {
+        let f = |v: f64, ok: bool| if ok && v < 0.0 { format!("{v:.4}") } else { format!("({v:.3})") };
+        println!(
+            "| {i} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |",
+            r.n,
+            r.p,
+            kind(r),
+            r.rate,
+            f(r.rep.theta, r.rep.theta_verified),
+            f(r.rep.theta_star, r.rep.theta_star_verified),
+            f(r.rep.theta_profile, r.rep.theta_profile_verified),
+            f(r.rep.theta_engaged, r.rep.theta_engaged_verified),
+            r.rep.theta_best_method
+        );
+    }
+    println!();
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
@@ -77,40 +136,8 @@ fn main() {
             break;
         }
         drawn += chunk.len();
-        let got: Vec<Row> = chunk
-            .par_iter()
-            .filter(|c| c.n >= 2)
-            .filter_map(|c| {
-                let mut sys = c.build();
-                if square {
-                    if let model::Input::Sine { amplitudes, omega, phase } = &sys.input {
-                        sys.input = model::Input::Square { amplitudes: amplitudes.clone(), omega: *omega, phase: *phase };
-                    }
-                }
-                let rep = assemble(&sys, &settings).ok()?;
-                let m = rep.measured.clone()?;
-                if m.ci_high >= 0.0 {
-                    return None;
-                }
-                // the ceiling's own lambda search (each point: the smallest certified beta at that
-                // lambda, so the minimum over lambda of eq. (theta) with exact inputs)
-                let ceiling = (rep.theta_verified && rep.theta < 0.0 && m.limsup_zdot > 0.0)
-                    .then(|| {
-                        let (g1, ginf) = (m.path_length_per_period / (rep.period * rep.R), m.limsup_zdot / rep.R);
-                        let psi =
-                            |l: f64, b: f64| bounds::Psi { alpha: rep.alpha.lower, lambda: l, beta: b }.theta(g1, ginf);
-                        let own = lmi::optimise_lambda(&sys.F(), &sys.E, &sys.C, psi, &settings.lambda).ok()?;
-                        own.curve
-                            .iter()
-                            .filter_map(|c| c.value.as_ref().ok().map(|v| psi(v.lambda, v.beta)))
-                            .chain(rep.curve.iter().map(|&(l, b, _)| psi(l, b)))
-                            .filter(|t| t.is_finite())
-                            .min_by(f64::total_cmp)
-                    })
-                    .flatten();
-                Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling })
-            })
-            .collect();
+        let got: Vec<Row> =
+            chunk.par_iter().filter(|c| c.n >= 2).filter_map(|c| measure_system(c, &settings, square)).collect();
         paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
         rows.extend(got);
     }
@@ -119,24 +146,7 @@ fn main() {
     let table_a: Vec<&Row> = rows.iter().collect();
     let table_b: Vec<&Row> = rows.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).collect();
     if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
-        println!("| # | n | p | Theta | measured | theta | theta* | theta_profile | theta_engaged | best |");
-        println!("|---|---|---|---|---|---|---|---|---|---|");
-        for (i, r) in table_a.iter().enumerate() {
-            let f = |v: f64, ok: bool| if ok && v < 0.0 { format!("{v:.4}") } else { format!("({v:.3})") };
-            println!(
-                "| {i} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} |",
-                r.n,
-                r.p,
-                kind(r),
-                r.rate,
-                f(r.rep.theta, r.rep.theta_verified),
-                f(r.rep.theta_star, r.rep.theta_star_verified),
-                f(r.rep.theta_profile, r.rep.theta_profile_verified),
-                f(r.rep.theta_engaged, r.rep.theta_engaged_verified),
-                r.rep.theta_best_method
-            );
-        }
-        println!();
+        print_rows(&table_a);
     }
     type Get = fn(&ThetaReport) -> (f64, bool);
     let bounds: [(&str, Get); 5] = [

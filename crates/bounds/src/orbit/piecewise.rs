@@ -160,21 +160,19 @@ pub(super) fn orbit(sys: &System, T: f64, K: usize) -> Option<EtaOrbit> {
         deta.push(d);
         sample_piece.push(j);
     }
-    // eta_T' jumps where w jumps (a square wave's edges, a CSV input's wrap)
+    // eta_T' jumps where w jumps (a square wave's edges, a CSV input's wrap): each edge at
+    // `t_e = t0 mod T` lies in the sample interval `(t_k, t_{k+1}]`, `k = ceil(t_e / h) - 1`
     let mut jumps = Vec::new();
-    for k in 0..K {
-        let (a, b) = (start + (t[k] - start).rem_euclid(T), start + (t[k] - start).rem_euclid(T) + h);
-        for (j, p) in pieces.iter().enumerate() {
-            for edge in [p.t0, p.t0 + T] {
-                let prev = (j + pieces.len() - 1) % pieces.len();
-                let w_before = &pieces[prev].u + &pieces[prev].r * pieces[prev].len;
-                if edge > a && edge <= b && w_before != pieces[j].u {
-                    let (_, before, _) = eval(prev, pieces[prev].len);
-                    let (_, after, _) = eval(j, 0.0);
-                    jumps.push(Jump { interval: k, before, after });
-                }
-            }
+    for (j, p) in pieces.iter().enumerate() {
+        let prev = &pieces[(j + pieces.len() - 1) % pieces.len()];
+        if &prev.u + &prev.r * prev.len == p.u {
+            continue;
         }
+        let te = p.t0.rem_euclid(T);
+        let k = if te <= 0.0 { K - 1 } else { ((te / h).ceil() as usize).saturating_sub(1).min(K - 1) };
+        let (_, before, _) = eval((j + pieces.len() - 1) % pieces.len(), prev.len);
+        let (_, after, _) = eval(j, 0.0);
+        jumps.push(Jump { interval: k, before, after });
     }
     // S >= sup ||e^{sF}|| over the longest piece: grid norms times e^{h ||F||}
     let lmax = pieces.iter().map(|p| p.len).fold(0.0, f64::max);

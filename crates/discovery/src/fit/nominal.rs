@@ -62,18 +62,21 @@ impl FreeNominal {
     /// The model (without its input) at parameter values `v` (`None` where an expression of
     /// a named parameter leaves its range, e.g. a negative friction level).
     pub fn system_at(&self, v: &[f64]) -> Option<System> {
-        let mut s = self.base.clone();
-        for (p, x) in self.params.iter().zip(v) {
-            p.set(&mut s, *x).ok()?;
-        }
-        Some(s)
+        self.apply(&self.base, v).ok()
     }
-    /// `sys` (with its input) at parameter values `v`; `sys` itself where an expression of a
-    /// named parameter leaves its range (as [`FreeNominal::system_at`]).
+    /// `sys` (with its input) at parameter values `v` (the named parameters set in one pass); an
+    /// error where an expression of a named parameter leaves its range.
     pub fn apply(&self, sys: &System, v: &[f64]) -> Result<System, model::ModelError> {
         let mut s = sys.clone();
+        let mut named: Vec<(&str, f64)> = Vec::new();
         for (p, x) in self.params.iter().zip(v) {
-            p.set(&mut s, *x)?;
+            match p.target {
+                FreeTarget::Parameter => named.push((p.name.as_str(), *x)),
+                FreeTarget::Entry { .. } => p.set(&mut s, *x)?,
+            }
+        }
+        if !named.is_empty() {
+            s.set_parameters(&named)?;
         }
         Ok(s)
     }

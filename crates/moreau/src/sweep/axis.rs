@@ -105,10 +105,11 @@ impl Parameter {
             return Ok(Parameter::MatrixEntry { matrix, i, j });
         }
         if let Some(rest) = t.strip_prefix("parameters.") {
-            let mut chars = rest.chars();
-            let ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-                && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
-            return if ok { Ok(Parameter::Named(rest.to_string())) } else { Err(unknown()) };
+            return if model::Parameters::is_name(rest) {
+                Ok(Parameter::Named(rest.to_string()))
+            } else {
+                Err(unknown())
+            };
         }
         match t {
             "input.amplitude" | "input.amplitudes" => return Ok(Parameter::InputAmplitude { component: None }),
