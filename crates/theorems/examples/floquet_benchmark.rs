@@ -5,13 +5,13 @@
 //! Systems from `theorems::strategies::systems` (n = 2..4, p = 1, Theta an interval, sine
 //! inputs with amplitude 10^[0, 1.5], mu in [-2, -0.3]). A system counts when its measured
 //! exponent's 95 % interval lies below 0 (a periodic regime attracts). For each: the enclosure
-//! (verified or not, its relative width, its time), the measured exponent (largest of 3 pairs,
-//! 30 periods after 10, dt = 1e-3, and again at dt = 2.5e-4), an independent estimate from
-//! the event-driven integrator's period map by finite differences, and `theta_best`. (The
-//! measured exponent's 95 % interval is its regression's, narrower than its biases: the
-//! catching-up step's O(h), and the finite window when the dominant multipliers are a complex
-//! pair, which makes `ln V` oscillate; the finite-difference estimate has neither.) Prints the
-//! summary and, with
+//! (verified or not, its relative width, its time), the measured exponent (3 pairs, 30 periods
+//! after 10, separation 1e-6, with `step_check`: dt = 2e-3 (`FLOQUET_DT=...` to change), its half
+//! and its quarter, the quarter's values with every interval widened by the larger change):
+//! the regression of `ln V` (largest pair) and the dominant multiplier fitted to the same pairs'
+//! differences (`dynamics::rate::multipliers`, free of the wobble of `ln V` when the slowest
+//! multipliers are a complex pair), an independent estimate from the event-driven integrator's
+//! period map by finite differences, and `theta_best`. Prints the summary and, with
 //! `FLOQUET_BENCHMARK_ROWS=1`, one row per system (the `theta_best / floquet` table).
 #![allow(non_snake_case, clippy::neg_cmp_op_on_partial_ord)]
 use bounds::beyond_paper::floquet::{floquet_enclosure, FloquetSettings};
@@ -45,8 +45,8 @@ struct Row {
     fd: Option<f64>,
     /// `[min (pair - 4 sigma), max (pair + 4 sigma)]` over the measured pairs.
     pair_range: (f64, f64),
-    /// The measured exponent at dt = 2.5e-4 (catching-up's O(h) bias four times smaller).
-    fine: (f64, f64, f64, f64),
+    /// The dominant multiplier's exponent from the same pairs: (exponent, ci_low, ci_high).
+    mult: Option<(f64, f64, f64)>,
     enc: [f64; 2],
     verified: bool,
     reason: Option<String>,
@@ -98,7 +98,16 @@ fn main() {
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3030);
     let params = theorems::strategies::draw(&system_params(&config()), seed, 40 * want);
-    let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 3, ..Default::default() };
+    let measure = RateSettings {
+        periods: 30,
+        transient_periods: 10,
+        pairs: 3,
+        step_check: true,
+        separation: 1e-6,
+        renorm_below: 1e-2,
+        dt: std::env::var("FLOQUET_DT").ok().and_then(|v| v.parse().ok()).unwrap_or(2e-3),
+        ..Default::default()
+    };
     let start = std::time::Instant::now();
     let mut rows: Vec<Row> = Vec::new();
     let mut drawn = 0;
@@ -116,10 +125,6 @@ fn main() {
                 if !(m.ci_high < 0.0) {
                     return None;
                 }
-                // the pair that gives the reported (largest) exponent
-                let pair = m.pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent))?;
-                let mf = measure_rate(&sys, &RateSettings { dt: 2.5e-4, ..measure.clone() }, None).ok()?;
-                let pf = mf.pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent))?;
                 let pair_range = m.pairs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
                     (a.min(p.exponent - 4.0 * p.std_error), b.max(p.exponent + 4.0 * p.std_error))
                 });
@@ -134,10 +139,11 @@ fn main() {
                     n: sys.n(),
                     rate: m.exponent,
                     ci: (m.ci_low, m.ci_high),
-                    sigma: pair.std_error,
+                    // a half-width of the (widened) interval is two sigmas
+                    sigma: 0.25 * (m.ci_high - m.ci_low),
                     fd,
                     pair_range,
-                    fine: (mf.exponent, mf.ci_low, mf.ci_high, pf.std_error),
+                    mult: m.multiplier.as_ref().map(|u| (u.exponent, u.ci_low, u.ci_high)),
                     enc: f.floquet_exponent,
                     verified: f.verified,
                     reason: f.reason.clone(),
@@ -152,7 +158,7 @@ fn main() {
     rows.truncate(want);
     let total = start.elapsed().as_secs_f64();
     if std::env::var("FLOQUET_BENCHMARK_ROWS").is_ok() {
-        println!("| # | n | measured, dt = 1e-3 (95 % CI) | measured, dt = 2.5e-4 | event-driven FD | floquet_exponent | rel. width | time | theta_best | theta_best / floquet |");
+        println!("| # | n | measured ln V (95 % CI + step) | measured multiplier (95 % CI + step) | event-driven FD | floquet_exponent | rel. width | time | theta_best | theta_best / floquet |");
         println!("|---|---|---|---|---|---|---|---|---|---|");
         for (i, r) in rows.iter().enumerate() {
             let enc = if r.verified {
@@ -166,12 +172,12 @@ fn main() {
                 _ => "-".into(),
             };
             println!(
-                "| {i} | {} | {:.5} ({:.5}, {:.5}) | {:.5} | {} | {enc} | {:.1e} | {:.0} ms | {tb} | {ratio} |",
+                "| {i} | {} | {:.5} ({:.5}, {:.5}) | {} | {} | {enc} | {:.1e} | {:.0} ms | {tb} | {ratio} |",
                 r.n,
                 r.rate,
                 r.ci.0,
                 r.ci.1,
-                r.fine.0,
+                r.mult.map(|u| format!("{:.6} ({:.6}, {:.6})", u.0, u.1, u.2)).unwrap_or("-".into()),
                 r.fd.map(|v| format!("{v:.6}")).unwrap_or("-".into()),
                 r.rel_width,
                 1e3 * r.secs
@@ -184,17 +190,19 @@ fn main() {
     let overlap = ver.iter().filter(|r| r.enc[0] <= r.ci.1 && r.ci.0 <= r.enc[1]).count();
     // exclusion beyond 4 sigma of the measurement
     let far = ver.iter().filter(|r| r.enc[0] > r.rate + 4.0 * r.sigma || r.enc[1] < r.rate - 4.0 * r.sigma).count();
-    let overlap_fine = ver.iter().filter(|r| r.enc[0] <= r.fine.2 && r.fine.1 <= r.enc[1]).count();
-    let far_fine =
-        ver.iter().filter(|r| r.enc[0] > r.fine.0 + 4.0 * r.fine.3 || r.enc[1] < r.fine.0 - 4.0 * r.fine.3).count();
-    // the finer step moves the measurement towards the enclosure (catching-up's bias)
-    let closer = ver
+    // the dominant multiplier: overlap, and exclusion by more than 4 sigma (2 half-widths)
+    let with_mult: Vec<(&Row, (f64, f64, f64))> = ver.iter().filter_map(|r| r.mult.map(|u| (*r, u))).collect();
+    let overlap_mult = with_mult.iter().filter(|(r, u)| r.enc[0] <= u.2 && u.1 <= r.enc[1]).count();
+    let far_mult = with_mult
         .iter()
-        .filter(|r| {
-            let m = 0.5 * (r.enc[0] + r.enc[1]);
-            (r.fine.0 - m).abs() <= (r.rate - m).abs()
+        .filter(|(r, u)| {
+            let half = 0.5 * (u.2 - u.1);
+            r.enc[0] > u.0 + 2.0 * half || r.enc[1] < u.0 - 2.0 * half
         })
         .count();
+    let mut mult_width: Vec<f64> = with_mult.iter().map(|(_, u)| (u.2 - u.1) / u.0.abs()).collect();
+    mult_width.sort_by(f64::total_cmp);
+    let mult_width_median = mult_width.get(mult_width.len() / 2).copied().unwrap_or(f64::NAN);
     let bracketed = ver.iter().filter(|r| r.pair_range.0 <= r.enc[1] && r.enc[0] <= r.pair_range.1).count();
     let fd_dev: Vec<f64> =
         ver.iter().filter_map(|r| r.fd.map(|f| (f - 0.5 * (r.enc[0] + r.enc[1])).abs() / f.abs())).collect();
@@ -206,8 +214,8 @@ fn main() {
         "seed {seed}: {} convergent p = 1 systems ({drawn} drawn, {total:.0} s); verified {} ({:.0} %); \
          relative width <= 1e-3: {narrow} (max {max_width:.1e}); measured CI overlaps: {overlap} of {}; \
          excluded beyond 4 sigma: {far}; slowest enclosure {:.0} ms\n\
-         at dt = 2.5e-4: CI overlaps {overlap_fine}, excluded beyond 4 sigma {far_fine}; \
-         the finer step's measurement is closer to the enclosure on {closer} of {}\n\
+         the dominant multiplier measured from the pairs: {} measured, its interval overlaps the enclosure on \
+         {overlap_mult}, excluded beyond 4 sigma {far_mult}, median relative width {mult_width_median:.1e}\n\
          the measured pairs (each +- 4 sigma) bracket the enclosure on {bracketed} of {}\n\
          event-driven finite differences: {} compared, relative deviation from the enclosure <= 1e-4 on {fd_1e4}, max {fd_max:.1e}",
         rows.len(),
@@ -215,7 +223,7 @@ fn main() {
         100.0 * ver.len() as f64 / rows.len().max(1) as f64,
         ver.len(),
         1e3 * max_secs,
-        ver.len(),
+        with_mult.len(),
         ver.len(),
         fd_dev.len()
     );

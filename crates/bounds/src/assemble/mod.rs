@@ -375,6 +375,7 @@ fn measured(
                     periods: r.periods,
                     transient_periods: r.transient_periods,
                     h: r.h,
+                    multiplier: r.multiplier.map(|u| [u.exponent, u.ci_low, u.ci_high]),
                 }),
                 Err(e) => {
                     notes.push(format!("measured side not computed: {e}"));

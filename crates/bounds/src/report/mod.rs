@@ -210,6 +210,14 @@ pub mod defs {
     );
     pub const MEASURED_RATE: QuantityDef =
         q("measured_rate", "measured exponent", "measured", "(VV)", Estimate, "pairs of simulated trajectories");
+    pub const MEASURED_MULTIPLIER: QuantityDef = q(
+        "measured_multiplier",
+        "measured ln rho / T",
+        "$\\ln\\rho/T$",
+        "(Floquet)",
+        Estimate,
+        "dominant multiplier of a linear map fitted to the pairs' differences at period ends",
+    );
     pub const PATH_MEASURED: QuantityDef =
         q("path_measured", "measured path/period", "path", "(path)", Estimate, "min over periods after the transient");
     pub const ZDOT_MEASURED: QuantityDef = q(
@@ -222,7 +230,7 @@ pub mod defs {
     );
 
     /// All of them, in report order.
-    pub const ALL: [&QuantityDef; 33] = [
+    pub const ALL: [&QuantityDef; 34] = [
         &PERIOD,
         &MU,
         &R,
@@ -254,6 +262,7 @@ pub mod defs {
         &PHI_FIRST_SINGULAR,
         &STATIONARY_SLACK,
         &MEASURED_RATE,
+        &MEASURED_MULTIPLIER,
         &PATH_MEASURED,
         &ZDOT_MEASURED,
     ];
@@ -375,6 +384,7 @@ pub fn glossary(key: &str) -> Option<&'static str> {
         "phi_first_singular" => "The first time in [0, T] at which Theorem 1's matrix Phi(t) = I - t C Psi(tA) E is singular (none: Theorem 1's representation holds on the whole period).",
         "stationary_slack" => "Theorem 1: slack of the SDP deciding whether some initial state stays at rest for a whole period (the stationary set R(T)); > 0 means R(T) is empty.",
         "measured_rate" => "The measured exponent: half the slope of ln V along simulated pairs of trajectories, with its 95 % interval. A verified bound must lie above it.",
+        "measured_multiplier" => "The measured dominant Floquet multiplier of the periodic regime, ln rho / T: the map between the pairs' differences at the ends of the periods fitted by least squares, its largest eigenvalue's modulus rho. Unlike the slope of ln V it does not wobble when the slowest multipliers are a complex pair. A measurement, not a proof: compare with floquet_exponent.",
         "path_measured" => "The measured path length of the backlash output per period (compare with the path bounds).",
         "zdot_measured" => "The measured limsup of the backlash speed |z'| (compare with the (zinf) bound).",
         _ => return None,

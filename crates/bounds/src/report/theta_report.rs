@@ -22,6 +22,9 @@ pub struct MeasuredSide {
     pub periods: usize,
     pub transient_periods: usize,
     pub h: f64,
+    /// The dominant multiplier's exponent from the same pairs
+    /// (`dynamics::rate::multipliers`): `[exponent, ci_low, ci_high]`.
+    pub multiplier: Option<[f64; 3]>,
 }
 
 /// Every quantity of the theta computation for one model.
@@ -240,6 +243,9 @@ impl ThetaReport {
                     .with(m.rate, false)
                     .note(format!("95% CI [{:.4}, {:.4}], {} periods", m.ci_low, m.ci_high, m.periods)),
             );
+            if let Some([e, lo, hi]) = m.multiplier {
+                q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]")));
+            }
             q.push(PATH_MEASURED.with(m.path_length_per_period, false));
             q.push(ZDOT_MEASURED.with(m.limsup_zdot, false));
         }
@@ -285,6 +291,10 @@ impl ThetaReport {
         m.insert("effects".into(), json!(self.effects));
         m.insert("pi".into(), json!(self.Pi));
         m.insert("measured_rate_ci".into(), json!(self.measured.as_ref().map(|m| [f(m.ci_low), f(m.ci_high)])));
+        m.insert(
+            "measured_multiplier_ci".into(),
+            json!(self.measured.as_ref().and_then(|m| m.multiplier).map(|[_, lo, hi]| [f(lo), f(hi)])),
+        );
         m.insert("stationary_set_empty".into(), json!(self.stationary.as_ref().and_then(|s| s.empty)));
         m.insert("stationary_verified".into(), json!(self.stationary.as_ref().map(|s| s.verified)));
         m.insert("stationary_point".into(), json!(self.stationary.as_ref().and_then(|s| s.point.clone())));

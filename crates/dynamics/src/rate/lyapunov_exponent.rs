@@ -17,6 +17,7 @@ use crate::integrators::catching_up::CatchingUpSettings;
 use crate::integrators::ensemble::{Ensemble, EnsembleState};
 use crate::linear::step_map::InputHold;
 use crate::periodic::{period_of, steps_per_period};
+use crate::rate::multipliers::{dominant_multiplier, MultiplierRate, Transition};
 use crate::rate::path_length::{PathAccumulator, PathStats};
 use geometry::ConvexSet;
 use model::System;
@@ -44,6 +45,11 @@ pub struct RateSettings {
     pub seed: u64,
     /// `Pi` of eq. (V_Gamma) (n x n, symmetric positive definite); `None`: identity.
     pub pi: Option<DMatrix<f64>>,
+    /// Measure again at a half and a quarter of the step, report the quarter step's values and
+    /// widen every interval by the larger change from the two coarser steps (the catching-up
+    /// step's error is first order but erratic, so one halving can show no change at all).
+    /// Seven times the work. Default `false`.
+    pub step_check: bool,
 }
 
 impl Default for RateSettings {
@@ -58,6 +64,7 @@ impl Default for RateSettings {
             renorm_below: 1e-4,
             seed: 11,
             pi: None,
+            step_check: false,
         }
     }
 }
@@ -141,6 +148,15 @@ pub struct MeasuredRate {
     pub path_length_per_period: f64,
     /// Measured limsup of `|z'|` (max over periods after the transient).
     pub limsup_z_speed: f64,
+    /// The dominant multiplier of the regime from the same pairs ([`dominant_multiplier`]), free
+    /// of the wobble of `ln V` when the slowest multipliers are a complex pair; `None` when the
+    /// window is too short or the pairs collapsed.
+    pub multiplier: Option<MultiplierRate>,
+    /// With `step_check`: the larger of `|exponent(h) - exponent(h/4)|` and
+    /// `|exponent(h/2) - exponent(h/4)|` of the regression (`h` here the quarter step's four
+    /// times), already added to both intervals (that of `multiplier` by its own change).
+    /// `None` without.
+    pub step_error: Option<f64>,
 }
 
 /// `V = |X|_Pi^2 + |Q|^2`, eq. (V_Gamma).
@@ -195,6 +211,45 @@ pub fn measure_rate(
     start: Option<(&[f64], &[f64])>,
 ) -> Result<MeasuredRate, DynamicsError> {
     settings.validate(sys.n())?;
+    let coarse = measure_once(sys, settings, start)?;
+    if !settings.step_check {
+        return Ok(coarse);
+    }
+    let at = |dt: f64| measure_once(sys, &RateSettings { dt, step_check: false, ..settings.clone() }, start);
+    let half = at(0.5 * coarse.h)?;
+    let mut fine = at(0.25 * coarse.h)?;
+    // the catching-up step's error is first order but erratic (it depends on where the switches
+    // fall between steps): the larger change from the two coarser steps bounds the finest's
+    let change = |e: &dyn Fn(&MeasuredRate) -> Option<f64>| -> Option<f64> {
+        let f = e(&fine)?;
+        Some((e(&coarse)? - f).abs().max((e(&half)? - f).abs()))
+    };
+    let step = change(&|m| Some(m.exponent)).unwrap_or(f64::INFINITY);
+    let step_multiplier = change(&|m| m.multiplier.as_ref().map(|u| u.exponent));
+    fine.ci_low -= step;
+    fine.ci_high += step;
+    if let Some(u) = fine.multiplier.as_mut() {
+        let d = step_multiplier.unwrap_or(f64::INFINITY);
+        u.ci_low -= d;
+        u.ci_high += d;
+    }
+    fine.step_error = Some(step);
+    Ok(fine)
+}
+
+/// `(X, Q) = (x1 - x2, q1 - q2)`, the difference whose norm `V` measures.
+fn difference(sys: &System, x1: &[f64], z1: &[f64], x2: &[f64], z2: &[f64]) -> DVector<f64> {
+    let X = DVector::from_column_slice(x1) - DVector::from_column_slice(x2);
+    let Q = DVector::from_column_slice(z1) - DVector::from_column_slice(z2) - &sys.C * &X;
+    DVector::from_iterator(X.len() + Q.len(), X.iter().chain(Q.iter()).copied())
+}
+
+/// One measurement at the settings' step.
+fn measure_once(
+    sys: &System,
+    settings: &RateSettings,
+    start: Option<(&[f64], &[f64])>,
+) -> Result<MeasuredRate, DynamicsError> {
     let T = period_of(sys)?;
     let (N, h) = steps_per_period(T, settings.dt)?;
     let cu = CatchingUpSettings { dt: h, hold: settings.hold };
@@ -209,6 +264,7 @@ pub fn measure_rate(
     let mut state = EnsembleState::zeros(n, p, np + 1);
     state.set(0, &x0, &z0);
     let mut log_v = Vec::with_capacity(np);
+    let mut starts = Vec::with_capacity(np);
     for pair in 0..np {
         // second state: x2 = x0 + d, q2 = P_Theta(q0 + e), scaled so that sqrt V = separation
         let dx: Vec<f64> = (0..n).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
@@ -221,7 +277,9 @@ pub fn measure_rate(
         }
         state.set(pair + 1, &x2, &z2);
         log_v.push(vec![lyapunov_v(sys, pi, &x0, &z0, &x2, &z2).ln()]);
+        starts.push(difference(sys, &x0, &z0, &x2, &z2));
     }
+    let mut transitions: Vec<Vec<Transition>> = vec![Vec::new(); np];
     let mut ens = Ensemble::new(sys, &cu)?;
     let mut offset = vec![0.0; np];
     let mut renorms = vec![0; np];
@@ -257,19 +315,56 @@ pub fn measure_rate(
                 continue;
             }
             log_v[pair].push(v.ln() + offset[pair]);
+            let end = difference(sys, &x1, &z1, &x2, &z2);
+            let start = std::mem::replace(&mut starts[pair], end.clone());
+            if j >= settings.transient_periods {
+                transitions[pair].push(Transition { start, end });
+            }
             if v.sqrt() < settings.renorm_below * settings.separation {
                 let s = settings.separation / v.sqrt();
                 let (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
                 let v_new = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
                 offset[pair] += v.ln() - v_new.ln();
                 renorms[pair] += 1;
+                starts[pair] = difference(sys, &x1, &z1, &x2, &z2);
                 state.set(pair + 1, &x2, &z2);
             }
         }
     }
+    let pairs = pair_rates(log_v, &renorms, &collapsed, settings, T);
+    let live: Vec<Vec<Transition>> =
+        transitions.into_iter().zip(&collapsed).filter(|(_, &c)| !c).map(|(t, _)| t).collect();
+    let multiplier = if live.is_empty() { None } else { dominant_multiplier(&live, T) };
+    let best = pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent)).expect("pairs >= 1");
+    let from = settings.transient_periods;
+    Ok(MeasuredRate {
+        exponent: best.exponent,
+        ci_low: best.ci_low,
+        ci_high: best.ci_high,
+        period: T,
+        h,
+        transient_periods: from,
+        periods: settings.periods,
+        path_length_per_period: path.liminf_path_length(from),
+        limsup_z_speed: path.limsup_speed(from),
+        path,
+        pairs,
+        multiplier,
+        step_error: None,
+    })
+}
+
+/// The regression of each pair's `ln V` over the window after the transient.
+fn pair_rates(
+    log_v: Vec<Vec<f64>>,
+    renorms: &[usize],
+    collapsed: &[bool],
+    settings: &RateSettings,
+    T: f64,
+) -> Vec<PairRate> {
     let ts: Vec<f64> = (settings.transient_periods..=settings.periods).map(|j| j as f64 * T).collect();
     let tq = t_quantile_975(ts.len().saturating_sub(2));
-    let pairs: Vec<PairRate> = log_v
+    log_v
         .into_iter()
         .enumerate()
         .map(|(pair, log_v)| {
@@ -296,22 +391,7 @@ pub fn measure_rate(
                 collapsed: false,
             }
         })
-        .collect();
-    let best = pairs.iter().max_by(|a, b| a.exponent.total_cmp(&b.exponent)).expect("pairs >= 1");
-    let from = settings.transient_periods;
-    Ok(MeasuredRate {
-        exponent: best.exponent,
-        ci_low: best.ci_low,
-        ci_high: best.ci_high,
-        period: T,
-        h,
-        transient_periods: from,
-        periods: settings.periods,
-        path_length_per_period: path.liminf_path_length(from),
-        limsup_z_speed: path.limsup_speed(from),
-        path,
-        pairs,
-    })
+        .collect()
 }
 
 /// `x2 = x1 + s dx`, `q2 = P_Theta(q1 + s dq)`, `z2 = C x2 + q2`.

@@ -69,6 +69,16 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
                 rate.transient_periods,
                 rate.periods
             );
+            if let Some(u) = &rate.multiplier {
+                println!(
+                    "  measured dominant multiplier ln rho / T: {:.6}  95% CI [{:.6}, {:.6}]  ({}, {} modes fitted)",
+                    u.exponent,
+                    u.ci_low,
+                    u.ci_high,
+                    if u.complex_pair { "a complex pair" } else { "real" },
+                    u.rank
+                );
+            }
             println!(
                 "  path length of z per period (min after transient): {:.6};  limsup |z'|: {:.6}",
                 rate.path_length_per_period, rate.limsup_z_speed

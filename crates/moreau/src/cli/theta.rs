@@ -149,8 +149,8 @@ fn directed_7(x: f64, up: bool) -> String {
 
 /// The line of the verified Floquet exponent (issue 30): `floquet_exponent [lo, hi] (verified)`
 /// (printed outward to 7 decimals), with the bracket `[floquet_lo, theta_best]` of the
-/// convergence exponent when both are proven; otherwise why not, with the floating-point
-/// estimate when there is one.
+/// convergence exponent when both are proven; otherwise why not, with the measured dominant
+/// multiplier (labelled as a measurement) or else the floating-point estimate when there is one.
 pub fn render_floquet(rep: &ThetaReport, f: &bounds::beyond_paper::floquet::FloquetEnclosure) -> String {
     let [lo, hi] = f.floquet_exponent;
     let text = if f.verified {
@@ -166,7 +166,15 @@ pub fn render_floquet(rep: &ThetaReport, f: &bounds::beyond_paper::floquet::Floq
         format!("floquet_exponent [{}, {}] (verified{bracket})", directed_7(lo, false), directed_7(hi, true))
     } else {
         let reason = f.reason.as_deref().unwrap_or("unknown");
-        if f.estimate.is_finite() {
+        let measured = rep.measured.as_ref().and_then(|m| m.multiplier);
+        if let Some([e, lo, hi]) = measured {
+            format!(
+                "floquet_exponent not verified ({reason}); measured from simulated pairs (not a proof): {} (95% CI [{}, {}])",
+                fmt_value(e),
+                fmt_value(lo),
+                fmt_value(hi)
+            )
+        } else if f.estimate.is_finite() {
             format!(
                 "floquet_exponent [{e}, {e}] (not verified: {reason}; floating-point estimate)",
                 e = fmt_value(f.estimate)

@@ -60,7 +60,8 @@ impl PeriodicRun {
             PeriodicRun::Paper { sys, regime: reg, linearised: lin, localisation: loc, rate } => serde_json::json!({
                 "name": sys.name, "period": reg.period, "h": reg.h,
                 "periodic_regime": reg, "xi_T0": lin.xi0(), "localisation": loc,
-                "rate": { "exponent": rate.exponent, "ci95": [rate.ci_low, rate.ci_high], "pairs": rate.pairs.iter().map(|p| serde_json::json!({"exponent": p.exponent, "ci95": [p.ci_low, p.ci_high], "renormalisations": p.renormalisations, "collapsed": p.collapsed})).collect::<Vec<_>>() },
+                "rate": { "exponent": rate.exponent, "ci95": [rate.ci_low, rate.ci_high], "pairs": rate.pairs.iter().map(|p| serde_json::json!({"exponent": p.exponent, "ci95": [p.ci_low, p.ci_high], "renormalisations": p.renormalisations, "collapsed": p.collapsed})).collect::<Vec<_>>(),
+                    "multiplier": rate.multiplier.as_ref().map(|u| serde_json::json!({"exponent": u.exponent, "ci95": [u.ci_low, u.ci_high], "rank": u.rank, "moduli": u.moduli, "complex_pair": u.complex_pair})) },
                 "path_length_per_period": rate.path_length_per_period, "limsup_z_speed": rate.limsup_z_speed,
                 "osc_eta_T_lower": lin.osc_lower(), "eta_T_dot_inf_sampled": lin.deta_inf_sampled(),
             }),
