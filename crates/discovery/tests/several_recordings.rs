@@ -46,9 +46,14 @@ y = "m"
 
 /// The reference of each kind of experiment.
 fn reference(kind: &str) -> Vec<f64> {
-    (0..N)
+    reference_at(kind, DT, N)
+}
+
+/// The reference sampled every `dt` for `n` samples.
+fn reference_at(kind: &str, dt: f64, n: usize) -> Vec<f64> {
+    (0..n)
         .map(|k| {
-            let t = k as f64 * DT;
+            let t = k as f64 * dt;
             match kind {
                 "multisine" => 0.5 * (0.7 * t).sin() + 0.3 * (2.3 * t + 1.0).sin() + 0.2 * (5.1 * t).sin(),
                 // a square wave of period 4 s, its edges smoothed over 0.2 s
@@ -60,13 +65,18 @@ fn reference(kind: &str) -> Vec<f64> {
 
 /// A recording of the machine with loop-gain factor `g` (kind, initial state, noise seed).
 fn record(g: f64, kind: &str, x0: [f64; 2], seed: u64) -> Recording {
+    record_at(g, kind, x0, seed, DT, N)
+}
+
+/// As [`record`], sampled every `dt` for `n` samples.
+fn record_at(g: f64, kind: &str, x0: [f64; 2], seed: u64, dt: f64, n: usize) -> Recording {
     let sys = machine(g);
-    let w = reference(kind);
-    let sim = ExtendedModel::new(&sys, &[], DT, 20).unwrap().simulate(&w, DT, &x0);
+    let w = reference_at(kind, dt, n);
+    let sim = ExtendedModel::new(&sys, &[], dt, 20).unwrap().simulate(&w, dt, &x0);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let y: Vec<Vec<f64>> = sim.y.iter().map(|v| vec![v + 2e-3 * gauss(&mut rng)]).collect();
-    let t: Vec<f64> = (0..N).map(|k| k as f64 * DT).collect();
-    Recording::from_samples(&format!("{kind}-g{g}.csv"), &t, w.into_iter().map(|v| vec![v]).collect(), y, None)
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    Recording::from_samples(&format!("{kind}-g{g}-dt{dt}.csv"), &t, w.into_iter().map(|v| vec![v]).collect(), y, None)
 }
 
 /// A standard normal sample (Box-Muller).
@@ -159,4 +169,19 @@ fn recordings_with_different_signals_are_refused_by_name() {
     assert!(msg.contains("two-inputs.csv") && msg.contains("inputs") && !msg.contains('\n'), "{msg}");
     let e = diagnose_recordings(&machine(1.0), &[], &[a], &settings()).unwrap_err();
     assert!(matches!(e, DiscoveryError::NoRecording), "{e}");
+}
+
+#[test]
+fn recordings_at_different_sample_rates_and_lengths_fit_one_machine() {
+    // 100 Hz for 10 s and 40 Hz for 15 s, the second also validated on a 50 Hz recording.
+    let recs = [record(1.25, "multisine", [0.0, 0.0], 8), record_at(1.25, "square", [0.2, 0.0], 9, 0.025, 600)];
+    let val = [record_at(1.25, "multisine", [0.0, 0.1], 10, 0.02, 500)];
+    let r = diagnose_recordings(&machine(1.0), &recs, &val, &settings()).unwrap();
+    print(&r);
+    let g = r.nominal_refit.iter().find(|v| v.name == "g").expect("g refitted");
+    assert!((g.value / 1.25 - 1.0).abs() < 0.02, "g = {} against 1.25", g.value);
+    assert_eq!(r.recordings.iter().map(|x| x.samples).collect::<Vec<_>>(), vec![1000, 600, 500]);
+    for row in &r.recordings {
+        assert!(row.rmse_joint[0] < 0.5 * row.rmse_nominal[0], "{row:?}");
+    }
 }

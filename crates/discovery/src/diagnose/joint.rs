@@ -180,17 +180,7 @@ pub fn diagnose_recordings(
     let all: Vec<&Recording> = recs.iter().chain(validate_on).collect();
     let setups: Vec<Setup> =
         all.iter().map(|r| Setup::new(sys, r, s).map_err(|e| in_recording(r, e))).collect::<Result<_, _>>()?;
-    // Hold and sub-steps: each recording fitted on as its diagnosis settled them; a recording
-    // validated on as the first recording's.
-    let data: Vec<Rec> = setups
-        .into_iter()
-        .enumerate()
-        .map(|(j, setup)| {
-            let sel = &singles[if j < n_fit { j } else { 0 }].1;
-            let ctx = detach(sys, setup.context(sel.hold, sel.substeps, setup.x_scale_free.clone()));
-            Rec { setup, ctx }
-        })
-        .collect();
+    let data = recording_data(sys, setups, &singles, recs[0].dt);
     let free = if s.refit_nominal { FreeNominal::of(sys) } else { None };
     let units: Vec<String> = (0..first.p()).map(|i| sys.signals.y_unit(i).to_string()).collect();
     let mut notes = Vec::new();
@@ -301,6 +291,36 @@ pub fn diagnose_recordings(
         per_recording: singles.iter().map(|(r, _)| (r.recording.clone(), r.verdict.clone())).collect(),
         fitted_model: Some(fitted_model),
     })
+}
+
+/// The fit context of each recording. Hold and sub-steps: each recording fitted on as its
+/// diagnosis settled them; a recording validated on with the first recording's hold and
+/// sub-step length (the sub-steps scaled by its sample time, between its own first count and
+/// the most allowed; `dt0` the first recording's sample time).
+fn recording_data<'a>(
+    sys: &'a System,
+    setups: Vec<Setup<'a>>,
+    singles: &[(Report, Selected)],
+    dt0: f64,
+) -> Vec<Rec<'a>> {
+    setups
+        .into_iter()
+        .enumerate()
+        .map(|(j, setup)| {
+            let (hold, substeps) = if j < singles.len() {
+                (singles[j].1.hold, singles[j].1.substeps)
+            } else {
+                let sel = &singles[0].1;
+                (
+                    sel.hold,
+                    ((sel.substeps as f64 * setup.dt / dt0).ceil() as usize)
+                        .clamp(setup.k0.max(1), setup.max_sub.max(sel.substeps)),
+                )
+            };
+            let ctx = detach(sys, setup.context(hold, substeps, setup.x_scale_free.clone()));
+            Rec { setup, ctx }
+        })
+        .collect()
 }
 
 /// The candidates: each recording's selection (per recording, and once each: the first
