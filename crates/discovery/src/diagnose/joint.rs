@@ -443,8 +443,11 @@ fn leave_one_out(
                 rmse.push(judged.rmse);
             }
             let mean_ratio = ratio.iter().sum::<f64>() / ratio.len() as f64;
-            let worse: Vec<String> =
-                fit_idx.iter().filter(|&&j| !(ratio[j] <= 1.0)).map(|&j| recs[j].source.clone()).collect();
+            let worse: Vec<String> = fit_idx
+                .iter()
+                .filter(|&&j| ratio[j].is_nan() || ratio[j] > 1.0)
+                .map(|&j| recs[j].source.clone())
+                .collect();
             let gain = 1.0 - s.select.min_val_gain;
             let (accepted, reason) = if !worse.is_empty() {
                 (false, format!("worsens left-out {}", worse.join(", ")))
@@ -549,7 +552,14 @@ fn problem<'a>(
 /// (from `x0`), RMSE per output and weighted mean square over the whole record.
 fn judge(d: &Rec, c: &Candidate, sh: &Shared, x0: &[f64], free: Option<&FreeNominal>, s: &DiagnoseSettings) -> Judged {
     let pb = problem(&d.ctx, c, free, &sh.nominal);
-    let f = fit_joint(std::slice::from_ref(&pb), sh, &[x0.to_vec()], &[d.setup.x_scale_free.clone()], false, &s.fit);
+    let f = fit_joint(
+        std::slice::from_ref(&pb),
+        sh,
+        &[x0.to_vec()],
+        std::slice::from_ref(&d.setup.x_scale_free),
+        false,
+        &s.fit,
+    );
     let x0 = f.x0[0].clone();
     let (p, n) = (d.ctx.p, d.ctx.n);
     let rmse = match pb.simulate_with(&sh.theta, &sh.nominal, &x0, None) {
