@@ -439,6 +439,54 @@ fn diagnose<'py>(
     Ok((to_json(&report)?, fitted, s.p, d))
 }
 
+/// `moreau diagnose --data A --data B [--validate-on C]` (several recordings of one machine,
+/// paths): (joint report JSON, fitted System or None).
+#[pyfunction]
+#[pyo3(signature = (model, *, data, validate_on=Vec::new(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, out=None))]
+#[allow(clippy::too_many_arguments)]
+fn diagnose_recordings(
+    py: Python<'_>,
+    model: &Bound<'_, PyAny>,
+    data: Vec<PathBuf>,
+    validate_on: Vec<PathBuf>,
+    estimation_fraction: f64,
+    max_effects: usize,
+    input_hold: String,
+    estimate_x0: bool,
+    metric: String,
+    no_refit: bool,
+    out: Option<PathBuf>,
+) -> PyResult<(String, Option<PySystem>)> {
+    use commands::diagnose::{diagnose_recordings, write_joint_outputs, DiagnoseOptions, RecordingSource};
+    let src = source(model)?;
+    let Some(input_hold) = discovery::HoldChoice::parse(&input_hold) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
+        )));
+    };
+    let Some(metric) = discovery::diagnose::Metric::parse(&metric) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
+        )));
+    };
+    let o =
+        DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, metric, refit_nominal: !no_refit };
+    let files = |v: Vec<PathBuf>| v.into_iter().map(RecordingSource::File).collect::<Vec<_>>();
+    let (fit, val) = (files(data), files(validate_on));
+    let run = move || -> anyhow::Result<discovery::diagnose::JointReport> {
+        let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
+        let r = diagnose_recordings(&src, &fit, &val, &o)?.report;
+        if let Some(st) = staged {
+            write_joint_outputs(&r, st)?;
+        }
+        Ok(r)
+    };
+    let r = py.detach(run).map_err(err)?;
+    let report = serde_json::to_value(&r).map_err(|e| err(e.into()))?;
+    let fitted = r.fitted_model.clone().map(|inner| PySystem { inner, stated: Stated { x0: true, z0: true } });
+    Ok((to_json(&report)?, fitted))
+}
+
 /// `moreau sweep SPEC --out DIR --quiet`: (JSON table, files written, exit status 0).
 #[pyfunction]
 #[pyo3(signature = (spec, out, *, shard=None, threads=None, digits=None, overwrite=false, fresh=false, retry_failed=false))]
@@ -569,6 +617,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(periodic, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_recordings, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(figure, m)?)?;
     m.add_function(wrap_pyfunction!(set_allow_large, m)?)?;

@@ -117,6 +117,23 @@ def test_diagnose_from_a_csv_path_matches_the_cli_report(cli, tmp_path):
     assert s["t"].ndim == 1 and s["y"].shape == (len(s["t"]), 1) == s["yhat_fitted"].shape
 
 
+def test_diagnose_takes_a_list_of_recordings_as_the_cli_does(cli, tmp_path):
+    # several recordings of one machine: `--data A --data B`, one model fitted jointly
+    model = EXAMPLES / "real" / "bam-xl330-kp100-physical.toml"
+    data = [BAM_DATA, ROOT / "data" / "bam-servo" / "xl330-kp100-sin_time_square.csv"]
+    out = tmp_path / "joint"
+    r = cli.run("diagnose", "--model", model, "--data", data[0], "--data", data[1], "--out", out)
+    assert r.returncode == 0, r.stderr
+    ref = json.loads((out / "report.json").read_text())
+    mine = moreau.diagnose(model, data, out=tmp_path / "mine")
+    assert dict(mine) == ref
+    assert (tmp_path / "mine" / "fitted.toml").exists()
+    assert [row["role"] for row in mine["recordings"]] == ["fit", "fit"]
+    assert isinstance(mine.fitted_model, moreau.System) and mine.series is None
+    with pytest.raises(TypeError, match="paths"):
+        moreau.diagnose(model, [np.zeros((3, 3))])
+
+
 def test_diagnose_takes_arrays_and_dataframes():
     names, data = _recording()
     by_path = moreau.diagnose(BAM_MODEL, BAM_DATA)

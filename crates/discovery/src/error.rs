@@ -29,6 +29,12 @@ pub enum DiscoveryError {
     Unstable { mu: f64 },
     #[error("simulation: {0}")]
     Dynamics(#[from] dynamics::DynamicsError),
+    #[error("no recording to fit on (give at least one --data)")]
+    NoRecording,
+    #[error("recordings {first} and {other} differ in their {what}: {first_has} against {other_has} (recordings of one machine have the same signal columns)")]
+    RecordingsDiffer { first: String, other: String, what: &'static str, first_has: String, other_has: String },
+    #[error("recording {path}: {reason}")]
+    InRecording { path: String, reason: String },
     #[error("settings: {field} = {value}: {reason}")]
     BadSetting { field: &'static str, value: f64, reason: &'static str },
 }

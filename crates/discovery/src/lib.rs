@@ -43,6 +43,6 @@ pub mod recording;
 pub mod residual;
 pub mod select;
 
-pub use diagnose::{diagnose, DiagnoseSettings, HoldChoice, InitialState, Report};
+pub use diagnose::{diagnose, diagnose_recordings, DiagnoseSettings, HoldChoice, InitialState, Report};
 pub use error::DiscoveryError;
 pub use recording::Recording;

@@ -324,3 +324,44 @@ fn bam_report_localises_against_a_null_and_zooms_on_the_windows_with_units() {
     assert!(zoom.iter().any(|t| t.starts_with("Window 1: t = ")), "{zoom:?}");
     assert!(zoom.iter().any(|t| t == "velocity residual (rad/s)"), "{zoom:?}");
 }
+
+/// `moreau diagnose` with several `--data` and `--validate-on` arguments.
+fn diagnose_several(args: &[&Path], out: &Path) -> Output {
+    let mut c = moreau();
+    c.arg("diagnose").arg("--model").arg(model()).arg("--out").arg(out);
+    for a in args {
+        c.arg(a);
+    }
+    c.output().unwrap()
+}
+
+#[test]
+fn several_recordings_bad_input_is_a_one_line_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out");
+    let a = write_csv(d, "a.csv", "t,w,y", 2000, good_row);
+    let flag = |s: &'static str| Path::new(s);
+    // --validate-on without --data
+    let o = diagnose_several(&[flag("--validate-on"), &a], &out);
+    assert_rejected(&o, &out, &["--data: no recording given", "--validate-on only judges"]);
+    let o = diagnose_several(&[], &out);
+    assert_rejected(&o, &out, &["--data: no recording given"]);
+    // a missing recording among several
+    let missing = d.join("missing.csv");
+    let o = diagnose_several(&[flag("--data"), &a, flag("--data"), &missing], &out);
+    assert_rejected(&o, &out, &["missing.csv"]);
+    let o = diagnose_several(&[flag("--data"), &a, flag("--validate-on"), &missing], &out);
+    assert_rejected(&o, &out, &["missing.csv"]);
+    // recordings with different signal columns
+    let two = write_csv(d, "two.csv", "t,w1,w2,y", 2000, |k| {
+        format!("{},{},{},{}", k as f64 * 0.01, w_of(k), 0.5 * w_of(k), y_of(k))
+    });
+    let o = diagnose_several(&[flag("--data"), &a, flag("--data"), &two], &out);
+    assert_rejected(&o, &out, &["a.csv", "two.csv", "inputs", "2"]);
+    let extra = write_csv(d, "extra.csv", "t,w,y,current", 2000, |k| {
+        format!("{},{},{},{}", k as f64 * 0.01, w_of(k), y_of(k), 0.1)
+    });
+    let o = diagnose_several(&[flag("--data"), &a, flag("--validate-on"), &extra], &out);
+    assert_rejected(&o, &out, &["extra.csv", "current"]);
+}

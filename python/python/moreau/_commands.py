@@ -257,10 +257,10 @@ def check(
 class Diagnosis(Result):
     """``report.json`` of ``moreau diagnose`` as a dict; ``fitted_model`` is the refitted
     :class:`System` (None if none), ``series`` the curves of its figures: ``t`` (N,),
-    ``y``, ``yhat_nominal``, ``yhat_fitted`` (N, p)."""
+    ``y``, ``yhat_nominal``, ``yhat_fitted`` (N, p); None for several recordings."""
 
     fitted_model: Optional[System]
-    series: Dict[str, np.ndarray]
+    series: Optional[Dict[str, np.ndarray]]
 
     def _parts(self) -> List[str]:
         verdict = str(self.get("verdict", ""))
@@ -309,17 +309,21 @@ def diagnose(
     metric: str = "auto",
     no_refit: bool = False,
     out: Optional[PathLike] = None,
+    validate_on: Optional[List[PathLike]] = None,
 ) -> Diagnosis:
     """Compares a model with a recording, locates the mismatch, names the missing physics,
-    refits and validates: ``moreau diagnose --model M --data R``.
+    refits and validates: ``moreau diagnose --model M --data R``. A list of recording paths
+    (several recordings of one machine) is ``--data A --data B``: one model fitted jointly,
+    selected by leave-one-recording-out validation; ``validate_on`` is ``--validate-on``.
 
     Parameters
     ----------
     model : System or path-like
         The nominal model (``[fit] free`` parameters are refitted unless ``no_refit``).
-    recording : path-like, str, DataFrame or array
+    recording : path-like, str, DataFrame, array or list of path-likes
         A CSV file (header ``t,w,y`` or ``t,w1..wm,y1..yp``, optional ``z``), a pandas
-        DataFrame with those columns, or a 2-D array with columns ``t, w1..wm, y1..yp[, z1..zp]``.
+        DataFrame with those columns, or a 2-D array with columns ``t, w1..wm, y1..yp[, z1..zp]``;
+        or a list of CSV files of one machine (the joint diagnosis).
     estimation_fraction : float, default 0.7
         Fraction of the record used for estimation (the rest validates).
     max_effects : int, default 2
@@ -334,13 +338,18 @@ def diagnose(
         Keep the parameters the model frees at their values (the CLI's ``--no-refit``).
     out : path-like, optional
         Write the CLI's report folder (report.md, report.json, fitted.toml, figures).
+    validate_on : list of path-likes, optional
+        Recordings the fitted model is judged on, never fitted on (``--validate-on``).
 
     Returns
     -------
     Diagnosis
         ``report.json`` as a dict (``verdict``, ``effects``, ``fit_before``, ``fit_after``,
         ``nominal_refit``, ...), with ``fitted_model`` (a :class:`System` or None) and
-        ``series`` (``t``, ``y``, ``yhat_nominal``, ``yhat_fitted``).
+        ``series`` (``t``, ``y``, ``yhat_nominal``, ``yhat_fitted``). The joint diagnosis
+        (a list, or ``validate_on``): its ``report.json`` (``recordings`` with the RMSE per
+        recording, ``own_fits``, ``candidates``, ``selected``, ``verdict``, ...), with
+        ``fitted_model`` and ``series`` None.
     """
     nm = _native_model(model)
     kw: Dict[str, Any] = dict(
@@ -352,6 +361,18 @@ def diagnose(
         no_refit=no_refit,
         out=None if out is None else os.fspath(out),
     )
+    if isinstance(recording, (list, tuple)) or validate_on is not None:
+        recs = list(recording) if isinstance(recording, (list, tuple)) else [recording]
+        paths = recs + list(validate_on or [])
+        if not all(isinstance(r, (str, os.PathLike)) for r in paths):
+            raise TypeError("several recordings are given as paths of CSV files")
+        text, fitted = _native.diagnose_recordings(
+            nm, data=[os.fspath(r) for r in recs], validate_on=[os.fspath(r) for r in validate_on or []], **kw
+        )
+        d = Diagnosis(json.loads(text))
+        d.fitted_model = None if fitted is None else System._wrap(fitted)
+        d.series = None
+        return d
     if isinstance(recording, (str, os.PathLike)):
         text, fitted, p, cols = _native.diagnose(nm, data=os.fspath(recording), **kw)
     else:

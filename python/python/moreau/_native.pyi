@@ -98,6 +98,19 @@ def diagnose(
     no_refit: bool = False,
     out: Optional[_Path] = None,
 ) -> Tuple[str, Optional[System], int, Dict[str, bytes]]: ...
+def diagnose_recordings(
+    model: _Model,
+    *,
+    data: List[_Path],
+    validate_on: List[_Path] = ...,
+    estimation_fraction: float = 0.7,
+    max_effects: int = 2,
+    input_hold: str = "auto",
+    estimate_x0: bool = False,
+    metric: str = "auto",
+    no_refit: bool = False,
+    out: Optional[_Path] = None,
+) -> Tuple[str, Optional[System]]: ...
 def figure(
     kind: str,
     input: _Path,

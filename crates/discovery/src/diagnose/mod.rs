@@ -26,6 +26,11 @@
 //!    apart), and the fitted model (`fitted.toml`).
 //! 6. Report: `verdict` (headline and text), `notes`, [`report`] (the types of
 //!    `report.json`) and `markdown` (`report.md`, [`Report::to_markdown`]).
+//!
+//! Several recordings of one machine: [`joint`] ([`diagnose_recordings`]) runs the above on
+//! each, then selects among the models they selected by leave-one-recording-out validation
+//! and fits the selected one jointly.
+pub mod joint;
 pub mod report;
 pub mod settings;
 
@@ -38,6 +43,7 @@ mod setup;
 mod verdict;
 
 pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
+pub use joint::{diagnose_recordings, JointReport};
 pub use report::{
     FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Report, Series, FITTED_INPUT_FILE,
 };
@@ -55,6 +61,25 @@ use verdict::Headline;
 
 /// Diagnoses `rec` against nominal model `sys`.
 pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<Report, DiscoveryError> {
+    Ok(diagnose_selected(sys, rec, s)?.0)
+}
+
+/// What a one-recording diagnosis selected, as the joint diagnosis of several recordings
+/// ([`joint`]) takes it up: the hold and sub-steps it settled on, the scales its hypotheses'
+/// parameters are mapped with, and the selected model.
+pub(crate) struct Selected {
+    pub hold: dynamics::extended::InputHold,
+    pub substeps: usize,
+    pub scales: crate::hypothesis::Scales,
+    pub chosen: Option<Ranked>,
+}
+
+/// [`diagnose`], with what it selected.
+pub(crate) fn diagnose_selected(
+    sys: &System,
+    rec: &Recording,
+    s: &DiagnoseSettings,
+) -> Result<(Report, Selected), DiscoveryError> {
     s.validate(sys, rec)?;
     let data = Setup::new(sys, rec, s)?;
     // Hold and discretisation, then the nominal fit under them.
@@ -96,7 +121,13 @@ pub fn diagnose(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<R
         &headline.text,
     );
     notes::closing(&data, &pass, &outcome, &fitted, headline.use_rmse, &mut notes);
-    Ok(assemble(&data, pass, nominal, outcome, unc, fitted, headline, verdict, notes))
+    let selected = Selected {
+        hold: pass.hold,
+        substeps: pass.ctx.substeps,
+        scales: pass.ctx.scales.clone(),
+        chosen: outcome.chosen.clone(),
+    };
+    Ok((assemble(&data, pass, nominal, outcome, unc, fitted, headline, verdict, notes), selected))
 }
 
 /// What the selection leaves standing.

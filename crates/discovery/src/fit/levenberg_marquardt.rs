@@ -111,6 +111,30 @@ impl Vars<'_, '_> {
         };
         (theta, nom, x0)
     }
+    /// Whether variable `c` is a freed nominal parameter on one of its bounds.
+    fn nominal_at_bound(&self, v: &[f64], c: usize) -> bool {
+        c >= self.k && c < self.k + self.kn && {
+            let i = c - self.k;
+            let tol = 1e-9 * (1.0 + v[c].abs());
+            v[c] <= self.nlo[i] + tol || v[c] >= self.nhi[i] - tol
+        }
+    }
+}
+
+/// A bounded least-squares objective of the solver ([`lm`]): the residual at a point, the
+/// projection on its box, and the side of a finite-difference step. [`fit`] solves one
+/// recording's [`Problem`]; [`crate::fit::joint`] several recordings with shared parameters.
+pub(crate) trait Objective {
+    /// The residual at `v` (`None` where the simulation blew up); counts the evaluation.
+    fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>>;
+    /// Projects `v` on the box.
+    fn clamp(&self, v: &mut [f64]);
+    /// Whether a forward step `h` on variable `c` would leave the box (then it is taken
+    /// backwards).
+    fn step_back(&self, v: &[f64], c: usize, h: f64) -> bool;
+}
+
+impl Objective for Vars<'_, '_> {
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
         *evals += 1;
         let (t, n, x) = self.split(v);
@@ -124,33 +148,22 @@ impl Vars<'_, '_> {
             v[self.k + i] = v[self.k + i].clamp(self.nlo[i], self.nhi[i]);
         }
     }
-    /// Whether variable `c` is a freed nominal parameter on one of its bounds.
-    fn nominal_at_bound(&self, v: &[f64], c: usize) -> bool {
-        c >= self.k && c < self.k + self.kn && {
-            let i = c - self.k;
-            let tol = 1e-9 * (1.0 + v[c].abs());
-            v[c] <= self.nlo[i] + tol || v[c] >= self.nhi[i] - tol
-        }
+    fn step_back(&self, v: &[f64], c: usize, h: f64) -> bool {
+        (c < self.k && v[c] + h > 1.0) || (c >= self.k && c < self.k + self.kn && v[c] + h > self.nhi[c - self.k])
     }
 }
 
-fn sse(r: &[f64]) -> f64 {
+pub(crate) fn sse(r: &[f64]) -> f64 {
     r.iter().map(|x| x * x).sum()
 }
 
-fn jacobian(vars: &Vars, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DMatrix<f64> {
+pub(crate) fn jacobian<O: Objective>(vars: &O, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DMatrix<f64> {
     let nv = v.len();
     let mut J = DMatrix::zeros(r0.len(), nv);
     for c in 0..nv {
         let mut vp = v.to_vec();
         // Step towards the interior for bounded variables.
-        let step = if (c < vars.k && v[c] + h > 1.0)
-            || (c >= vars.k && c < vars.k + vars.kn && v[c] + h > vars.nhi[c - vars.k])
-        {
-            -h
-        } else {
-            h
-        };
+        let step = if vars.step_back(v, c, h) { -h } else { h };
         vp[c] += step;
         if let Some(rp) = vars.res(&vp, evals) {
             for i in 0..r0.len() {
@@ -234,8 +247,8 @@ fn residual_correlation_length(r: &[f64], p: usize, max_lag: usize) -> usize {
 }
 
 /// Runs LM from `v`, at most `iters` iterations. Returns (v, r, cost, converged).
-fn lm(
-    vars: &Vars,
+pub(crate) fn lm<O: Objective>(
+    vars: &O,
     mut v: Vec<f64>,
     iters: usize,
     s: &FitSettings,

@@ -3,10 +3,12 @@
 //! bounded multi-start solver and the Gauss-Newton parameter covariance, [`nominal`] the
 //! freed nominal parameters of a grey-box refit (`[fit] free` in the model file),
 //! [`missing_input`] the check for a recorded signal the model leaves out, [`input_effects`]
-//! input effects on one input of several, [`jackknife`] the model-error spread of fitted
+//! input effects on one input of several, [`joint`] one model fitted to several recordings,
+//! [`jackknife`] the model-error spread of fitted
 //! parameters over contiguous folds.
 pub mod input_effects;
 pub mod jackknife;
+pub mod joint;
 pub mod levenberg_marquardt;
 pub mod missing_input;
 pub mod nominal;

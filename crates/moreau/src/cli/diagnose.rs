@@ -2,9 +2,13 @@
 //! recording, locate the mismatch, name the missing physics, refit and validate
 //! (crate `discovery`). Writes `report.md`, `report.json`, `fitted.toml`, `fit.svg`,
 //! `residual.svg`, `zoom-1.svg` .. `zoom-3.svg` (the top located windows; PNG copies of all)
-//! into DIR, all together or not at all. The work is [`crate::commands::diagnose`]; this
+//! into DIR, all together or not at all. With `--data` repeated (several recordings of one
+//! machine) or `--validate-on`: the joint diagnosis, `report.md`, `report.json` and
+//! `fitted.toml` (no figures). The work is [`crate::commands::diagnose`]; this
 //! module parses the arguments and prints the summary.
-use crate::commands::diagnose::{diagnose, write_outputs, DiagnoseOptions, RecordingSource};
+use crate::commands::diagnose::{
+    diagnose, diagnose_recordings, write_joint_outputs, write_outputs, DiagnoseOptions, RecordingSource,
+};
 use crate::commands::Source;
 use crate::output::StagedDir;
 use std::path::PathBuf;
@@ -15,9 +19,15 @@ pub struct Args {
     /// Nominal model file (TOML).
     #[arg(long)]
     pub model: PathBuf,
-    /// Recording CSV: header `t,w,y` or `t,w1..wm,y1..yp`, optional `z`.
+    /// Recording CSV: header `t,w,y` or `t,w1..wm,y1..yp`, optional `z`. Repeat it for
+    /// several recordings of one machine (each its own initial state, input and sample time):
+    /// one model fitted to all jointly, selected by leave-one-recording-out validation.
     #[arg(long)]
-    pub data: PathBuf,
+    pub data: Vec<PathBuf>,
+    /// A recording of the same machine that the model is judged on, never fitted on
+    /// (repeatable): a fitted model that predicts it worse than the nominal is not adopted.
+    #[arg(long)]
+    pub validate_on: Vec<PathBuf>,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
@@ -48,6 +58,12 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
+    if a.data.is_empty() {
+        anyhow::bail!(
+            "--data: no recording given{} (usage: moreau diagnose --model M.toml --data R.csv [--data R2.csv ...] [--validate-on V.csv ...] --out DIR)",
+            if a.validate_on.is_empty() { "" } else { "; --validate-on only judges the fitted model, at least one --data is fitted on" }
+        );
+    }
     let o = DiagnoseOptions {
         estimation_fraction: a.estimation_fraction,
         max_effects: a.max_effects,
@@ -57,7 +73,10 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         refit_nominal: !a.no_refit,
     };
     let staged = StagedDir::replacing(&a.out)?;
-    let run = diagnose(&Source::File(a.model.clone()), &RecordingSource::File(a.data.clone()), &o)?;
+    if a.data.len() > 1 || !a.validate_on.is_empty() {
+        return run_joint(a, &o, staged);
+    }
+    let run = diagnose(&Source::File(a.model.clone()), &RecordingSource::File(a.data[0].clone()), &o)?;
     let (r, secs) = (&run.report, run.seconds);
     write_outputs(r, staged)?;
     println!("{}", r.verdict);
@@ -113,6 +132,38 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         println!("  {}: {}", e.label, params.join(", "));
     }
     println!("{} hypotheses ranked in {secs:.2} s; report in {}", r.ranking.len(), a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Several recordings (`--data` repeated, or `--validate-on`): the joint diagnosis.
+fn run_joint(a: &Args, o: &DiagnoseOptions, staged: StagedDir) -> anyhow::Result<ExitCode> {
+    let files = |v: &[PathBuf]| v.iter().map(|p| RecordingSource::File(p.clone())).collect::<Vec<_>>();
+    let run = diagnose_recordings(&Source::File(a.model.clone()), &files(&a.data), &files(&a.validate_on), o)?;
+    let r = &run.report;
+    write_joint_outputs(r, staged)?;
+    println!("{}", r.verdict);
+    for v in &r.nominal_refit {
+        println!(
+            "  {}: {} -> {} +- {} (refitted plant parameter)",
+            v.name,
+            sig4(v.nominal),
+            sig4(v.value),
+            sig4(v.std)
+        );
+    }
+    for e in &r.effects {
+        let params: Vec<String> = e
+            .params
+            .iter()
+            .zip(&e.uncertainty)
+            .map(|((name, v), (_, s))| format!("{name} = {} +- {}", sig4(*v), sig4(*s)))
+            .collect();
+        println!("  {}: {}", e.label, params.join(", "));
+    }
+    for o in r.own_fits.iter().filter(|o| !o.worsens.is_empty()) {
+        println!("  {} fitted on {} alone {}", o.label, o.recording, o.note);
+    }
+    println!("{} recording(s) diagnosed in {:.2} s; report in {}", r.recordings.len(), run.seconds, a.out.display());
     Ok(ExitCode::SUCCESS)
 }
 

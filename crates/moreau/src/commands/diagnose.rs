@@ -2,11 +2,13 @@
 //! physics, refit and validate (crate `discovery`); [`write_outputs`] writes `report.md`,
 //! `report.json`, `fitted.toml` and the figures ([`crate::figures::diagnosis`]) into a
 //! directory, all together or not at all. The recording goes through the checked reader
-//! ([`discovery::Recording::load`], [`discovery::Recording::parse_checked`]).
+//! ([`discovery::Recording::load`], [`discovery::Recording::parse_checked`]). Several
+//! recordings of one machine: [`diagnose_recordings`] and [`write_joint_outputs`].
 use super::{Source, Stated};
 use crate::figures::canvas;
 use crate::output::StagedDir;
 use anyhow::Context;
+use discovery::diagnose::JointReport;
 use discovery::diagnose::Metric;
 use discovery::recording::TimeColumn;
 use discovery::{DiagnoseSettings, HoldChoice, Recording, Report};
@@ -56,24 +58,46 @@ pub struct DiagnoseRun {
 
 /// Reads the model (with which initial values it states) and the recording, diagnoses.
 pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) -> anyhow::Result<DiagnoseRun> {
+    let (sys, settings) = model_and_settings(model_src, o)?;
+    let rec = read_recording(rec)?;
+    let start = std::time::Instant::now();
+    let report = discovery::diagnose(&sys, &rec, &settings)?;
+    Ok(DiagnoseRun { report, seconds: start.elapsed().as_secs_f64() })
+}
+
+/// The result of `diagnose` on several recordings: the joint report and the seconds it took.
+pub struct JointRun {
+    pub report: JointReport,
+    pub seconds: f64,
+}
+
+/// Reads the model and the recordings, diagnoses them jointly (`recs` fitted on, `validate_on`
+/// judged only; see [`discovery::diagnose::joint`]).
+pub fn diagnose_recordings(
+    model_src: &Source,
+    recs: &[RecordingSource],
+    validate_on: &[RecordingSource],
+    o: &DiagnoseOptions,
+) -> anyhow::Result<JointRun> {
+    if recs.is_empty() {
+        anyhow::bail!("no recording to fit on: give at least one --data (--validate-on only judges)");
+    }
+    let (sys, settings) = model_and_settings(model_src, o)?;
+    let fit: Vec<Recording> = recs.iter().map(read_recording).collect::<anyhow::Result<_>>()?;
+    let val: Vec<Recording> = validate_on.iter().map(read_recording).collect::<anyhow::Result<_>>()?;
+    let start = std::time::Instant::now();
+    let report = discovery::diagnose_recordings(&sys, &fit, &val, &settings)?;
+    Ok(JointRun { report, seconds: start.elapsed().as_secs_f64() })
+}
+
+/// The model and the diagnosis settings (the initial values the model file states).
+fn model_and_settings(model_src: &Source, o: &DiagnoseOptions) -> anyhow::Result<(model::System, DiagnoseSettings)> {
     let (sys, stated) = match model_src {
         Source::File(p) => {
             let sys = super::load(p).with_context(|| format!("model {}", p.display()))?;
             (sys, None)
         }
         Source::Built(_, stated) => (model_src.system()?, Some(*stated)),
-    };
-    let rec = match rec {
-        RecordingSource::File(p) => {
-            let text = discovery::recording::read_checked(p, "recording", TimeColumn::Numeric("t"))?;
-            let source = p.display().to_string();
-            crate::budget::recording_rows(&source, &text)?;
-            Recording::parse_str(&text, &source)?
-        }
-        RecordingSource::Text { text, source } => {
-            crate::budget::recording_rows(source, text)?;
-            Recording::parse_checked(text, source)?
-        }
     };
     let stated = match (stated, model_src) {
         (Some(s), _) => s,
@@ -93,9 +117,23 @@ pub fn diagnose(model_src: &Source, rec: &RecordingSource, o: &DiagnoseOptions) 
         refit_nominal: o.refit_nominal,
         ..Default::default()
     };
-    let start = std::time::Instant::now();
-    let report = discovery::diagnose(&sys, &rec, &settings)?;
-    Ok(DiagnoseRun { report, seconds: start.elapsed().as_secs_f64() })
+    Ok((sys, settings))
+}
+
+/// A recording through the checked reader and the row budget.
+fn read_recording(rec: &RecordingSource) -> anyhow::Result<Recording> {
+    Ok(match rec {
+        RecordingSource::File(p) => {
+            let text = discovery::recording::read_checked(p, "recording", TimeColumn::Numeric("t"))?;
+            let source = p.display().to_string();
+            crate::budget::recording_rows(&source, &text)?;
+            Recording::parse_str(&text, &source)?
+        }
+        RecordingSource::Text { text, source } => {
+            crate::budget::recording_rows(source, text)?;
+            Recording::parse_checked(text, source)?
+        }
+    })
 }
 
 /// Writes every output of a report into the output directory `st` (made with
@@ -114,12 +152,29 @@ pub fn write_outputs(r: &Report, st: StagedDir) -> anyhow::Result<()> {
     std::fs::write(st.path("report.md"), r.to_markdown(&caps))?;
     std::fs::write(st.path("report.json"), serde_json::to_string_pretty(r)?)?;
     if let Some(m) = &r.fitted_model {
-        let text = model::to_toml_string(m);
-        if let (model::Input::Samples { path, .. }, Some(csv)) = (&m.input, m.input.samples_csv()) {
-            std::fs::write(st.path(path), csv)?;
-        }
-        std::fs::write(st.path("fitted.toml"), text)?;
-        model::load(&st.path("fitted.toml")).context("the fitted model does not read back (internal error)")?;
+        write_fitted(m, &st)?;
     }
     st.commit()
+}
+
+/// Writes the outputs of a joint diagnosis (`report.md`, `report.json`, `fitted.toml` and its
+/// input file) into `st`, all together.
+pub fn write_joint_outputs(r: &JointReport, st: StagedDir) -> anyhow::Result<()> {
+    std::fs::write(st.path("report.md"), r.to_markdown())?;
+    std::fs::write(st.path("report.json"), serde_json::to_string_pretty(r)?)?;
+    if let Some(m) = &r.fitted_model {
+        write_fitted(m, &st)?;
+    }
+    st.commit()
+}
+
+/// `fitted.toml` and its input file, read back.
+fn write_fitted(m: &model::System, st: &StagedDir) -> anyhow::Result<()> {
+    let text = model::to_toml_string(m);
+    if let (model::Input::Samples { path, .. }, Some(csv)) = (&m.input, m.input.samples_csv()) {
+        std::fs::write(st.path(path), csv)?;
+    }
+    std::fs::write(st.path("fitted.toml"), text)?;
+    model::load(&st.path("fitted.toml")).context("the fitted model does not read back (internal error)")?;
+    Ok(())
 }
