@@ -266,17 +266,18 @@ fn source(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
 
 /// `moreau theta FILE --json` (guidance as without `--no-guidance` when `guidance`).
 #[pyfunction]
-#[pyo3(signature = (model, *, measure=true, stationary=true, guidance=true))]
+#[pyo3(signature = (model, *, measure=true, stationary=true, guidance=true, step_check=false))]
 fn theta(
     py: Python<'_>,
     model: &Bound<'_, PyAny>,
     measure: bool,
     stationary: bool,
     guidance: bool,
+    step_check: bool,
 ) -> PyResult<String> {
     use commands::theta::{theta, ThetaOptions};
     let src = source(model)?;
-    let o = ThetaOptions { measure, stationary, guidance };
+    let o = ThetaOptions { measure, stationary, guidance, step_check };
     let v = py.detach(move || theta(&src, &o).and_then(|r| r.to_json())).map_err(err)?;
     to_json(&v)
 }

@@ -50,7 +50,9 @@ def _f64(b: bytes, shape: Any) -> np.ndarray:
     return np.frombuffer(b, dtype="<f8").reshape(shape).copy()
 
 
-def theta(model: Model, *, measure: bool = True, stationary: bool = True, guidance: bool = True) -> ThetaResult:
+def theta(
+    model: Model, *, measure: bool = True, stationary: bool = True, guidance: bool = True, step_check: bool = False
+) -> ThetaResult:
     """The bound theta of eq. (theta) with every quantity: ``moreau theta FILE --json``.
 
     Parameters
@@ -63,6 +65,9 @@ def theta(model: Model, *, measure: bool = True, stationary: bool = True, guidan
         Certify the stationary point (``False`` is ``--no-stationary``).
     guidance : bool, default True
         Add design guidance when nothing is certified (``False`` is ``--no-guidance``).
+    step_check : bool, default False
+        Measure again at a half and a quarter of the step and widen the measured intervals by
+        the change (``--step-check``; seven times the measurement's work).
 
     Returns
     -------
@@ -79,7 +84,9 @@ def theta(model: Model, *, measure: bool = True, stationary: bool = True, guidan
         one-line message.
     """
     return ThetaResult(
-        json.loads(_native.theta(_native_model(model), measure=measure, stationary=stationary, guidance=guidance))
+        json.loads(_native.theta(
+            _native_model(model), measure=measure, stationary=stationary, guidance=guidance, step_check=step_check
+        ))
     )
 
 

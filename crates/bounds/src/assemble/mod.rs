@@ -376,6 +376,7 @@ fn measured(
                     transient_periods: r.transient_periods,
                     h: r.h,
                     multiplier: r.multiplier.map(|u| [u.exponent, u.ci_low, u.ci_high]),
+                    step_error: r.step_error,
                 }),
                 Err(e) => {
                     notes.push(format!("measured side not computed: {e}"));

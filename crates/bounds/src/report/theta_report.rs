@@ -25,6 +25,17 @@ pub struct MeasuredSide {
     /// The dominant multiplier's exponent from the same pairs
     /// (`dynamics::rate::multipliers`): `[exponent, ci_low, ci_high]`.
     pub multiplier: Option<[f64; 3]>,
+    /// The stepping error added to both intervals (`RateSettings::step_check`); `None`: not
+    /// estimated, the intervals are the regression's and the blocks' only.
+    pub step_error: Option<f64>,
+}
+
+/// What a measured interval says about the stepping error.
+fn step_note(m: &MeasuredSide) -> String {
+    match m.step_error {
+        Some(e) => format!(", step h = {:.2e} (stepping error {e:.1e} included)", m.h),
+        None => format!(", step h = {:.2e} (stepping error not included: --step-check)", m.h),
+    }
 }
 
 /// Every quantity of the theta computation for one model.
@@ -241,10 +252,10 @@ impl ThetaReport {
             q.push(
                 MEASURED_RATE
                     .with(m.rate, false)
-                    .note(format!("95% CI [{:.4}, {:.4}], {} periods", m.ci_low, m.ci_high, m.periods)),
+                    .note(format!("95% CI [{:.4}, {:.4}], {} periods{}", m.ci_low, m.ci_high, m.periods, step_note(m))),
             );
             if let Some([e, lo, hi]) = m.multiplier {
-                q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]")));
+                q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]{}", step_note(m))));
             }
             q.push(PATH_MEASURED.with(m.path_length_per_period, false));
             q.push(ZDOT_MEASURED.with(m.limsup_zdot, false));

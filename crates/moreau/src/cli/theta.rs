@@ -27,6 +27,10 @@ pub struct Args {
     /// Skip the measured side (simulated pairs of trajectories).
     #[arg(long)]
     pub no_measure: bool,
+    /// Measure again at a half and a quarter of the step and widen the measured intervals by
+    /// the change (the catching-up step's error; seven times the measurement's work).
+    #[arg(long, conflicts_with = "no_measure")]
+    pub step_check: bool,
     /// Skip the stationary set of Theorem 1.
     #[arg(long)]
     pub no_stationary: bool,
@@ -252,7 +256,7 @@ pub fn explain(rep: &ThetaReport) -> String {
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     // `--brief` prints no guidance: computed only when a JSON object carries it
     let guidance = !a.no_guidance && (!a.brief || a.out.is_some());
-    let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance };
+    let o = ThetaOptions { measure: !a.no_measure, stationary: !a.no_stationary, guidance, step_check: a.step_check };
     // refused before the work, not after it
     crate::output::register_input(&a.file);
     if let Some(out) = &a.out {

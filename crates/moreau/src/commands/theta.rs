@@ -7,7 +7,8 @@ use bounds::beyond_paper::floquet::{self, FloquetEnclosure, FloquetSettings};
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use model::System;
 
-/// Options of `theta` (the CLI's `--no-measure`, `--no-stationary`, `--no-guidance`).
+/// Options of `theta` (the CLI's `--no-measure`, `--no-stationary`, `--no-guidance`,
+/// `--step-check`).
 #[derive(Debug, Clone, Copy)]
 pub struct ThetaOptions {
     /// Simulate the measured side (rate, path length, limsup |z'|).
@@ -16,11 +17,14 @@ pub struct ThetaOptions {
     pub stationary: bool,
     /// Design guidance when nothing is certified (and the model has no effects).
     pub guidance: bool,
+    /// Measure at the step, its half and its quarter and widen the measured intervals by the
+    /// change (`dynamics::rate::lyapunov_exponent::RateSettings::step_check`).
+    pub step_check: bool,
 }
 
 impl Default for ThetaOptions {
     fn default() -> Self {
-        Self { measure: true, stationary: true, guidance: true }
+        Self { measure: true, stationary: true, guidance: true, step_check: false }
     }
 }
 
@@ -70,6 +74,9 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
     let mut settings = ThetaSettings::default();
     if !o.measure {
         settings.measure = None;
+    }
+    if let Some(m) = settings.measure.as_mut() {
+        m.step_check = o.step_check;
     }
     if !o.stationary {
         settings.stationary = None;

@@ -29,7 +29,7 @@ fn model_file(data: &[u8]) -> Option<(tempfile::TempDir, PathBuf)> {
 pub fn theta(data: &[u8]) {
     let _registry = REGISTRY.lock().unwrap_or_else(|e| e.into_inner());
     let Some((_dir, p)) = model_file(data) else { return };
-    let o = ThetaOptions { measure: false, stationary: true, guidance: false };
+    let o = ThetaOptions { measure: false, stationary: true, guidance: false, step_check: false };
     let _ = crate::commands::theta::theta(&Source::File(p), &o);
     crate::output::forget_inputs();
 }
