@@ -249,11 +249,13 @@ impl ThetaReport {
             );
         }
         if let Some(m) = &self.measured {
-            q.push(
-                MEASURED_RATE
-                    .with(m.rate, false)
-                    .note(format!("95% CI [{:.4}, {:.4}], {} periods{}", m.ci_low, m.ci_high, m.periods, step_note(m))),
-            );
+            q.push(MEASURED_RATE.with(m.rate, false).note(format!(
+                "95% CI [{:.4}, {:.4}], {} periods{}",
+                m.ci_low,
+                m.ci_high,
+                m.periods,
+                step_note(m)
+            )));
             if let Some([e, lo, hi]) = m.multiplier {
                 q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]{}", step_note(m))));
             }

@@ -4,7 +4,9 @@
 //! - [`multipliers`]: the regime's dominant Floquet multiplier from the same pairs (a linear map
 //!   fitted to the differences at the ends of the periods), free of `ln V`'s wobble when it is a
 //!   complex pair.
+//! - [`statistics`]: least-squares slope and the Student-t quantile of its interval.
 //! - [`path_length`]: path length of `z` per period and the running maximum of `|z'|`.
 pub mod lyapunov_exponent;
 pub mod multipliers;
 pub mod path_length;
+pub mod statistics;

@@ -148,7 +148,7 @@ pub fn dominant_multiplier(per_pair: &[Vec<Transition>], period: f64) -> Option<
     };
     // a floor for the rounding of ln rho (an exponent of 1e-17 relative is not a measurement)
     let std_error = std_error.max(4.0 * f64::EPSILON * exponent.abs().max(1.0 / period));
-    let half = crate::rate::lyapunov_exponent::t_quantile_975(BLOCKS - 1) * std_error;
+    let half = crate::rate::statistics::t_quantile_975(BLOCKS - 1) * std_error;
     let mut moduli: Vec<f64> = whole.eig.iter().map(|z| z.norm()).collect();
     moduli.sort_by(|a, b| b.total_cmp(a));
     let top = whole.eig.iter().copied().max_by(|a, b| a.norm().total_cmp(&b.norm()));
@@ -213,7 +213,7 @@ mod tests {
             })
             .collect();
         let ts: Vec<f64> = (1..=logs.len()).map(|j| 2.0 * j as f64).collect();
-        let (b, _) = crate::rate::lyapunov_exponent::regression_slope(&ts, &logs);
+        let (b, _) = crate::rate::statistics::regression_slope(&ts, &logs);
         assert!((b - truth).abs() > 1e-3, "the regression happens to be exact: {b} vs {truth}");
     }
 
