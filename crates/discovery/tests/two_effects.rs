@@ -79,3 +79,17 @@ fn one_named_effect_is_not_called_incomplete() {
         assert!(!r.verdict.contains("still missing"), "{}", r.verdict);
     }
 }
+
+#[test]
+fn pair_search_fits_both_effects_jointly() {
+    // Backlash and Coulomb friction at once (seed 27, case 0): the greedy forward step added a
+    // second effect to a friction estimate that had absorbed the play and stopped at 2.3 times
+    // the noise level, non-white. Where something is left, pairs of the best singles are fitted
+    // jointly from their own estimates: a friction law and the backlash, white residual.
+    let case = bench_gen::generate_pair(["backlash", "coulomb_friction"], 27, 0, Profile::Classic).unwrap();
+    let r = run(&case);
+    let kinds: Vec<&str> = r.effects.iter().map(|e| e.kind.as_str()).collect();
+    assert!(kinds.contains(&"backlash"), "{}", r.verdict);
+    assert!(kinds.iter().any(|k| k.contains("friction") || k.contains("coulomb")), "{}", r.verdict);
+    assert!(r.residual_fitted.white && !r.model_incomplete, "{}", r.verdict);
+}
