@@ -414,3 +414,67 @@ mod tests {
         assert!(class_set("none,no-such-class").is_none());
     }
 }
+
+/// Outcome of one case with two concealed effects ([`bench_gen::generate_pair`], issue 27
+/// item 4).
+#[derive(Debug, Clone, Serialize)]
+pub struct PairResult {
+    pub pair: [String; 2],
+    pub index: usize,
+    pub description: String,
+    /// Every selected effect (`none` when nothing was added).
+    pub selected: String,
+    /// How many of the two concealed classes the selected model names.
+    pub named: usize,
+    /// The report's `model_incomplete`.
+    pub model_incomplete: bool,
+    /// Portmanteau statistic of the final residual and its threshold.
+    pub q_final: f64,
+    pub q_threshold: f64,
+    pub seconds: f64,
+    pub error: Option<String>,
+}
+
+/// Runs case `index` of the pair `pair` (`None` where the pair cannot co-occur), the true
+/// initial state handed over as in [`run_case_with`].
+pub fn run_pair_case(
+    pair: [&'static str; 2],
+    seed: u64,
+    index: usize,
+    profile: Profile,
+    s: &DiagnoseSettings,
+) -> Option<PairResult> {
+    let case = bench_gen::generate_pair(pair, seed, index, profile)?;
+    let mut s = s.clone();
+    if s.initial_state.is_none() {
+        s.initial_state = Some(crate::diagnose::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        });
+    }
+    let start = std::time::Instant::now();
+    let r = diagnose(&case.nominal, &case.recording, &s);
+    let mut out = PairResult {
+        pair: [pair[0].into(), pair[1].into()],
+        index,
+        description: case.description.clone(),
+        selected: "error".into(),
+        named: 0,
+        model_incomplete: false,
+        q_final: f64::NAN,
+        q_threshold: f64::NAN,
+        seconds: start.elapsed().as_secs_f64(),
+        error: None,
+    };
+    match r {
+        Err(e) => out.error = Some(e.to_string()),
+        Ok(rep) => {
+            out.selected = rep.selected();
+            out.named = case.truths.iter().filter(|t| rep.effects.iter().any(|e| e.kind == t.kind())).count();
+            out.model_incomplete = rep.model_incomplete;
+            out.q_final = rep.residual_fitted.q_auto;
+            out.q_threshold = rep.residual_fitted.q_auto_threshold;
+        }
+    }
+    Some(out)
+}

@@ -176,8 +176,13 @@ pub struct Case {
     pub class: &'static str,
     /// The nominal model handed to the diagnosis.
     pub nominal: System,
-    /// The true concealed effect.
+    /// The true concealed effect (the first of two with [`generate_pair`]).
     pub truth: Option<Effect>,
+    /// Every true concealed effect (one, none, or two with [`generate_pair`]), in the order of
+    /// `classes`.
+    pub truths: Vec<Effect>,
+    /// The concealed classes (`[class]`, or the pair).
+    pub classes: Vec<&'static str>,
     pub recording: Recording,
     /// Fit % of the nominal model (true initial state) on the noisy recording.
     pub nominal_fit: f64,
@@ -401,8 +406,57 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
 
 /// Generates case number `index` of `class` from `seed` in `profile`.
 pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
+    generate_classes(&[class], seed, index, profile)
+}
+
+/// Whether two classes can be concealed in one recording by [`generate_pair`]: distinct, not
+/// `none`, not two frictions, and neither a concealed backlash with a change of the nominal's
+/// play (gap width, backlash inertia: a concealed backlash means the nominal has no play).
+pub fn pair_compatible(a: &str, b: &str) -> bool {
+    let friction = |c: &str| c == names::COULOMB_FRICTION || FRICTION_CLASSES.contains(&c);
+    let play = |c: &str| c == names::GAP_WIDTH || c == names::BACKLASH_INERTIA;
+    a != b
+        && a != NONE
+        && b != NONE
+        && !(friction(a) && friction(b))
+        && !((a == names::BACKLASH && play(b)) || (b == names::BACKLASH && play(a)))
+        && all_classes().contains(&a)
+        && all_classes().contains(&b)
+}
+
+/// Every pair of [`CLASSES`] that [`pair_compatible`] allows (each once, in class order).
+pub fn pairs() -> Vec<[&'static str; 2]> {
+    let mut v = Vec::new();
+    for (i, &a) in CLASSES.iter().enumerate() {
+        for &b in &CLASSES[i + 1..] {
+            if pair_compatible(a, b) {
+                v.push([a, b]);
+            }
+        }
+    }
+    v
+}
+
+/// Generates case number `index` with two concealed effects at once (issue 27 item 4), each
+/// of a magnitude that alone drops the nominal fit to its own target in [86, 94] %; the
+/// plant, input and noise are drawn as for the first class alone. `None` where the pair is not
+/// [`pair_compatible`].
+pub fn generate_pair(pair: [&'static str; 2], seed: u64, index: usize, profile: Profile) -> Option<Case> {
+    pair_compatible(pair[0], pair[1]).then(|| generate_classes(&pair, seed, index, profile))
+}
+
+/// Generates case number `index` concealing every class of `classes` (one, or a pair) from
+/// `seed` in `profile`. One class draws exactly what it always did; the second of a pair takes
+/// its target and sign from a stream of its own.
+fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: Profile) -> Case {
+    let class = classes[0];
     let class_index = all_classes().iter().position(|c| *c == class).unwrap_or(0);
-    let mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
+    let mut mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
+    if let Some(&second) = classes.get(1) {
+        let i2 = all_classes().iter().position(|c| *c == second).unwrap_or(0);
+        mix ^= (i2 as u64 + 1) << 48;
+    }
+    let has = |c: &str| classes.contains(&c);
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
     let mut fshape = FrictionShape::draw(mix);
     let digital = profile == Profile::Digital;
@@ -423,9 +477,9 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     let t: Vec<f64> = (0..ns).map(|k| k as f64 * dt).collect();
     let w: Vec<f64> = t.iter().map(|&tk| signal.eval(tk)).collect();
     let wmax = w.iter().map(|v| v.abs()).fold(0.0, f64::max);
-    let nominal_has_play = class != names::BACKLASH;
+    let nominal_has_play = !has(names::BACKLASH);
     let mut plant = plant;
-    if class == names::BACKLASH_INERTIA {
+    if has(names::BACKLASH_INERTIA) {
         // Coasting is bounded by the gap: the effect needs a play wide enough to be seen, and
         // its time constant is capped at half a natural period (see the bisection below).
         plant.half_width = rng.random_range(0.15..0.3);
@@ -448,18 +502,34 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
         - clean_nom.iter().copied().fold(f64::INFINITY, f64::min);
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let noise = measurement_noise(&mut rng, ns, noise_std, noise_rho);
-    let measure = |eff: Option<&Effect>| -> Vec<f64> {
-        plant_sim::simulate(&plant, hw_nom, eff, &signal, &x0, dt, ns, zoh)
+    let measure_all = |effs: &[&Effect]| -> Vec<f64> {
+        plant_sim::simulate_effects(&plant, hw_nom, effs, &signal, &x0, dt, ns, zoh)
             .iter()
             .zip(&noise)
             .map(|(a, b)| a + b)
             .collect()
     };
-    let fit_at =
-        |a: f64| fit_percent(&measure(effect_at(class, a, sign, wmax, plant.vel, &fshape).as_ref()), &clean_nom);
-    let truth_a = if class == NONE { 0.0 } else { truth_magnitude(class, fit_at, target, period, ystd) };
-    let truth = effect_at(class, truth_a, sign, wmax, plant.vel, &fshape);
-    let y = measure(truth.as_ref());
+    // Each class's magnitude alone (the second of a pair: target and sign of its own stream).
+    let mut r2 = ChaCha8Rng::seed_from_u64(mix ^ 0x7A1B_0000_0000_0027);
+    let truths: Vec<Effect> = classes
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &c)| {
+            let (target, sign) = if i == 0 {
+                (target, sign)
+            } else {
+                (r2.random_range(86.0..94.0), if r2.random::<bool>() { 1.0 } else { -1.0 })
+            };
+            let fit_at = |a: f64| {
+                let e = effect_at(c, a, sign, wmax, plant.vel, &fshape);
+                fit_percent(&measure_all(e.iter().collect::<Vec<_>>().as_slice()), &clean_nom)
+            };
+            let a = if c == NONE { 0.0 } else { truth_magnitude(c, fit_at, target, period, ystd) };
+            effect_at(c, a, sign, wmax, plant.vel, &fshape)
+        })
+        .collect();
+    let truth = truths.first().cloned();
+    let y = measure_all(&truths.iter().collect::<Vec<_>>());
     let nominal_fit = fit_percent(&y, &clean_nom);
     let theta = if nominal_has_play {
         geometry::Shape::Interval(geometry::Interval::symmetric(plant.half_width).expect("positive half-width"))
@@ -469,7 +539,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
     let x0v = DVector::from_column_slice(&x0);
     let z0 = &plant.C * &x0v;
     let nominal = System::builder()
-        .name(format!("bench {class} #{index} (n = {n})"))
+        .name(format!("bench {} #{index} (n = {n})", classes.join("+")))
         .A(plant.A.clone())
         .B(plant.B.clone())
         .C(plant.C.clone())
@@ -482,7 +552,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
         .build()
         .expect("generated plant is valid");
     let recording = Recording::from_samples(
-        &format!("bench-{class}-{index}"),
+        &format!("bench-{}-{index}", classes.join("+")),
         &t,
         w.iter().map(|v| vec![*v]).collect(),
         y.iter().map(|v| vec![*v]).collect(),
@@ -502,7 +572,7 @@ pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: P
         plant.zeta,
         conditions.short()
     );
-    Case { class, nominal, truth, recording, nominal_fit, description, conditions }
+    Case { class, nominal, truth, truths, classes: classes.to_vec(), recording, nominal_fit, description, conditions }
 }
 
 /// A standard normal sample (Box-Muller).

@@ -26,38 +26,55 @@ pub fn simulate(
     ns: usize,
     zoh: bool,
 ) -> Vec<f64> {
+    simulate_effects(pl, hw, eff.as_slice(), sig, x0, dt, ns, zoh)
+}
+
+/// [`simulate`] with every effect of `effs` at once (two concealed effects, issue 27 item 4):
+/// each acts as it does alone (a play widened by both a backlash and a gap change takes both,
+/// the backlash first; at most one of the friction library and one cogging force).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_effects(
+    pl: &Plant,
+    hw: f64,
+    effs: &[&Effect],
+    sig: &Signal,
+    x0: &[f64],
+    dt: f64,
+    ns: usize,
+    zoh: bool,
+) -> Vec<f64> {
     let n = pl.A.nrows();
     let h = dt / FINE as f64;
     let mut hw = hw;
     let (mut delay, mut sat, mut force, mut fric, mut tau, mut offset) = (0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0);
-    match eff {
-        Some(Effect::Backlash { width, location: PlayLocation::Loop }) => hw += 0.5 * width,
-        Some(Effect::GapWidth { relative_change }) => hw *= 1.0 + relative_change,
-        Some(Effect::InputDelay { delay: d }) => delay = *d,
-        Some(Effect::InputSaturation { limit }) => sat = *limit,
-        Some(Effect::ConstantForce { force: f, .. }) => force = *f,
-        Some(Effect::CoulombFriction { level, .. }) => fric = *level,
-        Some(Effect::BacklashInertia { mass, damping }) => tau = mass / damping,
-        Some(Effect::SensorOffset { offset: o }) => offset = o[0],
-        _ => {}
-    }
+    let mut gap = 1.0;
     // The friction library: (sliding up, sliding down, static excess, Stribeck velocity) and
     // the cogging force (amplitude, wavenumber, phase) with position state 0.
-    let lib: Option<(f64, f64, f64, f64)> = match eff {
-        Some(Effect::StribeckFriction { level, static_level, stribeck_velocity, .. }) => {
-            Some((*level, *level, static_level - level, *stribeck_velocity))
+    let mut lib: Option<(f64, f64, f64, f64)> = None;
+    let mut cog: Option<(f64, f64, f64, usize)> = None;
+    for eff in effs {
+        match eff {
+            Effect::Backlash { width, location: PlayLocation::Loop } => hw += 0.5 * width,
+            Effect::GapWidth { relative_change } => gap *= 1.0 + relative_change,
+            Effect::InputDelay { delay: d } => delay = *d,
+            Effect::InputSaturation { limit } => sat = *limit,
+            Effect::ConstantForce { force: f, .. } => force = *f,
+            Effect::CoulombFriction { level, .. } => fric = *level,
+            Effect::BacklashInertia { mass, damping } => tau = mass / damping,
+            Effect::SensorOffset { offset: o } => offset = o[0],
+            Effect::StribeckFriction { level, static_level, stribeck_velocity, .. } => {
+                lib = Some((*level, *level, static_level - level, *stribeck_velocity))
+            }
+            Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
+                lib = Some((*level_positive, *level_negative, 0.0, 1.0))
+            }
+            Effect::Cogging { amplitude, period, phase, position_state, .. } => {
+                cog = Some((*amplitude, std::f64::consts::TAU / period, *phase, *position_state))
+            }
+            _ => {}
         }
-        Some(Effect::AsymmetricCoulomb { level_positive, level_negative, .. }) => {
-            Some((*level_positive, *level_negative, 0.0, 1.0))
-        }
-        _ => None,
-    };
-    let cog: Option<(f64, f64, f64, usize)> = match eff {
-        Some(Effect::Cogging { amplitude, period, phase, position_state, .. }) => {
-            Some((*amplitude, std::f64::consts::TAU / period, *phase, *position_state))
-        }
-        _ => None,
-    };
+    }
+    hw *= gap;
     let input = |t: f64| {
         let s = t - delay;
         // Held: the sample at or before `s` (a hair of tolerance so that the fine grid's

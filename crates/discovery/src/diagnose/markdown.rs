@@ -18,6 +18,7 @@ impl Report {
             &self.localisation.null,
             &self.units,
         );
+        s += &self.md_remaining();
         s += &self.md_missing_inputs();
         s += &self.md_plant_parameters();
         s += &self.md_effects();
@@ -85,6 +86,45 @@ impl Report {
             r.mean, r.mean_bound, if r.zero_mean { "zero mean" } else { "offset" }, r.q_auto, r.q_auto_threshold, r.lags, r.lag_step, if r.white { "white" } else { "not white" }, fmt_vec(&r.q_cross), r.q_cross_threshold, if r.uncorrelated { "uncorrelated" } else { "correlated" },
             self.residual_fitted.white, self.residual_fitted.uncorrelated, self.residual_fitted.q_auto, fmt_vec(&self.residual_fitted.q_cross)
         );
+        s
+    }
+
+    /// What the final model leaves unexplained (where it is incomplete).
+    fn md_remaining(&self) -> String {
+        let Some(r) = &self.remaining else { return String::new() };
+        let mut s = format!(
+            "\n## Still missing\n\nThe final model's residual is not white (Q = {:.1} against the 99 % threshold {:.1}; {:.1} with an AR(1) noise colour of {} removed; {} with the input) and its RMS is {} times the noise level: the model is incomplete. Where the residual left concentrates:\n\n",
+            r.q_auto,
+            r.q_auto_threshold,
+            r.q_auto_ar1,
+            r.ar1.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", "),
+            r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", "),
+            if r.uncorrelated { "uncorrelated" } else { "correlated" }
+        );
+        if r.windows.is_empty() {
+            s += "- no window stands out (spread over the record)\n";
+        }
+        for w in &r.windows {
+            s += &format!(
+                "- t = {:.4}-{:.4} s: {:.1} % of the energy in {:.1} % of the time, mostly {} ({:.0} %)\n",
+                w.t_start,
+                w.t_end,
+                100.0 * w.share_energy,
+                100.0 * w.share_time,
+                w.dominant_regime,
+                100.0 * w.dominant_fraction
+            );
+        }
+        if !r.regimes.is_empty() {
+            s += &format!(
+                "- enriched regimes: {}\n",
+                r.regimes
+                    .iter()
+                    .map(|g| format!("{} ({:.1} x the time share)", g.regime, g.enrichment))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
         s
     }
 

@@ -113,7 +113,7 @@ impl<'a> Pass<'a> {
         // Hypotheses. State scales and the nominal run for data-derived bounds and starts
         // (hypothesis.rs).
         self.ctx.scales = self.ctx.scales.clone().with_nominal(&nom_sim.x, &nom_sim.y, &self.ctx.y, data.k_est);
-        let plan = s.plan();
+        let plan = select::Plan { whiteness: Some((s.lags, data.lag_step)), ..s.plan() };
         let singles =
             select::candidate::fit_singles(&self.ctx, &plan, data.sys, &self.nom, self.prev_singles.as_deref());
         let overturned = hold::overturned_by_effects(

@@ -136,6 +136,29 @@ pub struct LocalisationInfo {
     pub null: localise::NullReference,
 }
 
+/// What the final model leaves unexplained (issue 27 item 4): its residual's whiteness tests, its
+/// size against the noise, and where the residual's energy concentrates (the localisation of [`localise`] run on the final
+/// residual instead of the nominal one).
+#[derive(Debug, Clone, Serialize)]
+pub struct Remaining {
+    /// Portmanteau statistic of the final residual and its 99 % threshold.
+    pub q_auto: f64,
+    pub q_auto_threshold: f64,
+    /// The same statistic once an AR(1) filter is removed from the residual (coloured
+    /// measurement noise alone passes then), and the filter's coefficient per output.
+    pub q_auto_ar1: f64,
+    pub ar1: Vec<f64>,
+    /// RMS of the final residual over the noise level, per output (above
+    /// [`super::INCOMPLETE_NOISE_RATIO`] for at least one).
+    pub rms_over_noise: Vec<f64>,
+    /// Whether the final residual is uncorrelated with every input (1 % level).
+    pub uncorrelated: bool,
+    /// Windows where the final residual's energy concentrates (largest share first).
+    pub windows: Vec<Window>,
+    /// Regimes in which the final residual's energy is enriched against the null.
+    pub regimes: Vec<RegimeShare>,
+}
+
 /// Time series kept for figures.
 #[derive(Debug, Clone, Default)]
 pub struct Series {
@@ -190,6 +213,13 @@ pub struct Report {
     pub residual_fitted: ResidualTests,
     /// Whether the nominal residual passes both tests.
     pub nominal_adequate: bool,
+    /// Whether the final model (the selected one, else the nominal) still leaves a residual that
+    /// is not white (nor once an AR(1) noise colour is removed) and above the noise level, where
+    /// the nominal was not adequate: something is still missing, and `remaining` says where
+    /// (issue 27 item 4). False where a missing input was found (the verdict names it).
+    pub model_incomplete: bool,
+    /// With `model_incomplete`: what is left and where.
+    pub remaining: Option<Remaining>,
     pub verdict: String,
     pub effects: Vec<FittedEffect>,
     /// What the reported 1-sigma of the fitted parameters includes, and what it does not.

@@ -174,6 +174,7 @@ impl DiagnoseSettings {
             max_effects: self.max_effects,
             max_second: self.max_second,
             parallel: self.parallel,
+            whiteness: None,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! where fit % saturates) and its text ([`verdict`]: nothing missing, an input missing, the
 //! missing physics or refitted plant parameters, or nothing the library explains).
 use super::markdown::{fmt_opt, fmt_units, g4};
-use super::report::NominalValue;
+use super::report::{NominalValue, Remaining};
 use super::settings::{Metric, SERVO_FIT_PERCENT};
 use super::setup::Setup;
 use crate::fit::missing_input::MissingInput;
@@ -125,4 +125,53 @@ fn fmt_nominal(v: &[NominalValue]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The verdict's addition where the final model is incomplete (issue 27 item 4): something is
+/// still missing, the whiteness test that says so, where the residual left concentrates (the
+/// two largest windows and the enriched regimes), and why the selection stopped there.
+pub(super) fn still_missing(r: &Remaining, chosen: Option<&Ranked>, max_effects: usize) -> String {
+    let whose = if chosen.is_some() { "the selected model's" } else { "the nominal" };
+    let windows: Vec<String> = r
+        .windows
+        .iter()
+        .take(2)
+        .map(|w| {
+            format!(
+                "t = {:.3}-{:.3} s ({:.0} % of the energy in {:.0} % of the time, mostly {})",
+                w.t_start,
+                w.t_end,
+                100.0 * w.share_energy,
+                100.0 * w.share_time,
+                w.dominant_regime
+            )
+        })
+        .collect();
+    let regimes: Vec<&str> = r.regimes.iter().map(|g| g.regime.as_str()).collect();
+    let mut at = String::new();
+    if !windows.is_empty() {
+        at += &format!("; what is left concentrates in {}", windows.join(" and "));
+    }
+    if !regimes.is_empty() {
+        at += &format!("; enriched in: {}", regimes.join(", "));
+    }
+    if windows.is_empty() && regimes.is_empty() {
+        at += "; spread over the record (no window or regime stands out)";
+    }
+    let why = match chosen {
+        Some(c) if c.parts.len() >= max_effects => {
+            format!(" (the selection stops at --max-effects {max_effects})")
+        }
+        Some(_) => {
+            " (no further effect of the library passed the BIC margin and the held-out folds: see the ranking)".into()
+        }
+        None => String::new(),
+    };
+    format!(
+        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
+        r.q_auto,
+        r.q_auto_threshold,
+        r.q_auto_ar1,
+        r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ")
+    )
 }

@@ -140,6 +140,26 @@ pub fn test_outputs(e: &[f64], w: &[f64], n: usize, m: usize, p: usize, lags: us
     t.expect("p >= 1")
 }
 
+/// A time-major residual `e` (`n` samples of `p` outputs) with an AR(1) filter removed from
+/// each output: `e_k - rho e_{k-1}`, `rho` the output's lag-one autocorrelation (clamped to
+/// [0, 0.99]); the filtered residual and the `rho` of each output. Coloured measurement noise
+/// (AR(1)) leaves an exact model's residual non-white, and its filtered residual white; a model
+/// error the filter cannot account for leaves the filtered residual non-white too.
+pub fn prewhiten_ar1(e: &[f64], n: usize, p: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut out = vec![0.0; e.len()];
+    let mut rhos = Vec::with_capacity(p);
+    for i in 0..p {
+        let col = centred(&(0..n).map(|k| e[k * p + i]).collect::<Vec<_>>());
+        let rho = (xcorr(&col, &col, 1) / xcorr(&col, &col, 0).max(1e-300)).clamp(0.0, 0.99);
+        for k in 1..n {
+            out[k * p + i] = col[k] - rho * col[k - 1];
+        }
+        out[i] = col[0] * (1.0 - rho * rho).sqrt();
+        rhos.push(rho);
+    }
+    (out, rhos)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

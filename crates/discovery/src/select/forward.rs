@@ -49,8 +49,16 @@ pub(crate) fn select_all(
         // the nominal model, refitted where it frees parameters, and nothing added)
         if let Some(best) = singles.iter().find(|r| r.beats_nominal && r.parts.len() <= plan.max_effects) {
             ties = sel.ties(&singles, best);
-            let (cur, tried) = sel.forward(&singles, best.clone(), &base_sse);
+            let (mut cur, tried) = sel.forward(&singles, best.clone(), &base_sse);
             extra = tried;
+            // Something left after the greedy steps: pairs of the best singles, fitted jointly.
+            if plan.max_effects >= 2 && sel.something_left(&cur) {
+                let (better, pairs) = sel.pair_search(&singles, &extra, &cur);
+                extra.extend(pairs);
+                if let Some(b) = better {
+                    cur = b;
+                }
+            }
             chosen = Some(cur);
         }
     }
@@ -225,6 +233,111 @@ impl Selector<'_, '_> {
         (cur, extra)
     }
 
+    /// Whether `cur`'s residual says something is left: not white, nor once an AR(1) noise
+    /// colour is removed (coloured measurement noise alone passes then).
+    fn something_left(&self, cur: &Ranked) -> bool {
+        let ctx = self.ctx;
+        let Some((lags, step)) = self.plan.whiteness else { return false };
+        let Some(sim) = cur.problem(ctx).simulate(&cur.params, &cur.x0, None) else { return false };
+        let e: Vec<f64> = ctx.y.iter().zip(&sim.y).map(|(a, b)| a - b).collect();
+        let test = |e: &[f64]| crate::residual::test_outputs(e, &ctx.w, ctx.n, ctx.m, ctx.p, lags, step).white;
+        !test(&e) && !test(&crate::residual::prewhiten_ar1(&e, ctx.n, ctx.p).0)
+    }
+
+    /// Where the greedy steps leave something (issue 27 item 4): the greedy second effect is
+    /// fitted from the first's estimate, which has absorbed what it could of the second effect
+    /// (a friction level raised to stand in for a wider gap), and its candidates are the best
+    /// singles, which may all be variants of the first (every friction law). Here every pair
+    /// of distinct, non-rival kinds among the best [`PAIR_POOL`] singles that clear the margin
+    /// is fitted jointly from both singles' own estimates; the best pairs that clear the margin
+    /// against `cur` are cross-validated against it until one passes (returned). A pair with a
+    /// generalisation (Stribeck over Coulomb friction) gives way to the pair with its simpler
+    /// form where that also passes against `cur` and the generalisation is not supported over
+    /// it on held-out folds. Also returned: every pair fitted (for the ranking).
+    fn pair_search(&self, singles: &[Ranked], tried: &[Ranked], cur: &Ranked) -> (Option<Ranked>, Vec<Ranked>) {
+        let (ctx, plan) = (self.ctx, self.plan);
+        let pool: Vec<&Ranked> = singles
+            .iter()
+            .filter(|r| {
+                r.parts.len() == 1
+                    && !r.refit
+                    && self.bic_nom - r.bic >= self.margin
+                    && matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations)
+            })
+            .take(PAIR_POOL)
+            .collect();
+        let same_labels = |a: &[String], b: &[String]| {
+            let (mut a, mut b) = (a.to_vec(), b.to_vec());
+            a.sort();
+            b.sort();
+            a == b
+        };
+        let label_of = |r: &Ranked| r.parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>();
+        let mut todo: Vec<(&Ranked, &Ranked)> = Vec::new();
+        for (i, a) in pool.iter().enumerate() {
+            for b in &pool[i + 1..] {
+                let (ka, kb) = (a.parts[0].kind, b.parts[0].kind);
+                let labels = vec![ka.label(), kb.label()];
+                if rivals(ka, kb)
+                    || tried.iter().chain(std::iter::once(cur)).any(|t| !t.refit && same_labels(&label_of(t), &labels))
+                {
+                    continue;
+                }
+                todo.push((a, b));
+            }
+        }
+        // Each single's estimate has absorbed part of the other effect: started from both
+        // estimates and from both scaled down (PAIR_START_SCALES), the best fit kept.
+        let f = |(a, b): &(&Ranked, &Ranked)| {
+            PAIR_START_SCALES
+                .iter()
+                .map(|&c| {
+                    let warm: Vec<f64> = a.params.iter().chain(&b.params).map(|v| c * v).collect();
+                    fit_hypothesis(
+                        ctx,
+                        plan,
+                        vec![a.parts[0].clone(), b.parts[0].clone()],
+                        None,
+                        Some(warm),
+                        &a.x0,
+                        self.bic_nom,
+                        self.val_sse_nom,
+                    )
+                })
+                .min_by(|x, y| x.bic.total_cmp(&y.bic))
+                .expect("at least one start")
+        };
+        let mut pairs: Vec<Ranked> =
+            if plan.parallel { todo.par_iter().map(f).collect() } else { todo.iter().map(f).collect() };
+        pairs.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+        let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| cv_sse_of(ctx, plan, cur));
+        let Some(mut best) = self.accept_combination(&mut pairs, cur, &cur_sse) else { return (None, pairs) };
+        // The simpler form of a generalisation in the pair, where it does as well.
+        for (i, h) in best.parts.clone().iter().enumerate() {
+            let Some(simple) = h.kind.simpler_form() else { continue };
+            let mut labels = label_of(&best);
+            labels[i] = simple.label();
+            let Some(si) = pairs.iter().position(|r| same_labels(&label_of(r), &labels)) else { continue };
+            let sse_s = cv_sse_of(ctx, plan, &pairs[si]);
+            let cv = cross_validate(ctx, plan, &best, &pairs[si], &sse_s);
+            if cv.status == "not_testable" || hypothesis::nested_supported(&cv.sse, &sse_s) {
+                continue;
+            }
+            let cv0 = cross_validate(ctx, plan, &pairs[si], cur, &cur_sse);
+            if cv0.status != "failed" {
+                best.beats_nominal = false;
+                if let Some(b) = pairs.iter_mut().find(|r| r.label == best.label) {
+                    b.beats_nominal = false;
+                }
+                pairs[si].beats_nominal = true;
+                pairs[si].cv = Some(cv0);
+                best = pairs[si].clone();
+                break;
+            }
+        }
+        (Some(best), pairs)
+    }
+
     /// Cross-validates the best few combinations that clear the margin against `cur`, until
     /// one passes (returned).
     fn accept_combination(&self, combos: &mut [Ranked], cur: &Ranked, base_sse: &[f64]) -> Option<Ranked> {
@@ -244,6 +357,19 @@ impl Selector<'_, '_> {
         }
         None
     }
+}
+
+/// How many of the best singles the pair search draws its pairs from.
+pub const PAIR_POOL: usize = 6;
+
+/// The pair search's starts: both singles' estimates times each of these.
+pub const PAIR_START_SCALES: [f64; 3] = [1.0, 0.6, 0.3];
+
+/// Two kinds that stand for the same physics (the same kind, or one the simpler form of the
+/// other, or two generalisations of one simpler form): not paired.
+fn rivals(a: hypothesis::Kind, b: hypothesis::Kind) -> bool {
+    let (sa, sb) = (a.simpler_form(), b.simpler_form());
+    a.name() == b.name() || sa == Some(b) || sb == Some(a) || (sa.is_some() && sa == sb)
 }
 
 /// Evidence of every fit; conclusive fits by BIC, stuck ones last (they are not evidence

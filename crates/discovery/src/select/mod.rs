@@ -56,6 +56,10 @@ pub struct Plan<'a> {
     pub max_effects: usize,
     pub max_second: usize,
     pub parallel: bool,
+    /// `(lags, lag_step)` of the residual whiteness test (`None`: not known, no pair search):
+    /// where the greedy forward selection stops with a residual that is not white, pairs of the
+    /// best singles are fitted jointly ([`forward`], issue 27 item 4).
+    pub whiteness: Option<(usize, usize)>,
 }
 
 /// `N log(SSE/N) + k log N`.
