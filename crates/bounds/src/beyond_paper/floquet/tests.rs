@@ -30,6 +30,25 @@ fn worked_example_is_verified_tight_and_inside_the_measured_interval() {
     assert!(s_lo <= T + 1e-12 && T - 1e-12 <= s_hi, "{s_lo} {s_hi}");
 }
 
+/// The enclosure against the dominant multiplier measured from simulated pairs (catching-up,
+/// no saltation, no interval): with the stepping error in its interval (`step_check`) the
+/// measurement brackets the proof; negative control: at one step, without the check, its
+/// interval (the blocks' spread only) is far narrower than the catching-up error and misses it.
+#[test]
+fn the_step_checked_multiplier_measurement_overlaps_the_enclosure() {
+    use dynamics::rate::lyapunov_exponent::{measure_rate, RateSettings};
+    let sys = worked();
+    let [lo, hi] = floquet_enclosure(&sys, &FloquetSettings::default()).floquet_exponent;
+    let settings = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
+    let checked = measure_rate(&sys, &RateSettings { step_check: true, ..settings.clone() }, None).unwrap();
+    let m = checked.multiplier.expect("a multiplier is measured");
+    assert!(m.ci_low <= hi && lo <= m.ci_high, "measured [{}, {}] vs proven [{lo}, {hi}]", m.ci_low, m.ci_high);
+    assert!(m.ci_high - m.ci_low < 2e-3, "an interval this wide says nothing: [{}, {}]", m.ci_low, m.ci_high);
+    assert!(checked.step_error.is_some_and(|e| e > 0.0));
+    let plain = measure_rate(&sys, &settings, None).unwrap().multiplier.unwrap();
+    assert!(plain.ci_high < lo || hi < plain.ci_low, "[{}, {}] vs [{lo}, {hi}]", plain.ci_low, plain.ci_high);
+}
+
 /// The shooting system at its verified zero, with the structure it came from.
 fn solved(sys: &System) -> (Generators, PhaseStructure, Vec<f64>) {
     let st = structure(sys, &FloquetSettings::default()).unwrap();
