@@ -122,3 +122,24 @@ fn coulomb_friction_inside_the_ticks_converges_with_the_substeps() {
         .y;
     assert!(max_rel_err(&free, &y64) > 10.0 * e8);
 }
+
+#[test]
+fn the_closed_loop_decay_rate_is_that_of_the_simulation() {
+    // Free response from x0 = (1 mm, 0) with w = 0: the envelope decays at the rate mu.
+    let dt = 1e-3;
+    let sys = model::parse_str(&model_text(1, dt, 0.0)).unwrap();
+    let mu = dynamics::extended::closed_loop_mu(&sys).unwrap();
+    assert!(mu < 0.0, "{mu}");
+    let ns = 4000;
+    let y = ExtendedModel::new(&sys, &[], dt, 1).unwrap().simulate(&vec![0.0; ns], dt, &[1e-3, 0.0]).y;
+    let peak = |a: usize, b: usize| y[a..b].iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let rate = (peak(3000, 3500) / peak(1000, 1500)).ln() / 2.0;
+    eprintln!("closed-loop mu {mu}, measured decay {rate}");
+    assert!((rate / mu - 1.0).abs() < 0.1, "{rate} against {mu}");
+    // negative control: a loop made unstable by a large velocity gain has mu > 0
+    let hot = model::parse_str(&model_text(1, dt, 0.0).replace("kv = 300", "kv = 3000")).unwrap();
+    assert!(dynamics::extended::closed_loop_mu(&hot).unwrap() > 0.0);
+    // no controller: none
+    let plain = model::parse_str(&model_text(1, dt, 0.0).split("[controller]").next().unwrap().to_string()).unwrap();
+    assert!(dynamics::extended::closed_loop_mu(&plain).is_none());
+}

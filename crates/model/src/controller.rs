@@ -83,6 +83,23 @@ impl StateSpaceLaw {
 
 const KEYS: &str = "period, delay, kind, kp, kv, ki, kd, velocity_filter, derivative_filter, Ac, Bc, Cc, Dc, x0";
 
+/// The law without its last state (the integrator) when `ki = 0`: that state never reaches the
+/// output, and its eigenvalue 1 would make the closed loop look marginally stable.
+fn without_unused_integrator(law: StateSpaceLaw, ki: f64) -> StateSpaceLaw {
+    if ki != 0.0 {
+        return law;
+    }
+    let k = law.Ac.nrows() - 1;
+    StateSpaceLaw {
+        Ac: law.Ac.view((0, 0), (k, k)).into_owned(),
+        Bc: law.Bc.rows(0, k).into_owned(),
+        Cc: law.Cc.columns(0, k).into_owned(),
+        Dc: law.Dc,
+        memory: law.memory,
+        x0: law.x0[..k].to_vec(),
+    }
+}
+
 fn filter_coeff(period: f64, tau: f64) -> f64 {
     if tau > 0.0 {
         (-period / tau).exp()
@@ -120,7 +137,7 @@ impl Controller {
                 let Bc = DMatrix::from_row_slice(3, 2, &[0.0, 1.0, 0.0, b, T * ev_e[0], T * ev_e[1]]);
                 let Cc = DMatrix::from_row_slice(1, 3, &[kv * ev_x[0], kv * ev_x[1], *ki]);
                 let Dc = DMatrix::from_row_slice(1, 2, &[kv * ev_e[0], kv * ev_e[1]]);
-                StateSpaceLaw { Ac, Bc, Cc, Dc, memory: vec![(0, 1)], x0: vec![0.0; 3] }
+                without_unused_integrator(StateSpaceLaw { Ac, Bc, Cc, Dc, memory: vec![(0, 1)], x0: vec![0.0; 3] }, *ki)
             }
             ControlLaw::Pid { kp, ki, kd, derivative_filter } => {
                 // x_c = [e_prev, d_prev, I], e = w - y
@@ -132,7 +149,7 @@ impl Controller {
                 let g = kp + kd * b;
                 let Dc = DMatrix::from_row_slice(1, 2, &[g, -g]);
                 // e_prev starts at e_0 = w_0 - y_0 (set by `Controller::start_state`)
-                StateSpaceLaw { Ac, Bc, Cc, Dc, memory: vec![], x0: vec![0.0; 3] }
+                without_unused_integrator(StateSpaceLaw { Ac, Bc, Cc, Dc, memory: vec![], x0: vec![0.0; 3] }, *ki)
             }
             ControlLaw::StateSpace { Ac, Bc, Cc, Dc, x0 } => StateSpaceLaw {
                 Ac: Ac.clone(),

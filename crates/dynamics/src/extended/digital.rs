@@ -156,3 +156,43 @@ impl ExtendedModel {
         out
     }
 }
+
+/// The closed sampled loop's decay rate as a continuous-time spectral abscissa:
+/// `mu = ln(rho) / period` with `rho` the spectral radius of the map over one period of the
+/// linearised loop (plant `F = A + E C` held over the period, controller state, and the `d`
+/// commands in flight of the computation delay), reference 0. `None` without a controller.
+/// `mu < 0` iff the sampled loop is asymptotically stable (`-inf` for a deadbeat loop).
+pub fn closed_loop_mu(sys: &model::System) -> Option<f64> {
+    let c = sys.controller.as_ref()?;
+    let (n, m, p) = (sys.n(), sys.m(), sys.p());
+    let law = c.law();
+    let nc = law.Ac.nrows();
+    let d = c.delay;
+    let T = c.period;
+    let I = crate::linear::expm::exp_integrals(&sys.F(), T);
+    let (Phi, Gam) = (I.phi, &I.gamma1 * &sys.B);
+    // the law's response to the sampled output y = C x (the reference columns dropped)
+    let Dy = law.Dc.columns(m, p) * &sys.C;
+    let By = law.Bc.columns(m, p) * &sys.C;
+    let N = n + nc + d * m;
+    let mut M = nalgebra::DMatrix::<f64>::zeros(N, N);
+    // u = Cc xc + Dy x: applied now (d = 0) or queued
+    let (ox, oc, oq) = (0, n, n + nc);
+    if d == 0 {
+        M.view_mut((ox, ox), (n, n)).copy_from(&(&Phi + &Gam * &Dy));
+        M.view_mut((ox, oc), (n, nc)).copy_from(&(&Gam * &law.Cc));
+    } else {
+        M.view_mut((ox, ox), (n, n)).copy_from(&Phi);
+        M.view_mut((ox, oq), (n, m)).copy_from(&Gam);
+        for i in 0..d - 1 {
+            M.view_mut((oq + i * m, oq + (i + 1) * m), (m, m)).fill_with_identity();
+        }
+        let last = oq + (d - 1) * m;
+        M.view_mut((last, ox), (m, n)).copy_from(&Dy);
+        M.view_mut((last, oc), (m, nc)).copy_from(&law.Cc);
+    }
+    M.view_mut((oc, ox), (nc, n)).copy_from(&By);
+    M.view_mut((oc, oc), (nc, nc)).copy_from(&law.Ac);
+    let rho = M.complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
+    Some(rho.ln() / T)
+}

@@ -35,6 +35,7 @@ pub mod step_maps;
 
 pub use self::model::ExtendedModel;
 pub use crate::linear::hold::InputHold;
+pub use digital::closed_loop_mu;
 pub use play::theta_is_point;
 pub use simulate::{regime_by_simulation, simulate_trajectory, SimOutput, SimulatedRegime};
 pub use step_maps::StepMaps;
