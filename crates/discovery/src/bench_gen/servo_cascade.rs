@@ -157,6 +157,12 @@ pub fn tick(tr: &CascadeTruth, x: f64, v: f64, f: f64, h: f64) -> (f64, f64) {
 
 /// Records experiment `e` on truth `(seed, index)` (noise from a stream of its own).
 pub fn record(seed: u64, index: usize, e: Experiment) -> Recording {
+    record_with_noise(seed, index, e, true)
+}
+
+/// [`record`], with the position quantisation and noise (`noisy`) or without (a clean
+/// recording for negative controls: what the fit can tell without the noise floor).
+pub fn record_with_noise(seed: u64, index: usize, e: Experiment, noisy: bool) -> Recording {
     let tr = truth(seed, index);
     let r = reference(seed, index, e, tr.kp);
     let mut rng = rng_for(seed, index, 10 + e as u64);
@@ -167,7 +173,8 @@ pub fn record(seed: u64, index: usize, e: Experiment) -> Recording {
     let (mut t, mut w, mut y) = (Vec::with_capacity(ns), Vec::with_capacity(ns), Vec::with_capacity(ns));
     for k in 0..ns {
         let tk = k as f64 * T;
-        let yk = ((x + POS_NOISE * gauss(&mut rng)) / QUANT).round() * QUANT;
+        let noise = POS_NOISE * gauss(&mut rng);
+        let yk = if noisy { ((x + noise) / QUANT).round() * QUANT } else { x };
         let wk = r(tk);
         t.push(tk);
         w.push(vec![wk]);
@@ -181,9 +188,10 @@ pub fn record(seed: u64, index: usize, e: Experiment) -> Recording {
     Recording::from_samples(&format!("servo-cascade-{seed}-{index}-{}", e.name()), &t, w, y, None)
 }
 
-/// The physical model file: `M`, `Fv`, `Fc` at the given values (freed), the gains known, the
-/// cascade in `[controller]` with computation delay `delay` and velocity gain `kv`.
-pub fn model_text(tr: &CascadeTruth, mass: f64, viscous: f64, coulomb: f64, kv: f64, delay: usize) -> String {
+/// The physical model file: `M`, `Fv`, `Fc` at the given values (freed), the cascade in
+/// `[controller]` with gains `gains = (kp, kv)` and computation delay `delay`.
+pub fn model_text(mass: f64, viscous: f64, coulomb: f64, gains: (f64, f64), delay: usize) -> String {
+    let (kp, kv) = gains;
     format!(
         r#"name = "carriage under a sampled cascade"
 [parameters]
@@ -214,8 +222,7 @@ y = "m"
 w = "m"
 t = "s"
 reference = "w"
-"#,
-        kp = tr.kp
+"#
     )
 }
 
@@ -272,10 +279,11 @@ mod tests {
                 let sys = model::parse_str(text).unwrap();
                 ExtendedModel::new(&sys, &[], T, sub).unwrap().simulate(&w, T, &[0.0, 0.0]).y
             };
-            let good = rmse(&run(&model_text(&tr, tr.mass, tr.viscous, tr.coulomb, tr.kv, DELAY), 16), &y);
+            let model = |kv: f64, delay: usize| model_text(tr.mass, tr.viscous, tr.coulomb, (tr.kp, kv), delay);
+            let good = rmse(&run(&model(tr.kv, DELAY), 16), &y);
             // negative controls: no computation delay; a velocity gain 10 % off
-            let no_delay = rmse(&run(&model_text(&tr, tr.mass, tr.viscous, tr.coulomb, tr.kv, 0), 16), &y);
-            let wrong_kv = rmse(&run(&model_text(&tr, tr.mass, tr.viscous, tr.coulomb, 1.1 * tr.kv, DELAY), 16), &y);
+            let no_delay = rmse(&run(&model(tr.kv, 0), 16), &y);
+            let wrong_kv = rmse(&run(&model(1.1 * tr.kv, DELAY), 16), &y);
             eprintln!("{}: true model RMSE {good:e}, without delay {no_delay:e}, kv +10 % {wrong_kv:e}", e.name());
             assert!(good < 3e-6, "{}: {good:e}", e.name());
             assert!(no_delay > 2.0 * good && wrong_kv > 2.0 * good, "{no_delay:e} {wrong_kv:e}");
