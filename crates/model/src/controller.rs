@@ -501,6 +501,8 @@ E = [0, 0]
         // a parameter moving the delay off the integers is refused, the system unchanged
         let mut sys = with("period = 1e-3\ndelay = \"M - 1\"\nkind = \"cascade\"\nkp = 1\nkv = 1\n").unwrap();
         assert_eq!(sys.controller.as_ref().unwrap().delay, 1);
+        // the delay's expression is written back (an integer slot)
+        assert!(crate::to_toml_string(&sys).contains("delay = \"M - 1\""), "{}", crate::to_toml_string(&sys));
         let msg = sys.set_parameter("M", 2.5).unwrap_err().to_string();
         assert!(msg.contains("controller.delay") && msg.contains("1.5"), "{msg}");
         assert_eq!(sys.parameters.value("M"), Some(2.0));

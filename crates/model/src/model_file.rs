@@ -593,7 +593,8 @@ fn write_expressions(s: &System, root: &mut Table) {
             }
         };
         if let Some(v) = slot {
-            if v.as_float() == Some(x) {
+            // (an integer slot: the controller's delay)
+            if v.as_float() == Some(x) || v.as_integer().map(|i| i as f64) == Some(x) {
                 *v = Value::String(b.text.clone());
             }
         }
