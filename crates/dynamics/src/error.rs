@@ -25,6 +25,8 @@ pub enum DynamicsError {
     TooManyEvents { count: usize, t: f64 },
     #[error("effect {kind}: {reason} (value {value})")]
     BadEffect { kind: &'static str, reason: &'static str, value: f64 },
+    #[error("controller.period = {period} is not a positive integer multiple of the sample spacing dt = {dt}: the controller ticks on the samples")]
+    ControllerPeriod { period: f64, dt: f64 },
     #[error("the state became non-finite at t = {t}")]
     NonFinite { t: f64 },
 }

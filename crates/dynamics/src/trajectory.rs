@@ -10,9 +10,10 @@ use model::System;
 /// Simulates `sys` for `steps` steps of `h` from `(sys.x0, sys.z0)`, recording every
 /// `record_every`-th state (and the first and last): the catching-up scheme for a model of the
 /// paper's class, the extended model ([`crate::extended::simulate_trajectory`]) when the model
-/// has `[[effects]]`. The one entry point of every command that simulates a model file.
+/// has `[[effects]]` or a `[controller]`. The one entry point of every command that simulates a
+/// model file.
 pub fn simulate_model(sys: &System, h: f64, steps: usize, record_every: usize) -> Result<Trajectory, DynamicsError> {
-    if sys.effects.list.is_empty() {
+    if sys.effects.list.is_empty() && sys.controller.is_none() {
         simulate_catching_up(sys, &CatchingUpSettings { dt: h, ..Default::default() }, steps, record_every)
     } else {
         simulate_trajectory(sys, h, steps, record_every)

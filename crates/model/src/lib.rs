@@ -13,10 +13,13 @@
 //! - [`model_file`]: reading and writing model files with errors that name key and value (the
 //!   parser: it builds the domain types above, which do not depend on it).
 //! - [`files`]: regular files only, with a size limit (no FIFO or device blocks a load).
+//! - [`controller`]: `[controller]`, a digital controller in the loop at its own sample period
+//!   ([`Controller`]: cascade, PID or a discrete state-space law, computation delay).
 //! - [`effects`]: optional physics extensions (friction, delay, ...) used by `discovery`;
 //!   all equal to the nominal model at zero.
 #![allow(non_snake_case)]
 
+pub mod controller;
 pub mod effects;
 pub mod error;
 pub mod files;
@@ -28,6 +31,7 @@ pub mod signals;
 pub mod system;
 mod toml_access;
 
+pub use controller::{ControlLaw, Controller};
 pub use effects::Effects;
 pub use error::ModelError;
 pub use fit::{FitRecord, FitSpec, FreeParam, PlantMatrix};

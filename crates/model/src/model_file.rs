@@ -33,6 +33,9 @@
 //! parameters (`[parameters] M = 2.0`, `A = [[0, 1], ["-k/M", "-c/M"]]`): see
 //! [`crate::parameters`].
 //!
+//! `[controller]`: a digital controller closing the loop at its own sample period (the plant's
+//! `B` takes its output, the input `w` is its reference): see [`crate::controller`].
+//!
 //! Optional tables for `moreau diagnose` (ignored by every other command):
 //!
 //! ```toml
@@ -298,7 +301,11 @@ pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, Mo
     let mut root: Table = text
         .parse::<Table>()
         .map_err(|e| ModelError::Syntax { path: origin.to_string(), message: toml_message(&e.to_string()) })?;
-    check_keys(&root, "", "name, parameters, plant, theta, input, initial, simulation, effects, fit, signals")?;
+    check_keys(
+        &root,
+        "",
+        "name, parameters, plant, theta, input, initial, simulation, effects, controller, fit, signals",
+    )?;
     let parameters = Parameters::take_from(&mut root)?;
     let name = match root.get("name") {
         Some(Value::String(s)) if s.len() > MAX_NAME_BYTES => {
@@ -374,6 +381,9 @@ pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, Mo
     let mut sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;
     check_step(sys.sim.dt, sys.period(), sys.sim.t_end, "simulation.dt")?;
     sys.parameters = parameters;
+    if let Some(t) = sub("controller")? {
+        sys.controller = Some(crate::controller::Controller::parse(t, sys.m(), sys.p())?);
+    }
     sys.fit = parse_fit(sub("fit")?, &sys)?;
     sys.signals = parse_signals(sub("signals")?, sys.m(), sys.p())?;
     Ok(sys)
@@ -505,6 +515,9 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     if let Some(e) = s.effects.to_value() {
         root.insert("effects".into(), e);
     }
+    if let Some(c) = &s.controller {
+        root.insert("controller".into(), Value::Table(c.to_table()));
+    }
     if let Some(f) = fit_table(&s.fit) {
         root.insert("fit".into(), Value::Table(f));
     }
@@ -531,8 +544,19 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
 
 /// The top-level keys of a model file in the order files are written (the order of the
 /// examples and of the file-format reference).
-const SECTION_ORDER: &[&str] =
-    &["name", "parameters", "plant", "theta", "input", "initial", "simulation", "effects", "fit", "signals"];
+const SECTION_ORDER: &[&str] = &[
+    "name",
+    "parameters",
+    "plant",
+    "theta",
+    "input",
+    "initial",
+    "simulation",
+    "effects",
+    "controller",
+    "fit",
+    "signals",
+];
 
 /// `[parameters]` and, in place of a number, the expression that gives it: where the number
 /// is still the expression's value (a number changed by other means, e.g. a sweep over the
@@ -559,9 +583,18 @@ fn write_expressions(s: &System, root: &mut Table) {
                     None => v,
                 }
             }
+            Place::Controller { key, element } => {
+                let v = root.get_mut("controller").and_then(|c| c.get_mut(key.as_str()));
+                match (element, key.as_str()) {
+                    (Some((i, _)), "x0") => v.and_then(|a| a.get_mut(*i)),
+                    (Some((i, j)), _) => v.and_then(|a| a.get_mut(*i)).and_then(|r| r.get_mut(*j)),
+                    (None, _) => v,
+                }
+            }
         };
         if let Some(v) = slot {
-            if v.as_float() == Some(x) {
+            // (an integer slot: the controller's delay)
+            if v.as_float() == Some(x) || v.as_integer().map(|i| i as f64) == Some(x) {
                 *v = Value::String(b.text.clone());
             }
         }

@@ -13,7 +13,7 @@
 //!
 //! Where an expression may stand: an entry of `[plant]` `A`, `B`, `C`, `E`; of `[initial]`
 //! `x0`, `z0`; a numeric key of an `[[effects]]` table (not the indices `state`,
-//! `position_state`). Anywhere else a string is an error, as without parameters. A parameter
+//! `position_state`); a number of `[controller]` (gains, period, entries of `Ac`..`Dc`). Anywhere else a string is an error, as without parameters. A parameter
 //! is a number (not an expression of other parameters). `[fit] free = ["M", "c"]` frees
 //! parameters for a refit: every number written with them moves together, and a fitted model
 //! keeps the expressions with the fitted values in `[parameters]`.
@@ -41,6 +41,8 @@ pub enum Place {
     Initial { x0: bool, index: usize },
     /// Key `key` of `[[effects]]` entry `index` (`element` of an array such as `offset`).
     Effect { index: usize, key: String, element: Option<usize> },
+    /// Key `key` of `[controller]` (`element`: `(row, col)` of a matrix, `(i, 0)` of `x0`).
+    Controller { key: String, element: Option<(usize, usize)> },
 }
 
 impl Place {
@@ -51,6 +53,9 @@ impl Place {
             Place::Initial { x0, index } => format!("initial.{}[{index}]", if *x0 { "x0" } else { "z0" }),
             Place::Effect { index, key, element: None } => format!("effects[{index}].{key}"),
             Place::Effect { index, key, element: Some(e) } => format!("effects[{index}].{key}[{e}]"),
+            Place::Controller { key, element: None } => format!("controller.{key}"),
+            Place::Controller { key, element: Some((i, _)) } if key == "x0" => format!("controller.{key}[{i}]"),
+            Place::Controller { key, element: Some((i, j)) } => format!("controller.{key}[{i}][{j}]"),
         }
     }
 }
@@ -254,6 +259,34 @@ impl Parameters {
                         }
                         _ => self.bind(v, Place::Effect { index, key: key.clone(), element: None })?,
                     }
+                }
+            }
+        }
+        if let Some(Toml::Table(t)) = root.get_mut("controller") {
+            for (key, v) in t.iter_mut() {
+                if key == "kind" {
+                    continue;
+                }
+                match v {
+                    Toml::Array(rows) => {
+                        let flat = rows.iter().all(|r| !matches!(r, Toml::Array(_)));
+                        for (i, r) in rows.iter_mut().enumerate() {
+                            match r {
+                                Toml::Array(row) => {
+                                    for (j, x) in row.iter_mut().enumerate() {
+                                        self.bind(x, Place::Controller { key: key.clone(), element: Some((i, j)) })?;
+                                    }
+                                }
+                                x if flat => {
+                                    // a flat array: x0 (component i) or a one-row matrix
+                                    let e = if key == "x0" { (i, 0) } else { (0, i) };
+                                    self.bind(x, Place::Controller { key: key.clone(), element: Some(e) })?;
+                                }
+                                _ => {}
+                            }
+                        }
+                    }
+                    _ => self.bind(v, Place::Controller { key: key.clone(), element: None })?,
                 }
             }
         }

@@ -1,4 +1,5 @@
 //! The validated closed-loop system of eqs. (xy), (yz).
+use crate::controller::Controller;
 use crate::effects::Effects;
 use crate::error::ModelError;
 use crate::fit::{FitSpec, FreeParam, FreeTarget, PlantMatrix};
@@ -72,6 +73,9 @@ pub struct System {
     /// `[parameters]`: named constants and the numbers above written as expressions of them
     /// (empty: plain numbers). Change one with [`System::set_parameter`].
     pub parameters: Parameters,
+    /// `[controller]`: a digital controller closing the loop (`None`: `w` drives the plant
+    /// directly). With one, `w` is the controller's reference and `B` takes its output.
+    pub controller: Option<Controller>,
 }
 
 fn dim_err(key: &str, expected: String, got: &DMatrix<f64>) -> ModelError {
@@ -314,6 +318,7 @@ impl System {
             fit: Default::default(),
             signals: Default::default(),
             parameters: Default::default(),
+            controller: None,
         })
     }
 
@@ -395,6 +400,12 @@ impl System {
                 Place::Initial { x0: true, index } => next.x0[*index] = x,
                 Place::Initial { x0: false, index } => next.z0[*index] = x,
                 Place::Effect { index, key, element } => effects.push((*index, key, *element, x)),
+                Place::Controller { key, element } => {
+                    let (m, p) = (next.m(), next.p());
+                    if let Some(c) = next.controller.as_ref() {
+                        next.controller = Some(c.with_number(key, *element, x, m, p)?);
+                    }
+                }
             }
         }
         if params.z0_follows_x0 && params.bindings.iter().any(|b| matches!(b.place, Place::Initial { x0: true, .. })) {

@@ -27,6 +27,7 @@
 //! The classic profile draws exactly the random numbers it always did (old seeds reproduce);
 //! the digital profile's extra draws come from a second stream.
 pub mod plant_sim;
+pub mod servo_cascade;
 pub mod servo_loop;
 
 use crate::recording::Recording;

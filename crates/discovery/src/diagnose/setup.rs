@@ -77,7 +77,9 @@ impl<'a> Setup<'a> {
     pub(super) fn new(sys: &'a System, rec: &'a Recording, s: &'a DiagnoseSettings) -> Result<Self, DiscoveryError> {
         let (m, p) = (rec.m(), rec.p());
         let nx = sys.n();
-        let mu = sys.mu();
+        // with a digital controller, the closed sampled loop's decay rate (the plant alone may
+        // be an integrator)
+        let mu = dynamics::extended::closed_loop_mu(sys).unwrap_or_else(|| sys.mu());
         if !(mu < 0.0) {
             return Err(DiscoveryError::Unstable { mu });
         }

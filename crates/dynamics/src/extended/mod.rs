@@ -7,6 +7,8 @@
 //! - [`simulate`]: its fixed-step simulator (one sub-step = input, linear step and forces,
 //!   play), [`simulate_trajectory`] for a model file and [`regime_by_simulation`] under a
 //!   periodic input.
+//! - [`digital`]: the loop closed by a digital controller (`[controller]`): ticks every
+//!   `period`, computation delay, the command held between ticks.
 //! - [`play`]: the play in the loop, the catching-up projection
 //!   `z_{k+1} = y_{k+1} + P_Theta(z_pred - y_{k+1})` (gap width, loop backlash, backlash
 //!   inertia).
@@ -22,6 +24,7 @@
 //! The one simulator of models with `[[effects]]`: `moreau simulate`, `periodic`,
 //! `convergence`, `figure trajectory` and `discovery` all use it (a model without effects
 //! reproduces the catching-up scheme of [`crate::integrators::catching_up`]).
+pub mod digital;
 pub mod forces;
 pub mod friction;
 pub mod input;
@@ -32,6 +35,7 @@ pub mod step_maps;
 
 pub use self::model::ExtendedModel;
 pub use crate::linear::hold::InputHold;
+pub use digital::closed_loop_mu;
 pub use play::theta_is_point;
 pub use simulate::{regime_by_simulation, simulate_trajectory, SimOutput, SimulatedRegime};
 pub use step_maps::StepMaps;

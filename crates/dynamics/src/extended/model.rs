@@ -21,6 +21,7 @@
 //!
 //! Compiling checks every effect (an error names the effect and the offending value); the
 //! simulation itself is [`super::simulate`].
+use super::digital::DigitalLoop;
 use super::forces::Forces;
 use super::input::{InputPath, Split};
 use super::play::{checked_width, Play, PlayEffects};
@@ -50,6 +51,8 @@ pub struct ExtendedModel {
     pub(super) offset: Vec<f64>,
     /// Set when an input delay puts the input's breakpoints inside a sub-step.
     pub(super) split: Option<Split>,
+    /// The digital controller closing the loop (`[controller]`), compiled for the samples.
+    pub(super) digital: Option<DigitalLoop>,
 }
 
 impl ExtendedModel {
@@ -100,6 +103,8 @@ impl ExtendedModel {
             }
         }
         let compiled_play = play.compile(sys, p)?;
+        let dt = maps.h * substeps as f64;
+        let digital = sys.controller.as_ref().map(|c| DigitalLoop::new(c, dt)).transpose()?;
         let split = if input.delay > 0.0 { Split::for_delay(sys, input.delay, maps.h, substeps) } else { None };
         Ok(Self {
             n,
@@ -114,6 +119,7 @@ impl ExtendedModel {
             input,
             offset,
             split,
+            digital,
         })
     }
 
@@ -126,6 +132,11 @@ impl ExtendedModel {
     /// The input hold between samples.
     pub fn hold(&self) -> InputHold {
         self.input.hold
+    }
+
+    /// Whether a digital controller closes the loop (`[controller]`).
+    pub fn has_controller(&self) -> bool {
+        self.digital.is_some()
     }
 
     /// Whether the model has a play in the loop.

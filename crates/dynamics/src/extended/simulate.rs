@@ -36,7 +36,7 @@ pub struct SimOutput {
 }
 
 impl SimOutput {
-    fn zeros(ns: usize, n: usize, p: usize) -> Self {
+    pub(super) fn zeros(ns: usize, n: usize, p: usize) -> Self {
         SimOutput {
             y: vec![0.0; ns * p],
             contact: vec![false; ns],
@@ -49,7 +49,7 @@ impl SimOutput {
 
     /// Records sample `k` (`y_meas = y + offset`) and accumulates the squares of `x`.
     #[inline]
-    fn record(&mut self, k: usize, st: &RunState, offset: &[f64]) {
+    pub(super) fn record(&mut self, k: usize, st: &RunState, offset: &[f64]) {
         let (n, p) = (st.x.len(), st.y.len());
         for i in 0..p {
             self.y[k * p + i] = st.y[i] + offset[i];
@@ -62,7 +62,7 @@ impl SimOutput {
     }
 
     /// The state left the finite numbers after sample `k`: every later output is `NaN`.
-    fn diverged_after(&mut self, k: usize, ns: usize, p: usize) {
+    pub(super) fn diverged_after(&mut self, k: usize, ns: usize, p: usize) {
         self.finite = false;
         for kk in k + 1..ns {
             for i in 0..p {
@@ -73,7 +73,7 @@ impl SimOutput {
 }
 
 /// Per-step constants of one step length.
-struct Piece<'a> {
+pub(super) struct Piece<'a> {
     maps: &'a StepMaps,
     /// `Psi b` (constant force).
     fb: Vec<f64>,
@@ -102,13 +102,13 @@ impl<'a> Piece<'a> {
 
 /// The pieces of one run: the regular sub-step and, with an input delay, the split sub-step's
 /// two parts (`(substep, at, first, second)`).
-struct Pieces<'a> {
+pub(super) struct Pieces<'a> {
     main: Piece<'a>,
     split: Option<(usize, f64, Piece<'a>, Piece<'a>)>,
 }
 
 impl<'a> Pieces<'a> {
-    fn new(model: &'a ExtendedModel) -> Self {
+    pub(super) fn new(model: &'a ExtendedModel) -> Self {
         let (force, tau) = (&model.forces.force, model.inertia_tau);
         let main = Piece::new(&model.maps, force, tau);
         let split = model
@@ -121,7 +121,7 @@ impl<'a> Pieces<'a> {
     /// Sub-step `s` of `sub` as one or two pieces `(fa, fb, piece)` (fractions of the sample
     /// interval); the count is the second value.
     #[inline]
-    fn of_substep(&self, s: usize, sub: usize) -> ([(f64, f64, &Piece<'a>); 2], usize) {
+    pub(super) fn of_substep(&self, s: usize, sub: usize) -> ([(f64, f64, &Piece<'a>); 2], usize) {
         let f0 = s as f64 / sub as f64;
         let f1 = (s + 1) as f64 / sub as f64;
         match &self.split {
@@ -135,14 +135,14 @@ impl<'a> Pieces<'a> {
 }
 
 /// The running state of one simulation.
-struct RunState {
-    x: Vec<f64>,
+pub(super) struct RunState {
+    pub(super) x: Vec<f64>,
     /// The next state (a linear step's end, then the forces).
     xn: Vec<f64>,
     /// The play's deviation `q = z - y`.
     q: Vec<f64>,
     z: Vec<f64>,
-    y: Vec<f64>,
+    pub(super) y: Vec<f64>,
     /// Coasting velocity of the backlash output (`backlash_inertia`).
     v: Vec<f64>,
     scratch: Vec<f64>,
@@ -222,7 +222,13 @@ impl ExtendedModel {
     /// moves the input's breakpoints to `t_k + delay`, and the sub-step that contains one is
     /// split there (two extra step maps, computed once per model). Saturation and a play at
     /// the input act on the held samples exactly (ZOH) or on the sub-step knots (FOH).
+    ///
+    /// With a `[controller]`, `w` is its reference and the loop is closed by the sampled
+    /// controller ([`super::digital`]).
     pub fn simulate_from(&self, w: &[f64], dt: f64, x0: &[f64], z0: Option<&[f64]>) -> SimOutput {
+        if let Some(dl) = &self.digital {
+            return self.simulate_loop(dl, w, dt, x0, z0);
+        }
         let (n, m, p) = (self.n, self.m, self.p);
         let ns = w.len() / m;
         let mut out = SimOutput::zeros(ns, n, p);
@@ -270,7 +276,7 @@ impl ExtendedModel {
     }
 
     /// The state at `t = 0`: `x0`, `y = C x0`, `z = z0` (with a play) or `y`.
-    fn start(&self, x0: &[f64], z0: Option<&[f64]>) -> RunState {
+    pub(super) fn start(&self, x0: &[f64], z0: Option<&[f64]>) -> RunState {
         let (n, p) = (self.n, self.p);
         let mut st = RunState {
             x: x0.to_vec(),
@@ -296,7 +302,7 @@ impl ExtendedModel {
     /// The plant over one piece: the exact linear step with `q` and the forces held, then the
     /// cogging and friction forces; `x` advances and `y = C x`.
     #[inline]
-    fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
+    pub(super) fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
         let (n, m, p) = (self.n, self.m, self.p);
         let mp = pc.maps;
         let (x, xn) = (&st.x, &mut st.xn);
@@ -324,7 +330,7 @@ impl ExtendedModel {
     /// The play over one piece: `z` coasts (with inertia), `q` is projected into `Theta` and
     /// `z = y + q`. Returns whether the play is in contact (`None` without a play: `z = y`).
     #[inline]
-    fn step_play(&self, st: &mut RunState, pc: &Piece) -> Option<bool> {
+    pub(super) fn step_play(&self, st: &mut RunState, pc: &Piece) -> Option<bool> {
         if !self.has_play() {
             st.z.copy_from_slice(&st.y);
             return None;

@@ -29,8 +29,22 @@ pub fn summary(s: &model::System) -> String {
         let list: String = s.effects.list.iter().map(|e| format!("\n    {}", e.describe())).collect();
         format!("{} (outside the paper's class: theta is not a certificate){list}", s.effects.list.len())
     };
+    // a digital controller closes the loop: its sampled loop's decay rate
+    let controller = match &s.controller {
+        None => String::new(),
+        Some(c) => {
+            let mu_c = dynamics::extended::closed_loop_mu(s).unwrap_or(f64::NAN);
+            format!(
+                "  controller: {}, period {}, computation delay {} period(s); closed sampled loop mu = ln(rho)/period = {mu_c:.6}{}\n",
+                c.kind(),
+                c.period,
+                c.delay,
+                if mu_c < 0.0 { " (stable)" } else { " (NOT stable)" }
+            )
+        }
+    };
     format!(
-        "name:    {}\n  n = {}, m = {}, p = {}\n  Theta:   {}\n  R:       {}\n  eig(F):  {}\n  mu:      {:.6}{}\n  input:   {} (period {per})\n  effects: {effects}\n",
+        "name:    {}\n  n = {}, m = {}, p = {}\n  Theta:   {}\n  R:       {}\n  eig(F):  {}\n  mu:      {:.6}{}\n  input:   {} (period {per})\n  effects: {effects}\n{controller}",
         s.name,
         s.n(),
         s.m(),

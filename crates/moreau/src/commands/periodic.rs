@@ -103,8 +103,11 @@ pub fn periodic(src: &Source, o: &PeriodicOptions) -> anyhow::Result<PeriodicRun
         (T / dt).ceil() * (o.periods as f64 * (2 * o.pairs + 1) as f64 + 100.0),
         &format!("{} periods, {} pairs, T = {}, dt = {}", o.periods, o.pairs, num(T), num(dt)),
     )?;
-    if !sys.effects.list.is_empty() {
-        let kinds: Vec<&'static str> = sys.effects.list.iter().map(|e| e.kind()).collect();
+    if !sys.effects.list.is_empty() || sys.controller.is_some() {
+        let mut kinds: Vec<&'static str> = sys.effects.list.iter().map(|e| e.kind()).collect();
+        if sys.controller.is_some() {
+            kinds.push("a digital controller");
+        }
         let regime = dynamics::extended::regime_by_simulation(&sys, dt, o.periods)?;
         let last_residual = regime.residuals.last().copied().unwrap_or(f64::NAN);
         let note = format!(

@@ -109,7 +109,10 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
         "numbers in trajectory.csv, --max-rows",
     )?;
     let every = steps.div_ceil(max_rows).max(1);
-    let effects: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
+    let mut effects: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
+    if sys.controller.is_some() {
+        effects.push("a digital controller");
+    }
     let (trajectory, method) = match o.integrator {
         Integrator::CatchingUp if effects.is_empty() => {
             (simulate_model(&sys, h, steps, every)?, format!("catching-up, h = {h:e}"))

@@ -71,6 +71,14 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
             (**s).clone()
         }
     };
+    if let Some(c) = &sys.controller {
+        anyhow::bail!(
+            "{}: theta certifies the continuous loop of the paper; this model closes its loop by a digital [controller] ({}, period {}): `simulate` and `diagnose` run it",
+            src.label(),
+            c.kind(),
+            c.period
+        );
+    }
     let mut settings = ThetaSettings::default();
     if !o.measure {
         settings.measure = None;
