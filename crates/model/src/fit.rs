@@ -60,14 +60,17 @@ impl FreeParam {
 
 /// A grey-box refit recorded in a fitted model (`[fit.result."plant.A[1][1]"]`): the value
 /// of the model file it was fitted from, the fitted value (the one in `[plant]`) and its
-/// 1-sigma uncertainty (`NaN`, and not written, where not identifiable). Informational:
-/// nothing reads it back into the dynamics.
+/// 1-sigma uncertainty (`NaN`, and not written, where not identifiable), and its correlation
+/// with each other refitted parameter (`correlation = { M = 0.93 }`: the fit's statistical
+/// correlation, Gauss-Newton). Informational: nothing reads it back into the dynamics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitRecord {
     pub name: String,
     pub nominal: f64,
     pub value: f64,
     pub std: f64,
+    /// `(other parameter's name, correlation in [-1, 1])`; empty where not computed.
+    pub correlation: Vec<(String, f64)>,
 }
 
 /// `[fit]`: the nominal parameters `moreau diagnose` may refit (empty: none).

@@ -646,6 +646,17 @@ fn free_param(s: &str, key: &str, sys: &System) -> Result<FreeParam, ModelError>
     Ok(FreeParam::entry(matrix, row, col))
 }
 
+/// The index in `free` of the parameter named `raw` (an entry's name in any spelling).
+fn lookup(free: &[FreeParam], key: &str, raw: &str) -> Result<usize, ModelError> {
+    let canonical = parse_param_name(raw).map(|(m, i, j)| FreeParam::entry(m, i, j).name);
+    let name = canonical.as_deref().unwrap_or(raw.trim());
+    free.iter().position(|f| f.name == name).ok_or_else(|| ModelError::WrongType {
+        key: key.into(),
+        expected: "a parameter listed in fit.free",
+        found: format!("{raw:?} (fit.free: {:?})", free.iter().map(|f| f.name.as_str()).collect::<Vec<_>>()),
+    })
+}
+
 fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
     let Some(t) = t else { return Ok(FitSpec::default()) };
     check_keys(t, "fit", "free, bounds, result")?;
@@ -674,15 +685,6 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
             free.push(param);
         }
     }
-    let lookup = |free: &[FreeParam], key: &str, raw: &str| -> Result<usize, ModelError> {
-        let canonical = parse_param_name(raw).map(|(m, i, j)| FreeParam::entry(m, i, j).name);
-        let name = canonical.as_deref().unwrap_or(raw.trim());
-        free.iter().position(|f| f.name == name).ok_or_else(|| ModelError::WrongType {
-            key: key.into(),
-            expected: "a parameter listed in fit.free",
-            found: format!("{raw:?} (fit.free: {:?})", free.iter().map(|f| f.name.as_str()).collect::<Vec<_>>()),
-        })
-    };
     if let Some(v) = t.get("bounds") {
         let Value::Table(b) = v else {
             return Err(ModelError::WrongType { key: "fit.bounds".into(), expected: "a table", found: describe(v) });
@@ -732,16 +734,41 @@ fn parse_fit(t: Option<&Table>, sys: &System) -> Result<FitSpec, ModelError> {
                     found: describe(rv),
                 });
             };
-            check_keys(rt, &key, "nominal, value, std")?;
+            check_keys(rt, &key, "nominal, value, std, correlation")?;
             result.push(FitRecord {
                 name: free[i].name.clone(),
                 nominal: f64_at(rt, &key, "nominal")?,
                 value: f64_at(rt, &key, "value")?,
                 std: opt_f64(rt, &key, "std")?.unwrap_or(f64::NAN),
+                correlation: parse_correlation(rt.get("correlation"), &key, &free)?,
             });
         }
     }
     Ok(FitSpec { free, result })
+}
+
+/// `correlation = { NAME = r, ... }` of one `[fit.result]` entry: each name a freed parameter,
+/// each value in `[-1, 1]`.
+fn parse_correlation(v: Option<&Value>, key: &str, free: &[FreeParam]) -> Result<Vec<(String, f64)>, ModelError> {
+    let Some(v) = v else { return Ok(vec![]) };
+    let key = format!("{key}.correlation");
+    let Value::Table(t) = v else {
+        return Err(ModelError::WrongType { key, expected: "a table of correlations", found: describe(v) });
+    };
+    let mut out = Vec::with_capacity(t.len());
+    for name in t.keys() {
+        let i = lookup(free, &key, name)?;
+        let r = f64_at(t, &key, name)?;
+        if !(-1.0..=1.0).contains(&r) {
+            return Err(ModelError::Invalid {
+                key: format!("{key}.{name}"),
+                value: r,
+                reason: "a correlation lies in [-1, 1]".into(),
+            });
+        }
+        out.push((free[i].name.clone(), r));
+    }
+    Ok(out)
 }
 
 fn parse_signals(t: Option<&Table>, m: usize, p: usize) -> Result<Signals, ModelError> {
@@ -837,6 +864,11 @@ fn fit_table(f: &FitSpec) -> Option<Table> {
         e.insert("value".into(), Value::Float(rec.value));
         if rec.std.is_finite() {
             e.insert("std".into(), Value::Float(rec.std));
+        }
+        let corr: Table =
+            rec.correlation.iter().filter(|(_, r)| r.is_finite()).map(|(n, r)| (n.clone(), Value::Float(*r))).collect();
+        if !corr.is_empty() {
+            e.insert("correlation".into(), Value::Table(corr));
         }
         r.insert(rec.name.clone(), Value::Table(e));
     }

@@ -34,12 +34,14 @@ fn free_parameters_bounds_and_units_are_read_and_written_back() {
         nominal: -0.6,
         value: -0.45,
         std: 0.003,
+        correlation: vec![("plant.B[1][0]".into(), -0.875)],
     });
     s2.fit.result.push(model::model_file::FitRecord {
         name: "plant.B[1][0]".into(),
         nominal: 1.0,
         value: 1.2,
         std: f64::NAN,
+        correlation: vec![],
     });
     let text = model::to_toml_string(&s2);
     let back = model::parse_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
@@ -76,6 +78,14 @@ fn bad_fit_tables_name_key_and_value() {
         ),
         ("[fit]\nfree = [\"plant.A[1][1]\"]\n[fit.bounds]\n\"plant.A[1][1]\" = [-1]\n", &["fit.bounds", "length 1"]),
         ("[fit]\nfree = [\"plant.A[1][1]\"]\nstart = 3\n", &["fit.start", "unknown key"]),
+        (
+            "[fit]\nfree = [\"plant.A[1][1]\", \"plant.B[1][0]\"]\n[fit.result.\"plant.A[1][1]\"]\nnominal = -0.6\nvalue = -0.5\ncorrelation = { \"plant.B[1][0]\" = 1.5 }\n",
+            &["correlation", "plant.B[1][0]", "1.5", "[-1, 1]"],
+        ),
+        (
+            "[fit]\nfree = [\"plant.A[1][1]\"]\n[fit.result.\"plant.A[1][1]\"]\nnominal = -0.6\nvalue = -0.5\ncorrelation = { \"plant.A[0][0]\" = 0.5 }\n",
+            &["correlation", "plant.A[0][0]", "listed in fit.free"],
+        ),
         ("[signals]\ny = [\"m\", \"rad\"]\n", &["signals.y", "one unit per output (1)", "length 2"]),
         ("[signals]\ny = 3\n", &["signals.y", "integer 3"]),
         ("[signals]\nz = \"m\"\n", &["signals.z", "unknown key"]),

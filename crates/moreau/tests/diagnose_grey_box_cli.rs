@@ -121,6 +121,13 @@ fn physical_parameters_are_refitted_as_such() {
     // the entries moved together: the mass read from B agrees with the one in [parameters]
     let (m_b, _) = servo_loop::mass_and_viscous(&back, case.truth.kp, case.truth.kd);
     assert!((m_b / m - 1.0).abs() < 1e-12, "{m_b} vs {m}");
+    // the fit's correlation is written with each value, the same number under both names
+    let corr = |a: &str, b: &str| -> f64 {
+        let rec = back.fit.result.iter().find(|r| r.name == a).unwrap_or_else(|| panic!("{a}: {fitted}"));
+        rec.correlation.iter().find(|(n, _)| n == b).unwrap_or_else(|| panic!("{a} ~ {b}: {fitted}")).1
+    };
+    let (r_mc, r_cm) = (corr("M", "c"), corr("c", "M"));
+    assert!(r_mc.abs() <= 1.0 && r_mc != 0.0 && (r_mc - r_cm).abs() < 1e-12, "{r_mc} {r_cm}");
 
     // a sweep over the mass of a cart behind a play: mu = -c / (2 M) while the poles are complex
     let cart = "[parameters]\nM = 2.0\nc = 1.2\nk = 8.0\nks = 4.0\n[plant]\nA = [[0, 1], [\"-k/M\", \"-c/M\"]]\n\

@@ -666,6 +666,8 @@ fn fitted_system(
                 nominal: v.nominal,
                 value: v.value,
                 std: v.std,
+                // the joint fit's correlation is not computed yet
+                correlation: vec![],
             })
             .collect();
     }

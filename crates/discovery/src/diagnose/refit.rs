@@ -149,6 +149,14 @@ fn nominal_values(data: &Setup, chosen: Option<&Ranked>, unc: &Uncertainty) -> V
                     .unwrap_or(f64::NAN),
                 relative_change: (f.nominal[i] != 0.0).then(|| c.nominal[i] / f.nominal[i] - 1.0),
                 bounds: fp.bounds,
+                correlation: c
+                    .nominal_correlation
+                    .get(i)
+                    .map(|row| {
+                        let others = f.params.iter().zip(row).enumerate().filter(|(j, _)| *j != i);
+                        others.map(|(_, (q, r))| (q.name.clone(), *r)).collect()
+                    })
+                    .unwrap_or_default(),
             })
             .collect(),
         _ => vec![],
@@ -183,6 +191,7 @@ fn fitted_system(
                 nominal: v.nominal,
                 value: v.value,
                 std: v.std,
+                correlation: v.correlation.clone(),
             })
             .collect();
     }

@@ -127,6 +127,9 @@ pub struct NominalValue {
     /// `value / nominal - 1` (`None` for a zero nominal).
     pub relative_change: Option<f64>,
     pub bounds: Option<(f64, f64)>,
+    /// Statistical correlation with each other refitted parameter (Gauss-Newton), written
+    /// into `fitted.toml` as `correlation = { NAME = r }`.
+    pub correlation: Vec<(String, f64)>,
 }
 
 /// Scales and null reference of the localisation (see [`localise`]).

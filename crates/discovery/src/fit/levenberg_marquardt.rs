@@ -73,6 +73,9 @@ pub struct FitResult {
     pub nominal: Vec<f64>,
     /// Their standard deviations, as `std`.
     pub nominal_std: Vec<f64>,
+    /// Their statistical correlation matrix (Gauss-Newton; `NaN` where not identifiable; empty
+    /// without a refit or where the normal matrix is singular).
+    pub nominal_correlation: Vec<Vec<f64>>,
     pub x0: Vec<f64>,
     /// Weighted sum of squared residuals on the estimation segment.
     pub sse: f64,
@@ -346,6 +349,7 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         std: vec![f64::NAN; k],
         nominal: nom0.clone(),
         nominal_std: vec![f64::NAN; kn],
+        nominal_correlation: vec![],
         x0: x0_init.to_vec(),
         sse: f64::INFINITY,
         n_res: 0,
@@ -379,6 +383,7 @@ fn nothing_to_fit(vars: &Vars, x0_init: &[f64], evals: &mut usize) -> FitResult 
         std: vec![],
         nominal: vec![],
         nominal_std: vec![],
+        nominal_correlation: vec![],
         x0: x0_init.to_vec(),
         sse: cost,
         n_res,
@@ -463,7 +468,9 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
     let slope = pb.slope(&v[..k]);
     // Physical units per solver unit: effect slopes, then the nominal scales.
     let unit: Vec<f64> = slope.iter().map(|s| s.abs()).chain(vars.ns.iter().copied()).collect();
-    let std_all: Vec<f64> = match JtJ.clone().try_inverse() {
+    let inverse = JtJ.clone().try_inverse();
+    let nominal_correlation = inverse.as_ref().map_or(vec![], |inv| correlation_block(inv, k, kn));
+    let std_all: Vec<f64> = match inverse {
         Some(inv) => {
             // The larger of the white-noise and the coloured-residual (batch-means sandwich)
             // variances: the report never claims more precision than either supports.
@@ -488,7 +495,37 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
     } else {
         FitStatus::MaxIterations
     };
-    FitResult { theta, std, nominal, nominal_std, x0, sse: cost, n_res: nres, status, evaluations: evals }
+    FitResult {
+        theta,
+        std,
+        nominal,
+        nominal_std,
+        nominal_correlation,
+        x0,
+        sse: cost,
+        n_res: nres,
+        status,
+        evaluations: evals,
+    }
+}
+
+/// The correlation matrix of the `n` parameters from index `from` of the covariance (or any
+/// positive multiple of it) `cov`; `NaN` where a variance is not positive.
+pub fn correlation_block(cov: &DMatrix<f64>, from: usize, n: usize) -> Vec<Vec<f64>> {
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    let (a, b) = (cov[(from + i, from + i)], cov[(from + j, from + j)]);
+                    if a > 0.0 && b > 0.0 {
+                        (cov[(from + i, from + j)] / (a * b).sqrt()).clamp(-1.0, 1.0)
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Starts iterated after screening (see [`fit`]).

@@ -40,6 +40,9 @@ pub struct Ranked {
     /// report's `nominal_refit`).
     pub nominal: Vec<f64>,
     pub nominal_std: Vec<f64>,
+    /// Their statistical correlation (see `FitResult::nominal_correlation`).
+    #[serde(skip)]
+    pub nominal_correlation: Vec<Vec<f64>>,
     #[serde(skip)]
     pub x0: Vec<f64>,
     #[serde(skip)]
@@ -118,6 +121,7 @@ pub(crate) fn fit_hypothesis(
         refit: is_refit,
         nominal: r.nominal.clone(),
         nominal_std: r.nominal_std.clone(),
+        nominal_correlation: r.nominal_correlation.clone(),
         sse_estimation: r.sse,
         bic: b,
         delta_bic: bic_nom - b,

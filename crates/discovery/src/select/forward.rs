@@ -91,6 +91,7 @@ impl Selector<'_, '_> {
             refit: false,
             nominal: vec![],
             nominal_std: vec![],
+            nominal_correlation: vec![],
             sse_estimation: nom.sse,
             bic: self.bic_nom,
             delta_bic: 0.0,
