@@ -10,6 +10,8 @@
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
 //! `THETA_BENCHMARK_INPUT=square` gives every system a square wave of the same amplitudes,
 //! period and phase instead of its sine (issue 29 item 2: the same systems, another input).
+//! `THETA_BENCHMARK_MIN_P=2` keeps only the drawn systems with `p >= 2` (issue 29 item 3: balls
+//! and ellipsoids in R^2 and R^3); the tables end with a breakdown by `p`.
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use rayon::prelude::*;
@@ -121,6 +123,7 @@ fn main() {
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
     let square = std::env::var("THETA_BENCHMARK_INPUT").is_ok_and(|v| v == "square");
+    let min_p: usize = std::env::var("THETA_BENCHMARK_MIN_P").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
     let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
@@ -136,8 +139,11 @@ fn main() {
             break;
         }
         drawn += chunk.len();
-        let got: Vec<Row> =
-            chunk.par_iter().filter(|c| c.n >= 2).filter_map(|c| measure_system(c, &settings, square)).collect();
+        let got: Vec<Row> = chunk
+            .par_iter()
+            .filter(|c| c.n >= 2 && c.p >= min_p)
+            .filter_map(|c| measure_system(c, &settings, square))
+            .collect();
         paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
         rows.extend(got);
     }
@@ -153,7 +159,7 @@ fn main() {
         ("theta (paper)", |r| (r.theta, r.theta_verified)),
         ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
         ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
-        ("theta_engaged (p = 1)", |r| (r.theta_engaged, r.theta_engaged_verified)),
+        ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
         ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
     ];
     let summary = |title: &str, set: &[&Row]| {
@@ -233,6 +239,30 @@ fn main() {
         speed_ratio(|r| r.zdot_bound),
         median(star_vs_ceiling)
     );
+    // by output dimension (issue 29 item 3): theta_engaged and theta_best per p
+    for (title, set) in [("A", &table_a), ("B", &table_b)] {
+        println!();
+        println!("Table {title} by p:");
+        println!();
+        println!("| p | systems | bound | certified | median bound / measured | min | violations |");
+        println!("|---|---|---|---|---|---|---|");
+        for p in 1..=3 {
+            let sub: Vec<&&Row> = set.iter().filter(|r| r.p == p).collect();
+            for (name, get) in &bounds[2..] {
+                let cert: Vec<&&&Row> = sub.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
+                let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
+                let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
+                let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+                println!(
+                    "| {p} | {} | {name} | {} | {:.3} | {lo:.3} | {violations} |",
+                    sub.len(),
+                    cert.len(),
+                    median(ratios.clone())
+                );
+            }
+        }
+    }
+    println!();
     let all_viol = rows
         .iter()
         .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
