@@ -11,9 +11,13 @@
 //! `|eta_T'| - D` (the p = 1 floor, which ignores that the contact point trails the direction of
 //! motion and has to travel round the boundary after each turn).
 //!
+//! The floors are those of the assembly (`contact_floors::for_system` rebuilds its tube kernel;
+//! the test checks the same `D` and the same engaged cells as `assemble`), with the engaged
+//! ceilings: every engaged cell's largest simulated step speed must lie below its ceiling.
+//!
 //! `CONTACT_FLOOR_CASES=N` (default 10) systems with at least one engaged cell.
 #![allow(non_snake_case)]
-use bounds::beyond_paper::contact_floors::{contact_floors, substeps, ContactGeometry};
+use bounds::beyond_paper::contact_floors::{for_system, substeps};
 use bounds::orbit::{EtaOrbit, OrbitSettings};
 use bounds::{assemble, ThetaSettings};
 use dynamics::integrators::catching_up::{CatchingUpSettings, Simulator};
@@ -29,8 +33,8 @@ const CELLS: usize = 400;
 /// Catching-up steps per orbit sample interval (2000 per period).
 const SUB: usize = 10;
 
-/// Smallest step speed `|z_{k+1} - z_k| / h` per cell over two periods of the regime.
-fn simulated_cell_speeds(sys: &model::System, T: f64, mu: f64) -> Vec<f64> {
+/// Smallest and largest step speed `|z_{k+1} - z_k| / h` per cell over two periods of the regime.
+fn simulated_cell_speeds(sys: &model::System, T: f64, mu: f64) -> (Vec<f64>, Vec<f64>) {
     let K = OrbitSettings::default().samples;
     let h = T / (K * SUB) as f64;
     let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, ..Default::default() }).expect("simulator");
@@ -40,15 +44,17 @@ fn simulated_cell_speeds(sys: &model::System, T: f64, mu: f64) -> Vec<f64> {
     let per_period = K * SUB;
     sim.run(0.0, &mut x, &mut z, transient * per_period, |_, _, _, _| {});
     let mut speed = vec![f64::INFINITY; CELLS];
+    let mut top = vec![0.0f64; CELLS];
     let mut prev = z.clone();
     let per_cell = per_period / CELLS;
     sim.run(transient as f64 * T, &mut x, &mut z, 2 * per_period, |k, _, _, zk| {
         let step = ((k - 1) % per_period) / per_cell;
         let v = prev.iter().zip(zk).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / h;
         speed[step] = speed[step].min(v);
+        top[step] = top[step].max(v);
         prev.copy_from_slice(zk);
     });
-    speed
+    (speed, top)
 }
 
 #[test]
@@ -83,15 +89,20 @@ fn contact_floors_hold_cell_by_cell_in_simulated_regimes_with_controls() {
             continue;
         }
         let orbit = EtaOrbit::new(&sys, &OrbitSettings::default()).expect("orbit");
-        let Some(geo) = ContactGeometry::of(&sys.theta, r.R) else { continue };
-        let Some(floors) = contact_floors(&orbit, CELLS, r.d_ftheta, &geo) else { continue };
-        let speed = simulated_cell_speeds(&sys, r.period, r.mu);
+        // the floors as the assembly computes them (same D, same engaged cells)
+        let Ok(Some((floors, d))) = for_system(&sys, CELLS, &ThetaSettings::bound_only()) else { continue };
+        assert_eq!(d.to_bits(), r.d_ftheta.to_bits(), "case {i}: D differs from the assembly's");
+        let engaged_here = floors.floor.iter().filter(|&&f| f > 0.0).count();
+        if r.profile_cells == CELLS && r.engaged_cells > 0 {
+            assert_eq!(engaged_here, r.engaged_cells, "case {i}: engaged cells differ from the assembly's");
+        }
+        let (speed, top) = simulated_cell_speeds(&sys, r.period, r.mu);
         checked += 1;
         by_p[sys.p()] += 1;
         let engaged = floors.floor.iter().filter(|&&f| f > 0.0).count();
         engaged_cells += engaged;
         // the naive control: |eta_T'| - D on every cell where it is positive, engaged at once
-        let subs = substeps(&orbit, r.d_ftheta).expect("substeps");
+        let subs = substeps(&orbit, r.d_ftheta, &|_| r.d_ftheta).expect("substeps");
         let per = subs.len() / CELLS;
         let naive: Vec<f64> = (0..CELLS)
             .map(|c| subs[c * per..(c + 1) * per].iter().map(|s| s.map_or(0.0, |s| s.s)).fold(f64::INFINITY, f64::min))
@@ -108,6 +119,12 @@ fn contact_floors_hold_cell_by_cell_in_simulated_regimes_with_controls() {
                     sys.p(),
                     sys.theta.kind(),
                     speed[cell]
+                );
+                let u = floors.ceiling[cell];
+                assert!(
+                    top[cell] <= u * (1.0 + 1e-2) + 1e-6 * r.eta_dot_inf,
+                    "case {i}: cell {cell}: simulated speed {} above the engaged ceiling {u}",
+                    top[cell]
                 );
                 if speed[cell] < tol(1.1 * f) {
                     raised_caught += 1;

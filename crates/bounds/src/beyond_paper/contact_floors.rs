@@ -104,17 +104,71 @@ pub struct Substep {
     pub s: f64,
     pub tau: f64,
     pub omega: f64,
+    /// Upper bound of `<y', e>` (`|eta_T'| + sigma_band(e)`): with the contact normal within
+    /// `c >= c_k` of `-e`, `|z'| <= s_max + tau sqrt(1 - c_k^2)` (the engaged ceiling).
+    pub s_max: f64,
 }
 
-/// Floors of `|z'|` per orbit sample interval and per cell (0 where not engaged).
+/// Floors and ceilings of `|z'|` per orbit sample interval and per cell (floor 0 and ceiling
+/// infinite where not engaged).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactFloors {
     /// Per sample interval of the orbit.
     pub sub_floor: Vec<f64>,
-    /// Per cell: the smallest of its sample intervals' floors.
+    pub sub_ceiling: Vec<f64>,
+    /// Per cell: the smallest of its sample intervals' floors and the largest ceiling.
     pub floor: Vec<f64>,
+    pub ceiling: Vec<f64>,
     /// Per sample interval: the bound `G_bar` of the gap over it.
     pub gap: Vec<f64>,
+}
+
+/// Upper bounds of the support function of the band `C(F Xi_inf + E Theta)` of (ydot) in a
+/// direction: `sigma_{C F Xi_inf}(u) + sigma_Theta((C E)^T u)` with the tube kernel's proven
+/// upper value, the error of `fl(C F)` ([`crate::tube::cf_rounding::cf_support_error`]) and the
+/// rounding of `(C E)^T u`; never above `D`, its radius.
+pub struct Band<'a> {
+    tube_CF: &'a crate::tube::TubeKernel,
+    theta: &'a Shape,
+    CEt: nalgebra::DMatrix<f64>,
+    err: f64,
+    d: f64,
+}
+
+impl<'a> Band<'a> {
+    /// `tube_CF` the kernel of `C F Xi_inf` built with `tube` (the semigroup `sg` of `F`), `d`
+    /// the proven `D`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        tube_CF: &'a crate::tube::TubeKernel,
+        C: &nalgebra::DMatrix<f64>,
+        F: &nalgebra::DMatrix<f64>,
+        E: &nalgebra::DMatrix<f64>,
+        theta: &'a Shape,
+        sg: &crate::tube::SemigroupData,
+        tube: &crate::tube::TubeSettings,
+        d: f64,
+    ) -> Self {
+        let d_theta = theta.deviation_from_origin().upper;
+        let CE = C * E;
+        // fl(C E) and fl((C E)^T u): within gamma_{n + p + 2} (|C| |E|) |u| of the exact values
+        let abs_ce: f64 = (C.abs() * E.abs()).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let err_w = rounding::gamma(C.ncols() + C.nrows() + 2) * abs_ce * 2.0;
+        let err = crate::tube::cf_rounding::cf_support_error(C, F, E, tube.f_radius, sg, d_theta) + d_theta * err_w;
+        Self { tube_CF, theta, CEt: CE.transpose(), err, d }
+    }
+
+    /// Upper bound of `sigma_band(u)` for `|u| <= 1 + 1e-9` (at most `D`).
+    pub fn support_upper(&self, u: &[f64]) -> f64 {
+        let w = &self.CEt * nalgebra::DVector::from_column_slice(u);
+        let v = self.tube_CF.support_upper(u) + self.theta.support_upper(w.as_slice()) + self.err;
+        let v = pad_up(v, 4.0 * REL);
+        if v.is_finite() {
+            v.min(self.d)
+        } else {
+            self.d
+        }
+    }
 }
 
 /// Laps of the period: the state is started from `G <= width` at `t = 0` of some late period
@@ -124,7 +178,12 @@ const LAPS: usize = 3;
 /// The sample intervals' constants of `orbit` (closed-form samples; `None` when the orbit is not
 /// verified, `p < 2`, or `D` is not finite): `|eta_T'|` from below by the samples less the
 /// Lipschitz constant times half the spacing and the samples' margin, `omega = Lip / |eta_T'|`.
-pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64) -> Option<Vec<Option<Substep>>> {
+///
+/// `band(u)` bounds the support function of the band of (ydot) in the unit direction `u`
+/// ([`Band::support_upper`]; `|_| D` is always valid): `<y', e> >= |eta_T'| - band(-e)`, with
+/// `band` taken at both ends of the interval plus `D` times the turn of `e` over half of it and
+/// the samples' direction error.
+pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64, band: &dyn Fn(&[f64]) -> f64) -> Option<Vec<Option<Substep>>> {
     if !orbit.verified || orbit.deta.first().map_or(0, Vec::len) < 2 || !d_ftheta.is_finite() {
         return None;
     }
@@ -132,7 +191,12 @@ pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64) -> Option<Vec<Option<Substep>>>
     let dt = orbit.period / K as f64;
     let lip = orbit.deta_lipschitz;
     let slack = pad_up(0.5 * dt * lip + 2.0 * orbit.rel_margin * orbit.eta_dot_inf, REL);
-    let norm_down = |d: &[f64]| sqrt_down(d.iter().map(|x| x * x).sum::<f64>() * (1.0 - REL));
+    let sample_err = 2.0 * orbit.rel_margin * orbit.eta_dot_inf;
+    let norm = |d: &[f64]| d.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let unit = |d: &[f64], sign: f64| -> Vec<f64> {
+        let n = norm(d);
+        d.iter().map(|x| sign * x / n).collect()
+    };
     let jumps: std::collections::BTreeSet<usize> = orbit.jumps.iter().map(|j| j.interval).collect();
     Some(
         (0..K)
@@ -140,14 +204,20 @@ pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64) -> Option<Vec<Option<Substep>>>
                 if jumps.contains(&k) {
                     return None;
                 }
-                let m = norm_down(&orbit.deta[k]).min(norm_down(&orbit.deta[k + 1])) - slack;
-                let m = pad_down(m, REL);
-                let s = pad_down(m - d_ftheta, REL);
-                (m > 0.0 && s > 0.0 && lip.is_finite()).then(|| Substep {
-                    s,
-                    tau: d_ftheta,
-                    omega: pad_up(lip / m, REL),
-                })
+                let (a, b) = (&orbit.deta[k], &orbit.deta[k + 1]);
+                let m = pad_down(norm(a).min(norm(b)) * (1.0 - REL) - slack, REL);
+                let top = pad_up(norm(a).max(norm(b)) * (1.0 + REL) + slack, REL);
+                if !(m > 0.0 && lip.is_finite()) {
+                    return None;
+                }
+                let omega = pad_up(lip / m, REL);
+                // e over the interval: within omega dt / 2 of an end's direction, and a sampled
+                // direction within 2 sample_err / m of the true one
+                let turn = pad_up(d_ftheta * (omega * 0.5 * dt + 2.0 * sample_err / m + 1e-9), REL);
+                let back = pad_up(band(&unit(a, -1.0)).max(band(&unit(b, -1.0))) + turn, REL).min(d_ftheta);
+                let fwd = pad_up(band(&unit(a, 1.0)).max(band(&unit(b, 1.0))) + turn, REL).min(d_ftheta);
+                let s = pad_down(m - back, REL);
+                (s > 0.0).then(|| Substep { s, tau: d_ftheta, omega, s_max: pad_up(top + fwd, REL) })
             })
             .collect(),
     )
@@ -211,6 +281,13 @@ fn floor_at_c(c: f64, st: &Substep) -> f64 {
     let c = c.min(1.0);
     let across = pad_up(st.tau * sqrt_up(pad_up((1.0 - c) * (1.0 + c), REL)), REL);
     pad_down(pad_down(st.s * c, REL) - across, REL).max(0.0)
+}
+
+/// `s_max + tau sqrt(1 - c^2)` from above: `|z'| = <y', e> c' - <q, n>` on the boundary with
+/// `-<n, e> = c' >= c >= 0`.
+fn ceiling_at_c(c: f64, st: &Substep) -> f64 {
+    let c = c.clamp(0.0, 1.0);
+    pad_up(st.s_max + st.tau * sqrt_up(pad_up((1.0 - c) * (1.0 + c), REL)), REL)
 }
 
 /// `c = 1 - G / r` from below: the cosine bound that the gap bound `g` gives on the boundary.
@@ -288,15 +365,17 @@ fn catch_rate(c_hi: f64, st: &Substep, drift: f64) -> f64 {
 
 /// Floors of `|z'|` per sample interval (module docs) from the intervals' constants, each of
 /// length `dt`; `start_gap` the bound of `G` at the start of a run (`geo.width`: any state).
-/// Returns the floors and the gap bounds per interval.
+/// Returns the floors, the engaged ceilings (infinite where not engaged) and the gap bounds per
+/// interval.
 pub fn floors_from_substeps(
     subs: &[Option<Substep>],
     dt: f64,
     geo: &ContactGeometry,
     start_gap: f64,
-) -> (Vec<f64>, Vec<f64>) {
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let K = subs.len();
     let mut floor = vec![0.0; K];
+    let mut ceiling = vec![f64::INFINITY; K];
     let mut gaps = vec![geo.width; K];
     let mut g = start_gap;
     // Some(c_bar): v is on the boundary with -<n, e> >= c_bar at the start of the interval
@@ -311,7 +390,7 @@ pub fn floors_from_substeps(
             let Some(st) = sub else {
                 (g, engaged, touch, catch) = (start_gap, None, None, [None; C_HI.len()]);
                 if last {
-                    (floor[k], gaps[k]) = (0.0, geo.width);
+                    (floor[k], ceiling[k], gaps[k]) = (0.0, f64::INFINITY, geo.width);
                 }
                 continue;
             };
@@ -319,13 +398,14 @@ pub fn floors_from_substeps(
             let leave = c_leave(st);
             let c_gap = c_of_gap(sup, geo);
             let drift = pad_up(st.omega * sqrt_up(2.0 * geo.R * sup), REL);
-            let mut fk = 0.0;
+            let (mut fk, mut ck) = (0.0, f64::INFINITY);
             if let Some(cb) = engaged {
                 // the cosine bound kept over the interval: a barrier level below cb, or the gap's
                 let barrier = c_barrier(cb, leave, st, geo);
                 let c_eff = barrier.unwrap_or(f64::NEG_INFINITY).max(c_gap);
                 if c_eff > leave {
                     fk = floor_at_c(c_eff, st);
+                    ck = ceiling_at_c(c_eff, st);
                     let raised = barrier.map_or(f64::NEG_INFINITY, |L| c_gain(L, dt, st, geo));
                     engaged = Some(raised.max(c_of_gap(next, geo)));
                 } else {
@@ -364,28 +444,62 @@ pub fn floors_from_substeps(
                 }
             }
             if last {
-                (floor[k], gaps[k]) = (fk, sup);
+                (floor[k], ceiling[k], gaps[k]) = (fk, ck, sup);
             }
             g = next;
         }
     }
-    (floor, gaps)
+    (floor, ceiling, gaps)
 }
 
 /// The floors for `orbit` split into `cells` equal cells (`cells` divides the samples), `None`
 /// when [`substeps`] gives none or no cell is engaged.
-pub fn contact_floors(orbit: &EtaOrbit, cells: usize, d_ftheta: f64, geo: &ContactGeometry) -> Option<ContactFloors> {
-    let subs = substeps(orbit, d_ftheta)?;
+pub fn contact_floors(
+    orbit: &EtaOrbit,
+    cells: usize,
+    d_ftheta: f64,
+    band: &dyn Fn(&[f64]) -> f64,
+    geo: &ContactGeometry,
+) -> Option<ContactFloors> {
+    let subs = substeps(orbit, d_ftheta, band)?;
     let K = subs.len();
     if cells == 0 || !K.is_multiple_of(cells) {
         return None;
     }
     let dt = orbit.period / K as f64;
-    let (sub_floor, gap) = floors_from_substeps(&subs, dt, geo, geo.width);
+    let (sub_floor, sub_ceiling, gap) = floors_from_substeps(&subs, dt, geo, geo.width);
     let per = K / cells;
     let floor: Vec<f64> =
         (0..cells).map(|c| sub_floor[c * per..(c + 1) * per].iter().copied().fold(f64::INFINITY, f64::min)).collect();
-    floor.iter().any(|&f| f > 0.0).then_some(ContactFloors { sub_floor, floor, gap })
+    let ceiling: Vec<f64> =
+        (0..cells).map(|c| sub_ceiling[c * per..(c + 1) * per].iter().copied().fold(0.0, f64::max)).collect();
+    floor.iter().any(|&f| f > 0.0).then_some(ContactFloors { sub_floor, sub_ceiling, floor, ceiling, gap })
+}
+
+/// The floors of `sys` as [`crate::assemble`] computes them (its stage 2's tube kernel of
+/// `C F Xi_inf`, `D`, `R` and orbit, rebuilt here with the same settings), for tests and
+/// benchmarks that compare them with simulations: `(floors, D)`, `None` where the assembly
+/// computes none.
+pub fn for_system(
+    sys: &model::System,
+    cells: usize,
+    settings: &crate::ThetaSettings,
+) -> Result<Option<(ContactFloors, f64)>, crate::BoundsError> {
+    use crate::tube::{tube_diameters_with, SemigroupData, TubeSettings};
+    let F = sys.F();
+    let (C, E) = (&sys.C, &sys.E);
+    let tube =
+        TubeSettings { f_radius: lmi::verify::f_enclosure_radius(&F, E, C).norm() * (1.0 + 1e-10), ..settings.tube };
+    let sg = SemigroupData::new(&F);
+    let d_theta = sys.theta.deviation_from_origin().upper;
+    let diam = tube_diameters_with(C, &F, E, &sys.theta, d_theta, &sg, &tube, &settings.sphere)?;
+    let d_ftheta = diam.d_ftheta.upper;
+    let orbit = EtaOrbit::new(sys, &settings.orbit)?;
+    let Some(geo) = ContactGeometry::of(&sys.theta, sys.theta.strong_convexity().upper()) else { return Ok(None) };
+    let band = Band::new(&diam.tube_CF, C, &F, E, &sys.theta, &sg, &tube, d_ftheta);
+    let K = orbit.t.len() - 1;
+    let cells = (1..=cells.min(K).max(1)).rev().find(|&d| K.is_multiple_of(d)).unwrap_or(1);
+    Ok(contact_floors(&orbit, cells, d_ftheta, &|u| band.support_upper(u), &geo).map(|f| (f, d_ftheta)))
 }
 
 #[cfg(test)]
@@ -402,9 +516,9 @@ mod tests {
     #[test]
     fn circle_without_band_approaches_the_exact_steady_speed() {
         let geo = ball(0.2);
-        let st = Substep { s: 1.0, tau: 0.0, omega: 1.0 };
+        let st = Substep { s: 1.0, tau: 0.0, omega: 1.0, s_max: 1.0 };
         let subs = vec![Some(st); 2000];
-        let (floor, _) = floors_from_substeps(&subs, std::f64::consts::TAU / 2000.0, &geo, geo.width);
+        let (floor, _, _) = floors_from_substeps(&subs, std::f64::consts::TAU / 2000.0, &geo, geo.width);
         let exact = (1.0f64 - 0.04).sqrt();
         let best = floor.iter().copied().fold(0.0, f64::max);
         assert!(best <= exact + 1e-12, "floor {best} above the exact normal speed {exact}");
@@ -416,10 +530,10 @@ mod tests {
     #[test]
     fn a_break_resets_engagement() {
         let geo = ball(0.2);
-        let st = Substep { s: 1.0, tau: 0.05, omega: 0.5 };
+        let st = Substep { s: 1.0, tau: 0.05, omega: 0.5, s_max: 1.1 };
         let mut subs = vec![Some(st); 400];
         subs[100] = None;
-        let (floor, _) = floors_from_substeps(&subs, 0.01, &geo, geo.width);
+        let (floor, _, _) = floors_from_substeps(&subs, 0.01, &geo, geo.width);
         assert_eq!(floor[100], 0.0);
         assert_eq!(floor[101], 0.0, "just after a break nothing is engaged");
         assert!(floor[399] > 0.5, "{}", floor[399]);

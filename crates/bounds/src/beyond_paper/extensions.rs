@@ -8,7 +8,7 @@
 //! [`extensions`] is a list of named steps: [`speed_profiles`] -> [`speeds_star`] ->
 //! [`theta_star`] -> [`theta_profile`] -> [`theta_engaged`] -> [`best`]. [`pinned_speed`] runs
 //! earlier, right after the paper's tube stage whose kernels it shares.
-use crate::beyond_paper::contact_floors::{contact_floors, ContactGeometry};
+use crate::beyond_paper::contact_floors::{contact_floors, Band, ContactGeometry};
 use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
 use crate::beyond_paper::speed_profile::SpeedProfile;
 use crate::error::BoundsError;
@@ -246,9 +246,11 @@ fn contact_profile(paper: &FromPaper, prof: &SpeedProfile, cells: usize) -> Opti
     if paper.sys.p() < 2 || !paper.strongly_convex {
         return None;
     }
-    let geo = ContactGeometry::of(&paper.sys.theta, paper.R)?;
-    let floors = contact_floors(paper.orbit, cells, paper.d_ftheta, &geo)?;
-    let prof = prof.clone().with_speed_floors(&floors.floor);
+    let sys = paper.sys;
+    let geo = ContactGeometry::of(&sys.theta, paper.R)?;
+    let band = Band::new(paper.tube_CF, &sys.C, paper.F, &sys.E, &sys.theta, paper.sg, paper.tube, paper.d_ftheta);
+    let floors = contact_floors(paper.orbit, cells, paper.d_ftheta, &|u| band.support_upper(u), &geo)?;
+    let prof = prof.clone().with_speed_ceilings(&floors.ceiling).with_speed_floors(&floors.floor);
     (prof.engaged_cells() > 0).then_some(prof)
 }
 

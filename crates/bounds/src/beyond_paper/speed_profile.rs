@@ -152,6 +152,19 @@ impl SpeedProfile {
         self
     }
 
+    /// The profile with given ceilings of `|z'|` per cell where lower (`p >= 2`: the engaged
+    /// ceilings of balls and ellipsoids, [`crate::beyond_paper::contact_floors`]): `g_c =
+    /// min(g_c, ceiling_c / R)` rounded up. Call before [`SpeedProfile::with_speed_floors`].
+    pub fn with_speed_ceilings(mut self, zdot_ceiling: &[f64]) -> Self {
+        assert_eq!(zdot_ceiling.len(), self.cells(), "one ceiling per cell");
+        for (g, &u) in self.g.iter_mut().zip(zdot_ceiling) {
+            if u.is_finite() && u >= 0.0 {
+                *g = g.min(scale_up(scale_up(u, MARGIN) / self.R, MARGIN));
+            }
+        }
+        self
+    }
+
     /// The profile with given floors of `|z'|` per cell (`p >= 2`: the contact floors of balls
     /// and ellipsoids, [`crate::beyond_paper::contact_floors`]; proofs-notes/theta-engaged-balls.md):
     /// `l_c = floor_c / R` rounded down, never above the cell's ceiling. No engaged history.
