@@ -198,30 +198,51 @@ pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64, band: &dyn Fn(&[f64]) -> f64) -
         d.iter().map(|x| sign * x / n).collect()
     };
     let jumps: std::collections::BTreeSet<usize> = orbit.jumps.iter().map(|j| j.interval).collect();
+    // |eta_T'| from below and above on each interval, and |e'| from above
+    let (m, top): (Vec<f64>, Vec<f64>) = (0..K)
+        .map(|k| {
+            let (a, b) = (norm(&orbit.deta[k]), norm(&orbit.deta[k + 1]));
+            (pad_down(a.min(b) * (1.0 - REL) - slack, REL), pad_up(a.max(b) * (1.0 + REL) + slack, REL))
+        })
+        .unzip();
+    // The band in the direction of motion, evaluated at every BAND_STRIDE-th sample (the tube
+    // kernel's support is the costly part): on a block of intervals e stays within
+    // omega_max (block length) / 2 of a direction at the block's ends (plus the samples'
+    // direction error 2 sample_err / m), and the band's support is D-Lipschitz.
+    let blocks = K.div_ceil(BAND_STRIDE);
+    let block_band: Vec<(f64, f64)> = (0..blocks)
+        .map(|bk| {
+            let (i0, i1) = (bk * BAND_STRIDE, ((bk + 1) * BAND_STRIDE).min(K));
+            let m_min = m[i0..i1].iter().copied().fold(f64::INFINITY, f64::min);
+            if !(m_min > 0.0 && lip.is_finite()) || (i0..i1).any(|k| jumps.contains(&k)) {
+                return (d_ftheta, d_ftheta);
+            }
+            let omega = pad_up(lip / m_min, REL);
+            let span = (i1 - i0) as f64 * dt;
+            let turn = pad_up(d_ftheta * (omega * 0.5 * span + 2.0 * sample_err / m_min + 1e-9), REL);
+            let (a, b) = (&orbit.deta[i0], &orbit.deta[i1]);
+            let back = pad_up(band(&unit(a, -1.0)).max(band(&unit(b, -1.0))) + turn, REL).min(d_ftheta);
+            let fwd = pad_up(band(&unit(a, 1.0)).max(band(&unit(b, 1.0))) + turn, REL).min(d_ftheta);
+            (back, fwd)
+        })
+        .collect();
     Some(
         (0..K)
             .map(|k| {
-                if jumps.contains(&k) {
+                if jumps.contains(&k) || !(m[k] > 0.0 && lip.is_finite()) {
                     return None;
                 }
-                let (a, b) = (&orbit.deta[k], &orbit.deta[k + 1]);
-                let m = pad_down(norm(a).min(norm(b)) * (1.0 - REL) - slack, REL);
-                let top = pad_up(norm(a).max(norm(b)) * (1.0 + REL) + slack, REL);
-                if !(m > 0.0 && lip.is_finite()) {
-                    return None;
-                }
-                let omega = pad_up(lip / m, REL);
-                // e over the interval: within omega dt / 2 of an end's direction, and a sampled
-                // direction within 2 sample_err / m of the true one
-                let turn = pad_up(d_ftheta * (omega * 0.5 * dt + 2.0 * sample_err / m + 1e-9), REL);
-                let back = pad_up(band(&unit(a, -1.0)).max(band(&unit(b, -1.0))) + turn, REL).min(d_ftheta);
-                let fwd = pad_up(band(&unit(a, 1.0)).max(band(&unit(b, 1.0))) + turn, REL).min(d_ftheta);
-                let s = pad_down(m - back, REL);
-                (s > 0.0).then(|| Substep { s, tau: d_ftheta, omega, s_max: pad_up(top + fwd, REL) })
+                let omega = pad_up(lip / m[k], REL);
+                let (back, fwd) = block_band[k / BAND_STRIDE];
+                let s = pad_down(m[k] - back, REL);
+                (s > 0.0).then(|| Substep { s, tau: d_ftheta, omega, s_max: pad_up(top[k] + fwd, REL) })
             })
             .collect(),
     )
 }
+
+/// Orbit sample intervals per evaluation of the band's support ([`substeps`]).
+const BAND_STRIDE: usize = 10;
 
 /// Upper bound of `H(G)` for `G in [g1, g2]` (module docs).
 fn h_upper(g1: f64, g2: f64, st: &Substep, geo: &ContactGeometry) -> f64 {
