@@ -104,7 +104,7 @@ fn bad_inputs_give_named_errors_or_reported_cases() {
     assert_eq!(r.theta, r.psi_0);
     assert!(r.theta > 0.0 && !r.convergence_guaranteed, "alpha = 0 gives psi(0) > 0");
     assert!(r.theta_profile == r.theta_star && r.profile_intervals == 0, "no profile without strong convexity");
-    assert!(!r.theta_engaged_verified && r.engaged_cells == 0, "no floors for p = 2");
+    assert!(!r.theta_engaged_verified && r.engaged_cells == 0, "no floors without strong convexity");
     assert!(r.notes.iter().any(|n| n.contains("not strongly convex")));
 }
 
@@ -165,4 +165,25 @@ fn psi_at_zero_is_never_negative_on_the_examples() {
             assert!(psi.at_zero() >= 0.0, "{name}: psi(0) = {} at lambda = {l}", psi.at_zero());
         }
     }
+}
+
+/// theta_engaged for balls and ellipsoids in R^2 and R^3 (proofs-notes/theta-engaged-balls.md):
+/// on the ellipse and ellipsoid examples the contact floors engage, `theta_engaged` is verified
+/// and at most `theta_profile`; on the lens (an intersection of discs, no curvature bound) it
+/// is not computed. Before the contact floors no p >= 2 system had an engaged cell.
+#[test]
+fn contact_floors_engage_on_the_p2_and_p3_examples() {
+    let s = ThetaSettings::bound_only();
+    for name in ["ellipse-p2.toml", "ellipsoid-p3.toml"] {
+        let r = assemble(&load(name), &s).unwrap();
+        eprintln!(
+            "{name}: theta_profile {} theta_engaged {} ({} of {} cells engaged) verified {}",
+            r.theta_profile, r.theta_engaged, r.engaged_cells, r.profile_cells, r.theta_engaged_verified
+        );
+        assert!(r.engaged_cells > 0, "{name}: no engaged cell");
+        assert_eq!(r.theta_engaged_verified, r.theta_profile_verified, "{name}");
+        assert!(r.theta_engaged <= r.theta_profile, "{name}");
+    }
+    let lens = assemble(&load("lens-p2.toml"), &s).unwrap();
+    assert!(lens.engaged_cells == 0 && !lens.theta_engaged_verified);
 }

@@ -10,6 +10,8 @@
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
 //! `THETA_BENCHMARK_INPUT=square` gives every system a square wave of the same amplitudes,
 //! period and phase instead of its sine (issue 29 item 2: the same systems, another input).
+//! `THETA_BENCHMARK_MIN_P=2` keeps only the drawn systems with `p >= 2` (issue 29 item 3: balls
+//! and ellipsoids in R^2 and R^3); the tables end with a breakdown by `p`.
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use rayon::prelude::*;
@@ -42,6 +44,10 @@ struct Row {
     /// For systems the paper certifies: eq. (theta) with the measured path and limsup |z'|,
     /// minimised by a lambda search of its own (the ceiling; not a bound).
     ceiling: Option<f64>,
+    /// For p >= 2 systems the paper certifies: theta_engaged's profile with the *simulated*
+    /// smallest |z'| per cell as floors (the exact normal speed; not a bound), minimised over the
+    /// certified curve: how far any speed floor can take theta_engaged.
+    floor_ceiling: Option<f64>,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -91,7 +97,41 @@ fn measure_system(
                 .min_by(f64::total_cmp)
         })
         .flatten();
-    Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling })
+    let floor_ceiling =
+        (sys.p() >= 2 && rep.theta_verified && rep.theta < 0.0).then(|| measured_floor_ceiling(&sys, &rep)).flatten();
+    Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling, floor_ceiling })
+}
+
+/// theta_engaged's bound with the simulated smallest `|z'|` per cell (400 cells, catching-up
+/// steps of `T / 20000`, two periods after `e^{mu t} < 1e-6`) as the floors and the certified
+/// ceilings and path bounds otherwise, at the best point of the certified curve (not a bound).
+fn measured_floor_ceiling(sys: &model::System, rep: &ThetaReport) -> Option<f64> {
+    use dynamics::integrators::catching_up::{CatchingUpSettings, Simulator};
+    const CELLS: usize = 400;
+    let orbit = bounds::orbit::EtaOrbit::new(sys, &bounds::orbit::OrbitSettings::default()).ok()?;
+    let (edot, nodes) = orbit.eta_dot_cells(CELLS)?;
+    let period = rep.period;
+    let steps = 20_000usize;
+    let h = period / steps as f64;
+    let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, ..Default::default() }).ok()?;
+    let (mut x, mut z) = (vec![0.0; sys.n()], vec![0.0; sys.p()]);
+    let transient = ((14.0 / -rep.mu) / period).ceil().max(5.0) as usize;
+    sim.run(0.0, &mut x, &mut z, transient * steps, |_, _, _, _| {});
+    let mut speed = vec![f64::INFINITY; CELLS];
+    let mut prev = z.clone();
+    sim.run(transient as f64 * period, &mut x, &mut z, 2 * steps, |k, _, _, zk| {
+        let c = ((k - 1) % steps) / (steps / CELLS);
+        let v = prev.iter().zip(zk).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / h;
+        speed[c] = speed[c].min(v);
+        prev.copy_from_slice(zk);
+    });
+    let prof = bounds::beyond_paper::SpeedProfile::new(period, nodes, &edot, rep.d_ftheta, rep.d, rep.R)
+        .with_speed_floors(&speed);
+    let alpha = rep.alpha.lower;
+    let at = |l: f64, b: f64| bounds::Psi { alpha, lambda: l, beta: b };
+    let (l0, b0, _) = *rep.curve.iter().min_by(|a, b| a.2.total_cmp(&b.2))?;
+    let parts = prof.best_partition(&at(l0, b0), 4);
+    rep.curve.iter().map(|&(l, b, _)| prof.bound(&at(l, b), &parts)).filter(|t| t.is_finite()).min_by(f64::total_cmp)
 }
 
 /// Every row of table A (`THETA_BENCHMARK_ROWS`).
@@ -121,6 +161,7 @@ fn main() {
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
     let square = std::env::var("THETA_BENCHMARK_INPUT").is_ok_and(|v| v == "square");
+    let min_p: usize = std::env::var("THETA_BENCHMARK_MIN_P").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
     let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
@@ -136,8 +177,11 @@ fn main() {
             break;
         }
         drawn += chunk.len();
-        let got: Vec<Row> =
-            chunk.par_iter().filter(|c| c.n >= 2).filter_map(|c| measure_system(c, &settings, square)).collect();
+        let got: Vec<Row> = chunk
+            .par_iter()
+            .filter(|c| c.n >= 2 && c.p >= min_p)
+            .filter_map(|c| measure_system(c, &settings, square))
+            .collect();
         paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
         rows.extend(got);
     }
@@ -153,7 +197,7 @@ fn main() {
         ("theta (paper)", |r| (r.theta, r.theta_verified)),
         ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
         ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
-        ("theta_engaged (p = 1)", |r| (r.theta_engaged, r.theta_engaged_verified)),
+        ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
         ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
     ];
     let summary = |title: &str, set: &[&Row]| {
@@ -233,6 +277,38 @@ fn main() {
         speed_ratio(|r| r.zdot_bound),
         median(star_vs_ceiling)
     );
+    // by output dimension (issue 29 item 3): theta_engaged and theta_best per p
+    for (title, set) in [("A", &table_a), ("B", &table_b)] {
+        println!();
+        println!("Table {title} by p:");
+        println!();
+        println!("| p | systems | bound | certified | median bound / measured | min | violations |");
+        println!("|---|---|---|---|---|---|---|");
+        for p in 1..=3 {
+            let sub: Vec<&&Row> = set.iter().filter(|r| r.p == p).collect();
+            for (name, get) in &bounds[2..] {
+                let cert: Vec<&&&Row> = sub.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
+                let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
+                let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
+                let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+                println!(
+                    "| {p} | {} | {name} | {} | {:.3} | {lo:.3} | {violations} |",
+                    sub.len(),
+                    cert.len(),
+                    median(ratios.clone())
+                );
+            }
+        }
+    }
+    let fc: Vec<f64> =
+        table_b.iter().filter_map(|r| r.floor_ceiling.filter(|c| *c < 0.0).map(|c| c / r.rate)).collect();
+    let fc_n = table_b.iter().filter(|r| r.p >= 2).count();
+    println!(
+        "Table B, p >= 2: theta_engaged with the simulated smallest |z'| per cell as floors (not a bound): < 0 on {} of {fc_n}, median / measured {:.3}.",
+        fc.len(),
+        median(fc.clone())
+    );
+    println!();
     let all_viol = rows
         .iter()
         .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))

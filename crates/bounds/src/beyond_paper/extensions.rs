@@ -1,12 +1,14 @@
 //! The bounds beyond the paper, computed from the paper's stages: `theta*` (eq. (theta) with
 //! the strongest proven path bound, proofs-notes/theta-star.md), `theta_profile` (the chord
-//! argument resolved in time, proofs-notes/theta-profile.md), `theta_engaged` (p = 1: speed
-//! floors where the backlash is provably engaged, proofs-notes/theta-engaged.md) and the best
+//! argument resolved in time, proofs-notes/theta-profile.md), `theta_engaged` (speed floors
+//! where the backlash is provably engaged: p = 1, proofs-notes/theta-engaged.md; balls and
+//! ellipsoids in R^2, R^3, proofs-notes/theta-engaged-balls.md) and the best
 //! verified one of these and the paper's `theta`.
 //!
 //! [`extensions`] is a list of named steps: [`speed_profiles`] -> [`speeds_star`] ->
 //! [`theta_star`] -> [`theta_profile`] -> [`theta_engaged`] -> [`best`]. [`pinned_speed`] runs
 //! earlier, right after the paper's tube stage whose kernels it shares.
+use crate::beyond_paper::contact_floors::{contact_floors, Band, ContactGeometry};
 use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
 use crate::beyond_paper::speed_profile::SpeedProfile;
 use crate::error::BoundsError;
@@ -159,7 +161,7 @@ struct Profiles {
     /// The profile of `theta_profile` (the engaged profile's ceilings without its floors when
     /// there is one).
     profile: Option<SpeedProfile>,
-    /// The profile of `theta_engaged` (p = 1, some cell engaged).
+    /// The profile of `theta_engaged` (p = 1, or a ball or an ellipsoid for p >= 2; some cell engaged).
     engaged: Option<SpeedProfile>,
 }
 
@@ -220,6 +222,9 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
             };
             (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
         }
+        // p >= 2, a ball or an ellipsoid: floors from the normal component of y' at the contact
+        // point (beyond_paper::contact_floors; proofs-notes/theta-engaged-balls.md)
+        (Some(prof), None, None) => contact_profile(paper, prof, cells),
         _ => None,
     };
     // theta_profile uses the engaged profile's ceilings (valid at every time of their cells)
@@ -233,6 +238,20 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
         None => profile,
     };
     Profiles { cells, profile, engaged }
+}
+
+/// The profile with the contact floors of a ball or an ellipsoid (`p >= 2`, closed-form orbit):
+/// `None` when the set has no proven curvature radii or no cell is engaged.
+fn contact_profile(paper: &FromPaper, prof: &SpeedProfile, cells: usize) -> Option<SpeedProfile> {
+    if paper.sys.p() < 2 || !paper.strongly_convex {
+        return None;
+    }
+    let sys = paper.sys;
+    let geo = ContactGeometry::of(&sys.theta, paper.R)?;
+    let band = Band::new(paper.tube_CF, &sys.C, paper.F, &sys.E, &sys.theta, paper.sg, paper.tube, paper.d_ftheta);
+    let floors = contact_floors(paper.orbit, cells, paper.d_ftheta, &|u| band.support_upper(u), &geo)?;
+    let prof = prof.clone().with_speed_ceilings(&floors.ceiling).with_speed_floors(&floors.floor);
+    (prof.engaged_cells() > 0).then_some(prof)
 }
 
 /// The speeds of `theta*`: `gamma_1*` from the strongest path bound, `gamma_inf*` from the
@@ -376,7 +395,7 @@ struct EngagedBound {
     cells: usize,
 }
 
-/// `theta_engaged` (p = 1): the engaged profile's best partition and a lambda search of its own
+/// `theta_engaged`: the engaged profile's best partition and a lambda search of its own
 /// (never above `theta_profile`).
 fn theta_engaged(
     paper: &FromPaper,

@@ -152,6 +152,32 @@ impl SpeedProfile {
         self
     }
 
+    /// The profile with given ceilings of `|z'|` per cell where lower (`p >= 2`: the engaged
+    /// ceilings of balls and ellipsoids, [`crate::beyond_paper::contact_floors`]): `g_c =
+    /// min(g_c, ceiling_c / R)` rounded up. Call before [`SpeedProfile::with_speed_floors`].
+    pub fn with_speed_ceilings(mut self, zdot_ceiling: &[f64]) -> Self {
+        assert_eq!(zdot_ceiling.len(), self.cells(), "one ceiling per cell");
+        for (g, &u) in self.g.iter_mut().zip(zdot_ceiling) {
+            if u.is_finite() && u >= 0.0 {
+                *g = g.min(scale_up(scale_up(u, MARGIN) / self.R, MARGIN));
+            }
+        }
+        self
+    }
+
+    /// The profile with given floors of `|z'|` per cell (`p >= 2`: the contact floors of balls
+    /// and ellipsoids, [`crate::beyond_paper::contact_floors`]; proofs-notes/theta-engaged-balls.md):
+    /// `l_c = floor_c / R` rounded down, never above the cell's ceiling. No engaged history.
+    pub fn with_speed_floors(mut self, zdot_floor: &[f64]) -> Self {
+        assert_eq!(zdot_floor.len(), self.cells(), "one floor per cell");
+        for (c, &f) in zdot_floor.iter().enumerate() {
+            let l = if f > 0.0 { f / self.R * (1.0 - 1e-12) } else { 0.0 };
+            self.floor[c] = l.min(self.g[c]).max(0.0);
+            self.engaged_age[c] = None;
+        }
+        self
+    }
+
     /// The engaged cells' bounds from the backlash's engaged history ([`EngagedHistory`], p = 1;
     /// proofs-notes/theta-engaged.md, "Engaged history"): on a cell engaged (sign `sigma`) for at
     /// least `age h`, `z' - eta_T'` lies in `hist.band(age h, w)` with `w = lo` (rising) or `hi`

@@ -176,7 +176,7 @@ pub mod defs {
         "$\\theta_{\\mathrm{eng}}$",
         "(theta),(ydot),(diffs1)",
         Upper,
-        "theta_profile with speed floors where the backlash is engaged, p = 1 (beyond the paper, proofs-notes/theta-engaged.md)",
+        "theta_profile with speed floors where the backlash is engaged, p = 1 or a ball or an ellipsoid in R^2, R^3 (beyond the paper, proofs-notes/theta-engaged.md, theta-engaged-balls.md)",
     );
     pub const PATH_BOUND: QuantityDef =
         q("path_bound", "(osc - d)_+", "$(\\mathrm{osc}-d)_+$", "(path)", Lower, "liminf path length of z per period");

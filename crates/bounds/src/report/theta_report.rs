@@ -120,10 +120,12 @@ pub struct ThetaReport {
     pub lambda_profile: f64,
     pub profile_intervals: usize,
     pub profile_cells: usize,
-    /// `theta_engaged` (p = 1): `theta_profile` with speed floors on the cells where the backlash
-    /// is provably engaged (beyond the paper, [`crate::beyond_paper::speed_profile`],
-    /// proofs-notes/theta-engaged.md), `<= theta_profile`. Equal to `theta_profile` and not
-    /// verified when `p > 1` or no cell is engaged.
+    /// `theta_engaged`: `theta_profile` with speed floors on the cells where the backlash is
+    /// provably engaged (beyond the paper, [`crate::beyond_paper::speed_profile`]; p = 1:
+    /// proofs-notes/theta-engaged.md; balls and ellipsoids for p >= 2:
+    /// [`crate::beyond_paper::contact_floors`], proofs-notes/theta-engaged-balls.md),
+    /// `<= theta_profile`. Equal to `theta_profile` and not verified for other sets with
+    /// `p > 1` or when no cell is engaged.
     pub theta_engaged: f64,
     pub theta_engaged_verified: bool,
     /// The certified `lambda` at which `theta_engaged` is attained, and the number of engaged
@@ -213,7 +215,7 @@ impl ThetaReport {
             } else if self.p == 1 {
                 "no cell provably engaged: equals theta_profile".to_string()
             } else {
-                "p = 1 only: equals theta_profile".to_string()
+                "no cell provably engaged (p >= 2: balls and ellipsoids only): equals theta_profile".to_string()
             }),
             PATH_BOUND.with(self.path_bound, orb && self.d_verified),
             PATH1_BOUND
