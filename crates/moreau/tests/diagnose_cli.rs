@@ -365,3 +365,38 @@ fn several_recordings_bad_input_is_a_one_line_error() {
     let o = diagnose_several(&[flag("--data"), &a, flag("--validate-on"), &extra], &out);
     assert_rejected(&o, &out, &["extra.csv", "current"]);
 }
+
+#[test]
+fn size_presets_put_the_figures_at_column_width_and_the_joint_diagnosis_rejects_them() {
+    // `--size column|two-column`: every figure the preset's width, each stack panel two thirds
+    // of its height (moreau::figures::diagnosis::stack_size); the layouts are checked in
+    // tests/figure_layout.rs
+    let d = tempfile::tempdir().unwrap();
+    for (preset, w, h2, h3) in [("column", 252, 288, 432), ("two-column", 515, 344, 516)] {
+        let out = d.path().join(preset);
+        let o = moreau()
+            .arg("diagnose")
+            .arg("--model")
+            .arg(root("examples/real/bam-xl330-kp100.toml"))
+            .arg("--data")
+            .arg(root("data/bam-servo/xl330-kp100-sin_sin.csv"))
+            .args(["--size", preset, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        for (f, h) in [("fit", h2), ("residual", h2), ("zoom-1", h3)] {
+            let svg = std::fs::read_to_string(out.join(format!("{f}.svg"))).unwrap();
+            assert!(svg.contains(&format!("width=\"{w}\" height=\"{h}\"")), "{preset} {f}: {}", &svg[..300]);
+            assert!(out.join(format!("{f}.png")).is_file());
+        }
+    }
+    // the joint diagnosis writes no figures: --size is an error, not silently ignored
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let a = write_csv(dir.path(), "a.csv", "t,w,y", 2000, good_row);
+    let b = write_csv(dir.path(), "b.csv", "t,w,y", 2000, good_row);
+    let p = |s: &'static str| Path::new(s);
+    let o = diagnose_several(&[p("--data"), &a, p("--data"), &b, p("--size"), p("column")], &out);
+    assert_rejected(&o, &out, &["--size", "joint diagnosis", "no figures"]);
+}

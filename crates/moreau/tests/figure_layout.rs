@@ -2,10 +2,12 @@
 //! `--size two-column`) and at 360 x 240, its text boxes (as usvg lays them out with the
 //! embedded DejaVu Sans, [`canvas::text_boxes`]) checked against each other and the page
 //! ([`canvas::layout_defects`]); the text is 8-9 pt at the presets. Negative controls: the
-//! checker flags overlapping and clipped text in a real rendering.
+//! checker flags overlapping and clipped text in a real rendering. The stacked figures of
+//! `moreau diagnose --size column|two-column` likewise, with a y scale (two tick labels) in every
+//! panel and the title 8-9 pt however tall the stack.
 use bounds::{assemble, ThetaSettings};
 use moreau::figures::canvas::{self, SizePreset, TextBox};
-use moreau::figures::{psi, sweep, trajectory, tube, Element, Figure};
+use moreau::figures::{diagnosis, psi, sweep, trajectory, tube, Element, Figure};
 use moreau::sweep::table::AxisInfo;
 use moreau::sweep::{Cell, Column, PointRecord, SweepResult};
 use std::path::Path;
@@ -88,18 +90,94 @@ fn every_figure() -> Vec<(String, Figure)> {
     figs
 }
 
-/// The figures of `moreau diagnose` (stacked panels, at their own sizes: `diagnose` has no size
-/// option) on a recording of the BAM servo.
-fn diagnosis_figures() -> Vec<(String, Figure)> {
+/// The diagnosis of a recording of the BAM servo (computed once for the tests of this file).
+fn servo_diagnosis() -> &'static discovery::Report {
     use moreau::commands::diagnose::{diagnose, DiagnoseOptions, RecordingSource};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let run = diagnose(
-        &moreau::commands::Source::File(root.join("examples/real/bam-xl330-kp100.toml")),
-        &RecordingSource::File(root.join("data/bam-servo/xl330-kp100-sin_sin.csv")),
-        &DiagnoseOptions::default(),
-    )
-    .unwrap();
-    moreau::figures::diagnosis::figures(&run.report)
+    static REPORT: std::sync::OnceLock<discovery::Report> = std::sync::OnceLock::new();
+    REPORT.get_or_init(|| {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        diagnose(
+            &moreau::commands::Source::File(root.join("examples/real/bam-xl330-kp100.toml")),
+            &RecordingSource::File(root.join("data/bam-servo/xl330-kp100-sin_sin.csv")),
+            &DiagnoseOptions::default(),
+        )
+        .unwrap()
+        .report
+    })
+}
+
+/// The figures of `moreau diagnose` (stacked panels, at their own sizes: no `--size`) on a
+/// recording of the BAM servo.
+fn diagnosis_figures() -> Vec<(String, Figure)> {
+    moreau::figures::diagnosis::figures(servo_diagnosis())
+}
+
+#[test]
+fn the_diagnosis_figures_at_the_column_presets_have_no_overlapping_or_clipped_text() {
+    // `moreau diagnose --size column|two-column`: fit, residual and the zooms, each a stack
+    let mut bad = vec![];
+    let mut total = 0;
+    for preset in [SizePreset::Column, SizePreset::TwoColumn] {
+        let figs = diagnosis::figures_sized(servo_diagnosis(), Some(preset));
+        assert!(figs.len() >= 3, "fit, residual and at least one zoom");
+        for (name, f) in &figs {
+            assert_eq!(f.size, diagnosis::stack_size(preset, f.panels().len()), "{name}");
+            assert_eq!(f.size.0, preset.size().0, "{name}: the preset's width");
+            let boxes = canvas::text_boxes(f).unwrap();
+            assert!(boxes.len() >= 10, "{name} at {preset:?}: only {} texts", boxes.len());
+            assert_eq!(boxes.iter().filter(|b| b.text.trim() == "t (s)").count(), 1, "{name}");
+            let d = canvas::layout_defects(&boxes, f.size);
+            total += d.len();
+            bad.extend(d.into_iter().map(|d| format!("{name} {preset:?}: {d}")));
+            // every panel has a y scale to read: at least two tick labels, right-aligned at the
+            // panels' common left edge (each counted for the panel whose y label is nearest)
+            // (the y labels' heights: their rotated lines, merged where they stand side by side)
+            let mut rotated: Vec<(f64, f64)> = boxes
+                .iter()
+                .filter(|b| b.text.chars().count() >= 4 && b.y1 - b.y0 > b.x1 - b.x0)
+                .map(|b| (b.y0, b.y1))
+                .collect();
+            rotated.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut y_labels: Vec<(f64, f64)> = vec![];
+            for (y0, y1) in rotated {
+                match y_labels.last_mut() {
+                    Some(l) if y0 < l.1 => l.1 = l.1.max(y1),
+                    _ => y_labels.push((y0, y1)),
+                }
+            }
+            assert_eq!(y_labels.len(), f.panels().len(), "{name}: one y label per panel");
+            let numbers: Vec<&TextBox> =
+                boxes.iter().filter(|b| b.text.trim().replace('−', "-").parse::<f64>().is_ok()).collect();
+            let shared = |x: f64| numbers.iter().filter(|b| (b.x1 - x).abs() < 0.6).count();
+            let edge = numbers.iter().map(|b| b.x1).max_by_key(|&x| shared(x)).unwrap();
+            let mut ticks = vec![0; y_labels.len()];
+            for b in numbers.iter().filter(|b| (b.x1 - edge).abs() < 0.6) {
+                let d = |k: usize| (0.5 * (y_labels[k].0 + y_labels[k].1) - 0.5 * (b.y0 + b.y1)).abs();
+                ticks[(0..y_labels.len()).min_by(|&i, &j| d(i).total_cmp(&d(j))).unwrap()] += 1;
+            }
+            assert!(ticks.iter().all(|&k| k >= 2), "{name} at {preset:?}: y tick labels per panel {ticks:?}");
+            // the text 8-9 pt, the title too, however tall the stack
+            for b in &boxes {
+                // tick labels (never rotated) by their height: `−1` is wider than tall
+                let pt = if b.text.chars().count() <= 3 { (b.y1 - b.y0) / 1.164 } else { text_pt(b) };
+                assert!((7.5..=9.05).contains(&pt), "{name} at {preset:?}: `{}` is {pt:.2} pt", b.text);
+            }
+            if std::env::var_os("MOREAU_FIGURE_DUMP").is_some() {
+                let png = canvas::to_png_at_dpi(f, 200.0).unwrap();
+                std::fs::write(format!("/tmp/diagnose-{name}-{}.png", f.size.0), png).unwrap();
+            }
+        }
+    }
+    eprintln!("{total} layout defects");
+    assert!(bad.is_empty(), "{} layout defects:\n{}", bad.len(), bad.join("\n"));
+    // negative control: the same check flags a zoom whose title is one word wider than the column
+    let (_, zoom) = diagnosis::figures_sized(servo_diagnosis(), Some(SizePreset::Column))
+        .into_iter()
+        .find(|(n, _)| n == "zoom-1")
+        .expect("a zoom");
+    let mut f = zoom;
+    f.title = "W".repeat(80);
+    assert!(defects(&f).iter().any(|d| d.contains("is not inside")), "clipping not flagged");
 }
 
 #[test]
@@ -148,6 +226,20 @@ fn every_figure_kind_at_the_column_presets_has_no_overlapping_or_clipped_text() 
     assert!(bad.is_empty(), "{} layout defects:\n{}", bad.len(), bad.join("\n"));
 }
 
+/// The font size of a rendered text in points: the height of its line box across the text (a
+/// y label is rotated) is 1.164 em in DejaVu Sans (ascent 0.928 + descent 0.236).
+fn text_pt(b: &TextBox) -> f64 {
+    let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
+    let em = if b.text.chars().count() <= 2 {
+        w.max(h)
+    } else if h > w {
+        w
+    } else {
+        h
+    };
+    em / 1.164
+}
+
 #[test]
 fn text_is_8_to_9_pt_at_the_presets() {
     // font size from the rendered SVG: the height of a text's line box is 1.164 em in DejaVu
@@ -156,17 +248,8 @@ fn text_is_8_to_9_pt_at_the_presets() {
     for preset in [SizePreset::Column, SizePreset::TwoColumn] {
         let boxes = canvas::text_boxes(&sized(f, preset.size())).unwrap();
         for b in &boxes {
-            // the line box's height across the text (a y label is rotated)
-            let (w, h) = (b.x1 - b.x0, b.y1 - b.y0);
-            let em = if b.text.chars().count() <= 2 {
-                w.max(h)
-            } else if h > w {
-                w
-            } else {
-                h
-            };
             // subscripts are 70 % of their text; everything else 8-9 pt
-            let pt = em / 1.164;
+            let pt = text_pt(b);
             assert!((5.5..=9.05).contains(&pt), "{preset:?}: `{}` is {pt:.2} pt", b.text);
         }
         let main = boxes.iter().filter(|b| (b.y1 - b.y0) / 1.164 >= 7.5).count();

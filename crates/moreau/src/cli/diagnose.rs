@@ -7,7 +7,7 @@
 //! `fitted.toml` (no figures). The work is [`crate::commands::diagnose`]; this
 //! module parses the arguments and prints the summary.
 use crate::commands::diagnose::{
-    diagnose, diagnose_recordings, write_joint_outputs, write_outputs, DiagnoseOptions, RecordingSource,
+    diagnose, diagnose_recordings, write_joint_outputs, write_outputs_sized, DiagnoseOptions, RecordingSource,
 };
 use crate::commands::Source;
 use crate::output::StagedDir;
@@ -55,6 +55,12 @@ pub struct Args {
     /// no grey-box refit.
     #[arg(long)]
     pub no_refit: bool,
+    /// Size preset of the figures for papers, in points, as `moreau figure --size`: `column`
+    /// (3.5 in, 252 pt wide) or `two-column` (7.16 in, 515 pt), text 8-9 pt, the legends below
+    /// the axes; each panel of a stack two thirds of the preset's height (`fit` and `residual`
+    /// 252 x 288 at `column`, the zooms 252 x 432). Default: 1200 x 760 and 1100 x 900.
+    #[arg(long, value_enum)]
+    pub size: Option<crate::figures::canvas::SizePreset>,
 }
 
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
@@ -62,6 +68,11 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!(
             "--data: no recording given{} (usage: moreau diagnose --model M.toml --data R.csv [--data R2.csv ...] [--validate-on V.csv ...] --out DIR)",
             if a.validate_on.is_empty() { "" } else { "; --validate-on only judges the fitted model, at least one --data is fitted on" }
+        );
+    }
+    if a.size.is_some() && (a.data.len() > 1 || !a.validate_on.is_empty()) {
+        anyhow::bail!(
+            "--size: the joint diagnosis (--data repeated or --validate-on) writes no figures; leave --size out"
         );
     }
     let o = DiagnoseOptions {
@@ -78,7 +89,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     }
     let run = diagnose(&Source::File(a.model.clone()), &RecordingSource::File(a.data[0].clone()), &o)?;
     let (r, secs) = (&run.report, run.seconds);
-    write_outputs(r, staged)?;
+    write_outputs_sized(r, staged, a.size)?;
     println!("{}", r.verdict);
     println!(
         "input hold {}{}; {} sub-step(s) per sample (remaining discretisation error {:.2e} output standard deviations; noise level {}); initial state {}",

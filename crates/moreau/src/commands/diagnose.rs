@@ -140,7 +140,13 @@ fn read_recording(rec: &RecordingSource) -> anyhow::Result<Recording> {
 /// [`StagedDir::replacing`] before the work, so the directory is locked during the run),
 /// all files together; the previous run's files there are replaced.
 pub fn write_outputs(r: &Report, st: StagedDir) -> anyhow::Result<()> {
-    let figs = crate::figures::diagnosis::figures(r);
+    write_outputs_sized(r, st, None)
+}
+
+/// [`write_outputs`] with the figures at the width of a paper's column (`moreau diagnose
+/// --size`, [`crate::figures::diagnosis::figures_sized`]); `None`: their own sizes.
+pub fn write_outputs_sized(r: &Report, st: StagedDir, size: Option<canvas::SizePreset>) -> anyhow::Result<()> {
+    let figs = crate::figures::diagnosis::figures_sized(r, size);
     let mut captions = Vec::new();
     for (name, fig) in &figs {
         let svg = canvas::to_svg(fig).with_context(|| format!("figure {name}"))?;

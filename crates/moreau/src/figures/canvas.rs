@@ -184,6 +184,9 @@ impl Style {
     /// The style of a figure of `size` points.
     fn of(size: (u32, u32)) -> Self {
         let k = (size.0 as f64 / 900.0).min(size.1 as f64 / 600.0).min(1.0);
+        // a figure no wider than two journal columns is printed at its size, however tall (a
+        // stack of panels, `moreau diagnose --size`): its text stays at the 8-9 pt floor
+        let k = if size.0 <= SizePreset::TwoColumn.size().0 { k.min(0.5) } else { k };
         let s = |big: f64, least: f64| (big * k).max(least).round() * SUPERSAMPLE as f64;
         Style {
             title: s(22.0, 11.0) as u32,
@@ -742,6 +745,12 @@ where
     // as many ticks as fit their labels
     let nx = ((pr - pl) / (widest_tick(x0, x1, st.tick) + 2 * st.gap).max(1)).clamp(2, 12) as usize;
     let ny = ((pb - pt) / (2 * line_h(st.tick)).max(1)).clamp(2, 12) as usize;
+    // at least two labelled ticks (a scale to read) where their labels fit one above the other:
+    // a short panel's two "nice" ticks over [-0.45, 0.35] are 0 alone
+    let fit = ((pb - pt) / line_h(st.tick).max(1)).clamp(2, 12) as usize;
+    let ny = (ny..=fit.max(ny))
+        .find(|&n| plotters::coord::types::RangedCoordf64::from(y0..y1).key_points(n).len() >= 2)
+        .unwrap_or(ny);
     let (dx, dy) = (tick_decimals(x0, x1, nx), tick_decimals(y0, y1, ny));
     let fx = move |v: &f64| tick_text(*v, dx);
     let fy = move |v: &f64| tick_text(*v, dy);

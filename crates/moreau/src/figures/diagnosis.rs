@@ -1,7 +1,7 @@
 //! The figures of a diagnosis report (`moreau diagnose`, output 1): measured against nominal
 //! and fitted, the residuals with their located windows shaded, and zooms into the top
 //! windows, each a stack of panels sharing the time axis.
-use super::canvas::{self, Element, Figure};
+use super::canvas::{self, Element, Figure, SizePreset};
 use discovery::Report;
 use plotters::style::RGBColor;
 
@@ -148,7 +148,23 @@ const MEASURED: RGBColor = RGBColor(0, 0, 0);
 /// - `residual`: the position and the derived velocity residual, each with its windows;
 /// - `zoom-1` .. `zoom-3`: the top located windows with context (record, residual, velocity
 ///   residual).
+///
+/// At their own sizes (1200 x 760 and 1100 x 900); [`figures_sized`] for a paper's column.
 pub fn figures(r: &Report) -> Vec<(String, Figure)> {
+    figures_sized(r, None)
+}
+
+/// Height in points of a stack of `panels` panels at the width of `preset` (`moreau diagnose
+/// --size`): each panel two thirds of the preset's height (its own y axis, tick labels and
+/// legend rows; the x axis once, under the bottom one), so the text stays 8-9 pt and the panels
+/// readable: `column` 252 x 288 (2 panels) and 252 x 432 (3), `two-column` 515 x 344 and 515 x 516.
+pub fn stack_size(preset: SizePreset, panels: usize) -> (u32, u32) {
+    let (w, h) = preset.size();
+    (w, 2 * h * panels as u32 / 3)
+}
+
+/// [`figures`] at the width of a paper's column (`None`: their own sizes), see [`stack_size`].
+pub fn figures_sized(r: &Report, preset: Option<SizePreset>) -> Vec<(String, Figure)> {
     let c = Curves::of(r);
     let n = c.t.len();
     if n < 2 {
@@ -213,6 +229,7 @@ pub fn figures(r: &Report) -> Vec<(String, Figure)> {
         )
     };
     let stack = |title: String, mut panels: Vec<Figure>, size: (u32, u32)| {
+        let size = preset.map_or(size, |p| stack_size(p, panels.len()));
         let mut top = panels.remove(0);
         top.title = title;
         top.size = size;
