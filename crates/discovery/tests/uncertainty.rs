@@ -166,6 +166,7 @@ fn backlash_inertia_sigma_includes_the_fitters_stepping_bias() {
     assert!(step.is_finite() && step > 0.0, "stepping part {step}");
     assert!((est - truth).abs() <= 2.0 * sigma, "{est} +- {sigma} misses {truth}");
     assert!(r.uncertainty_method.contains("s_step"), "{}", r.uncertainty_method);
+    assert!(r.to_markdown(&[]).contains(&format!("stepping {step:.2e}")));
     // Negative control: without the stepping part (the sigma as reported before) the truth
     // lies beyond 2 sigma.
     let before = jackknife_free(stat, jack);
