@@ -189,9 +189,11 @@ impl Report {
             for (i, ((n, v), (_, u))) in e.params.iter().zip(&e.uncertainty).enumerate() {
                 let part = |l: &[(String, f64)]| l.get(i).map_or(f64::NAN, |x| x.1);
                 let (st, jk) = (part(&e.uncertainty_statistical), part(&e.uncertainty_jackknife));
+                let sp = part(&e.uncertainty_stepping);
                 s += &format!(
-                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma; statistical {st:.2e}, fold jackknife {})\n",
-                    if jk.is_finite() { format!("{jk:.2e}") } else { "n/a".into() }
+                    "  - {n} = {v:.6} +- {u:.2e} (1 sigma; statistical {st:.2e}, fold jackknife {}{})\n",
+                    if jk.is_finite() { format!("{jk:.2e}") } else { "n/a".into() },
+                    if sp.is_finite() { format!(", stepping {sp:.2e}") } else { String::new() }
                 );
             }
             if let Some((h, ps)) = &e.other_hold {

@@ -93,7 +93,7 @@ pub(crate) fn diagnose_selected(
     let mut outcome = conclude(&data, &pass, &nominal, selection, &mut notes);
     notes::selection(&data, &pass, nominal.delta_bic_disc, &outcome.cv_rejected, &mut notes);
     // Refit: the selected model's uncertainty and the fitted model.
-    let unc = refit::uncertainty(&data, &pass.ctx, outcome.chosen.as_mut());
+    let unc = refit::uncertainty(&data, &pass.ctx, outcome.chosen.as_mut(), pass.finer_fit.as_ref());
     // An input delay under an `auto` hold: its reading under the other hold, and its
     // interval widened to cover both where the recording cannot tell the holds apart.
     if let Some(note) =

@@ -103,6 +103,10 @@ pub struct FittedEffect {
     /// estimation segment, widened by [`crate::fit::jackknife::t_factor`] for its degrees of
     /// freedom (`NaN`, JSON `null`, where not computed).
     pub uncertainty_jackknife: Vec<(String, f64)>,
+    /// Its stepping part: the bias of the fitter's own stepping, from the selected model
+    /// refitted at a finer stepping (`|theta(k) - theta(k_f)| k_f / (k_f - k)`; `NaN`, JSON
+    /// `null`, where not computed).
+    pub uncertainty_stepping: Vec<(String, f64)>,
     /// `input_delay` only: the equivalent parameters under the other input hold (a zero-order
     /// hold acts as a first-order hold delayed by h/2): `(hold, params)`. Where the data do not
     /// decide the hold (see the report's `hold`), the recording cannot tell the two apart and
