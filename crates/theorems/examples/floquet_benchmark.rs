@@ -93,6 +93,41 @@ fn finite_difference_exponent(sys: &model::System) -> Option<f64> {
     Some(rho.ln() / T)
 }
 
+/// One convergent system's row: the measurement (pairs, multiplier, step-checked), the
+/// finite-difference estimate, the enclosure and `theta_best`; `None` when it does not converge.
+fn measure_system(sys: &model::System, measure: &RateSettings) -> Option<Row> {
+    let m = measure_rate(sys, measure, None).ok()?;
+    if !(m.ci_high < 0.0) {
+        return None;
+    }
+    let pair_range = m.pairs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+        (a.min(p.exponent - 4.0 * p.std_error), b.max(p.exponent + 4.0 * p.std_error))
+    });
+    let fd = finite_difference_exponent(sys);
+    let t = std::time::Instant::now();
+    let f = floquet_enclosure(sys, &FloquetSettings::default());
+    let secs = t.elapsed().as_secs_f64();
+    let theta_best = assemble(sys, &ThetaSettings::bound_only())
+        .ok()
+        .and_then(|r| (r.theta_best_verified && r.theta_best < 0.0).then_some(r.theta_best));
+    Some(Row {
+        n: sys.n(),
+        rate: m.exponent,
+        ci: (m.ci_low, m.ci_high),
+        // a half-width of the (widened) interval is two sigmas
+        sigma: 0.25 * (m.ci_high - m.ci_low),
+        fd,
+        pair_range,
+        mult: m.multiplier.as_ref().map(|u| (u.exponent, u.ci_low, u.ci_high)),
+        enc: f.floquet_exponent,
+        verified: f.verified,
+        reason: f.reason.clone(),
+        rel_width: f.relative_width(),
+        secs,
+        theta_best,
+    })
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
@@ -116,43 +151,8 @@ fn main() {
             break;
         }
         drawn += chunk.len();
-        let got: Vec<Row> = chunk
-            .par_iter()
-            .filter(|c| c.n >= 2)
-            .filter_map(|c| {
-                let sys = c.build();
-                let m = measure_rate(&sys, &measure, None).ok()?;
-                if !(m.ci_high < 0.0) {
-                    return None;
-                }
-                let pair_range = m.pairs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                    (a.min(p.exponent - 4.0 * p.std_error), b.max(p.exponent + 4.0 * p.std_error))
-                });
-                let fd = finite_difference_exponent(&sys);
-                let t = std::time::Instant::now();
-                let f = floquet_enclosure(&sys, &FloquetSettings::default());
-                let secs = t.elapsed().as_secs_f64();
-                let theta_best = assemble(&sys, &ThetaSettings::bound_only())
-                    .ok()
-                    .and_then(|r| (r.theta_best_verified && r.theta_best < 0.0).then_some(r.theta_best));
-                Some(Row {
-                    n: sys.n(),
-                    rate: m.exponent,
-                    ci: (m.ci_low, m.ci_high),
-                    // a half-width of the (widened) interval is two sigmas
-                    sigma: 0.25 * (m.ci_high - m.ci_low),
-                    fd,
-                    pair_range,
-                    mult: m.multiplier.as_ref().map(|u| (u.exponent, u.ci_low, u.ci_high)),
-                    enc: f.floquet_exponent,
-                    verified: f.verified,
-                    reason: f.reason.clone(),
-                    rel_width: f.relative_width(),
-                    secs,
-                    theta_best,
-                })
-            })
-            .collect();
+        let got: Vec<Row> =
+            chunk.par_iter().filter(|c| c.n >= 2).filter_map(|c| measure_system(&c.build(), &measure)).collect();
         rows.extend(got);
     }
     rows.truncate(want);

@@ -156,6 +156,34 @@ fn print_rows(rows: &[&Row]) {
     println!();
 }
 
+/// A bound of the report: its value and whether it is verified.
+type Get = fn(&ThetaReport) -> (f64, bool);
+
+/// Table `title` by output dimension p: for each bound, how many are certified, the median
+/// bound / measured, the smallest ratio and the violations.
+fn print_by_p(title: &str, set: &[&Row], bounds: &[(&str, Get)]) {
+    println!();
+    println!("Table {title} by p:");
+    println!();
+    println!("| p | systems | bound | certified | median bound / measured | min | violations |");
+    println!("|---|---|---|---|---|---|---|");
+    for p in 1..=3 {
+        let sub: Vec<&&Row> = set.iter().filter(|r| r.p == p).collect();
+        for (name, get) in bounds {
+            let cert: Vec<&&&Row> = sub.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
+            let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
+            let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
+            let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+            println!(
+                "| {p} | {} | {name} | {} | {:.3} | {lo:.3} | {violations} |",
+                sub.len(),
+                cert.len(),
+                median(ratios.clone())
+            );
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
@@ -192,7 +220,6 @@ fn main() {
     if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
         print_rows(&table_a);
     }
-    type Get = fn(&ThetaReport) -> (f64, bool);
     let bounds: [(&str, Get); 5] = [
         ("theta (paper)", |r| (r.theta, r.theta_verified)),
         ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
@@ -279,26 +306,7 @@ fn main() {
     );
     // by output dimension (issue 29 item 3): theta_engaged and theta_best per p
     for (title, set) in [("A", &table_a), ("B", &table_b)] {
-        println!();
-        println!("Table {title} by p:");
-        println!();
-        println!("| p | systems | bound | certified | median bound / measured | min | violations |");
-        println!("|---|---|---|---|---|---|---|");
-        for p in 1..=3 {
-            let sub: Vec<&&Row> = set.iter().filter(|r| r.p == p).collect();
-            for (name, get) in &bounds[2..] {
-                let cert: Vec<&&&Row> = sub.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
-                let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
-                let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
-                let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-                println!(
-                    "| {p} | {} | {name} | {} | {:.3} | {lo:.3} | {violations} |",
-                    sub.len(),
-                    cert.len(),
-                    median(ratios.clone())
-                );
-            }
-        }
+        print_by_p(title, set, &bounds[2..]);
     }
     let fc: Vec<f64> =
         table_b.iter().filter_map(|r| r.floor_ceiling.filter(|c| *c < 0.0).map(|c| c / r.rate)).collect();
