@@ -138,6 +138,8 @@ pub struct JointValue {
     pub nominal: f64,
     pub value: f64,
     pub std: f64,
+    /// Statistical correlation with each other freed parameter (Gauss-Newton, joint fit).
+    pub correlation: Vec<(String, f64)>,
 }
 
 /// A model judged on one recording: its fitted initial state, RMSE per output and weighted
@@ -263,7 +265,7 @@ pub fn diagnose_recordings(
         .collect();
     let pb0 = problem(&data[0].ctx, final_cand, free.as_ref(), &final_shared.nominal);
     let effects = joint_effects(final_cand, &final_shared, &std.0);
-    let nominal_refit = nominal_values(free.as_ref(), final_cand, &final_shared, &std.1);
+    let nominal_refit = nominal_values(free.as_ref(), final_cand, &final_shared, &std.1, &std.2);
     if final_cand.parts.iter().any(|h| matches!(h.kind, Kind::InputOn { .. })) {
         notes.push("An effect on one input of several cannot be stated in a model file: fitted.toml omits it.".into());
     }
@@ -362,7 +364,13 @@ fn candidates(singles: &[(Report, Selected)], free: Option<&FreeNominal>) -> (Ve
 }
 
 /// The adopted model's freed nominal parameters (where refitted) with their sigma.
-fn nominal_values(free: Option<&FreeNominal>, c: &Candidate, sh: &Shared, std: &[f64]) -> Vec<JointValue> {
+fn nominal_values(
+    free: Option<&FreeNominal>,
+    c: &Candidate,
+    sh: &Shared,
+    std: &[f64],
+    correlation: &[Vec<f64>],
+) -> Vec<JointValue> {
     match (free, c.refit) {
         (Some(f), true) => f
             .params
@@ -373,6 +381,11 @@ fn nominal_values(free: Option<&FreeNominal>, c: &Candidate, sh: &Shared, std: &
                 nominal: f.nominal[i],
                 value: sh.nominal[i],
                 std: std.get(i).copied().unwrap_or(f64::NAN),
+                correlation: crate::fit::levenberg_marquardt::correlations_with_others(
+                    f.params.iter().map(|q| q.name.as_str()),
+                    correlation,
+                    i,
+                ),
             })
             .collect(),
         _ => vec![],
@@ -606,9 +619,9 @@ fn joint_std(
     judged: &[Judged],
     free: Option<&FreeNominal>,
     s: &DiagnoseSettings,
-) -> (Vec<f64>, Vec<f64>) {
+) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
     if c.parts.is_empty() && !c.refit {
-        return (vec![], vec![]);
+        return (vec![], vec![], vec![]);
     }
     let pbs: Vec<Problem> = idx.iter().map(|&j| problem(&data[j].ctx, c, free, &sh.nominal)).collect();
     let x0: Vec<Vec<f64>> = idx.iter().map(|&j| judged[j].x0.clone()).collect();
@@ -616,7 +629,7 @@ fn joint_std(
     // From the solution: the solver stops at once and reports the sigma there.
     let settings = crate::fit::FitSettings { max_iter: 1, ..s.fit.clone() };
     let f = fit_joint(&pbs, sh, &x0, &xs, true, &settings);
-    (f.std, f.nominal_std)
+    (f.std, f.nominal_std, f.nominal_correlation)
 }
 
 /// The adopted effects with their parameters and sigma.
@@ -666,8 +679,7 @@ fn fitted_system(
                 nominal: v.nominal,
                 value: v.value,
                 std: v.std,
-                // the joint fit's correlation is not computed yet
-                correlation: vec![],
+                correlation: v.correlation.clone(),
             })
             .collect();
     }

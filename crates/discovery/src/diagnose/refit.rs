@@ -190,14 +190,11 @@ fn nominal_values(data: &Setup, chosen: Option<&Ranked>, unc: &Uncertainty) -> V
                     .unwrap_or(f64::NAN),
                 relative_change: (f.nominal[i] != 0.0).then(|| c.nominal[i] / f.nominal[i] - 1.0),
                 bounds: fp.bounds,
-                correlation: c
-                    .nominal_correlation
-                    .get(i)
-                    .map(|row| {
-                        let others = f.params.iter().zip(row).enumerate().filter(|(j, _)| *j != i);
-                        others.map(|(_, (q, r))| (q.name.clone(), *r)).collect()
-                    })
-                    .unwrap_or_default(),
+                correlation: crate::fit::levenberg_marquardt::correlations_with_others(
+                    f.params.iter().map(|q| q.name.as_str()),
+                    &c.nominal_correlation,
+                    i,
+                ),
             })
             .collect(),
         _ => vec![],

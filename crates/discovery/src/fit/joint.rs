@@ -10,7 +10,7 @@
 //!
 //! With the shared parameters held ([`fit_joint`] with `free_shared = false`) the fit is
 //! the initial states alone: a fitted model judged on a recording it was not fitted on.
-use crate::fit::levenberg_marquardt::{jacobian, lm, sse, Objective};
+use crate::fit::levenberg_marquardt::{correlation_block, jacobian, lm, sse, Objective};
 use crate::fit::{FitSettings, FitStatus, Problem};
 
 /// The shared parameters of a joint fit: where it starts, or where it is held.
@@ -30,6 +30,9 @@ pub struct JointFit {
     /// `NaN` where not identifiable or not fitted.
     pub std: Vec<f64>,
     pub nominal_std: Vec<f64>,
+    /// Statistical correlation of the nominal parameters (Gauss-Newton; empty where not
+    /// computed).
+    pub nominal_correlation: Vec<Vec<f64>>,
     /// Initial state per recording.
     pub x0: Vec<Vec<f64>>,
     /// Weighted SSE per recording (unscaled by its length) and its residual count.
@@ -146,6 +149,7 @@ pub fn fit_joint(
         shared: start.clone(),
         std: vec![f64::NAN; k],
         nominal_std: vec![f64::NAN; kn],
+        nominal_correlation: vec![],
         x0: x0_init.to_vec(),
         sse: vec![f64::INFINITY; pbs.len()],
         n_res: vec![0; pbs.len()],
@@ -155,6 +159,7 @@ pub fn fit_joint(
     let Some(parts) = joint.residuals(&v) else { return failed() };
     // Gauss-Newton sigma of the shared parameters, in physical units.
     let (mut std, mut nominal_std) = (vec![f64::NAN; k], vec![f64::NAN; kn]);
+    let mut nominal_correlation = vec![];
     if k + kn > 0 {
         let J = jacobian(&joint, &v, &r, s.tol_fd, &mut evals);
         let dof = (r.len() as f64 - v.len() as f64).max(1.0);
@@ -169,6 +174,7 @@ pub fn fit_joint(
             for i in 0..kn {
                 nominal_std[i] = (s2 * inv[(k + i, k + i)]).max(0.0).sqrt() * joint.ns[i];
             }
+            nominal_correlation = correlation_block(&inv, k, kn);
         }
     }
     let (shared, x0) = joint.split(&v);
@@ -176,6 +182,7 @@ pub fn fit_joint(
         shared,
         std,
         nominal_std,
+        nominal_correlation,
         x0,
         sse: parts.iter().map(|r| sse(r)).collect(),
         n_res: parts.iter().map(|r| r.len()).collect(),

@@ -509,6 +509,17 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
     }
 }
 
+/// Row `i` of a correlation matrix as `(name, r)` for every other parameter (`names` in the
+/// matrix's order); empty where the matrix was not computed.
+pub fn correlations_with_others<'n>(
+    names: impl Iterator<Item = &'n str>,
+    matrix: &[Vec<f64>],
+    i: usize,
+) -> Vec<(String, f64)> {
+    let Some(row) = matrix.get(i) else { return vec![] };
+    names.zip(row).enumerate().filter(|(j, _)| *j != i).map(|(_, (n, r))| (n.to_string(), *r)).collect()
+}
+
 /// The correlation matrix of the `n` parameters from index `from` of the covariance (or any
 /// positive multiple of it) `cov`; `NaN` where a variance is not positive.
 pub fn correlation_block(cov: &DMatrix<f64>, from: usize, n: usize) -> Vec<Vec<f64>> {
@@ -593,5 +604,21 @@ mod tests {
         }
         let l = residual_correlation_length(&r, 2, 1000);
         assert!((3..=10).contains(&l), "pooled correlation length {l}");
+    }
+
+    /// A covariance's correlation, named row by row; a parameter without variance gets `NaN`.
+    #[test]
+    fn correlation_of_a_known_covariance() {
+        let cov = DMatrix::from_row_slice(3, 3, &[4.0, 2.0, 0.0, 2.0, 9.0, 0.0, 0.0, 0.0, 0.0]);
+        let c = correlation_block(&cov, 0, 3);
+        assert!((c[0][1] - 1.0 / 3.0).abs() < 1e-15 && (c[1][0] - c[0][1]).abs() == 0.0);
+        assert_eq!((c[0][0], c[1][1]), (1.0, 1.0));
+        assert!(c[2][0].is_nan() && c[0][2].is_nan());
+        let row = correlations_with_others(["a", "b", "c"].into_iter(), &c, 1);
+        assert_eq!(row.len(), 2);
+        assert_eq!((row[0].0.as_str(), row[0].1), ("a", c[1][0]));
+        assert!(correlations_with_others(["a"].into_iter(), &[], 0).is_empty());
+        // from an offset: the block of the last two
+        assert!((correlation_block(&cov, 1, 2)[0][0] - 1.0).abs() < 1e-15);
     }
 }
