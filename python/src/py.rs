@@ -401,25 +401,14 @@ fn diagnose<'py>(
     no_refit: bool,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>, usize, Bound<'py, PyDict>)> {
-    use commands::diagnose::{diagnose, write_outputs, DiagnoseOptions, RecordingSource};
+    use commands::diagnose::{diagnose, write_outputs, RecordingSource};
     let src = source(model)?;
     let rec = match (data, text) {
         (Some(p), None) => RecordingSource::File(p),
         (None, Some(text)) => RecordingSource::Text { text, source: source_name },
         _ => return Err(PyTypeError::new_err("give exactly one of data= (a path) and text= (CSV text)")),
     };
-    let Some(input_hold) = discovery::HoldChoice::parse(&input_hold) else {
-        return Err(MoreauError::new_err(format!(
-            "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
-        )));
-    };
-    let Some(metric) = discovery::diagnose::Metric::parse(&metric) else {
-        return Err(MoreauError::new_err(format!(
-            "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
-        )));
-    };
-    let o =
-        DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, metric, refit_nominal: !no_refit };
+    let o = diagnose_options(estimation_fraction, max_effects, &input_hold, estimate_x0, &metric, no_refit)?;
     let run = move || -> anyhow::Result<discovery::Report> {
         let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;
@@ -440,6 +429,36 @@ fn diagnose<'py>(
     Ok((to_json(&report)?, fitted, s.p, d))
 }
 
+/// The options of `diagnose` from the keywords of [`diagnose`] and [`diagnose_recordings`]
+/// (the CLI's messages for a bad `input_hold` or `metric`).
+fn diagnose_options(
+    estimation_fraction: f64,
+    max_effects: usize,
+    input_hold: &str,
+    estimate_x0: bool,
+    metric: &str,
+    no_refit: bool,
+) -> PyResult<commands::diagnose::DiagnoseOptions> {
+    let Some(input_hold) = discovery::HoldChoice::parse(input_hold) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
+        )));
+    };
+    let Some(metric) = discovery::diagnose::Metric::parse(metric) else {
+        return Err(MoreauError::new_err(format!(
+            "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
+        )));
+    };
+    Ok(commands::diagnose::DiagnoseOptions {
+        estimation_fraction,
+        max_effects,
+        input_hold,
+        estimate_x0,
+        metric,
+        refit_nominal: !no_refit,
+    })
+}
+
 /// `moreau diagnose --data A --data B [--validate-on C]` (several recordings of one machine,
 /// paths): (joint report JSON, fitted System or None).
 #[pyfunction]
@@ -458,20 +477,9 @@ fn diagnose_recordings(
     no_refit: bool,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>)> {
-    use commands::diagnose::{diagnose_recordings, write_joint_outputs, DiagnoseOptions, RecordingSource};
+    use commands::diagnose::{diagnose_recordings, write_joint_outputs, RecordingSource};
     let src = source(model)?;
-    let Some(input_hold) = discovery::HoldChoice::parse(&input_hold) else {
-        return Err(MoreauError::new_err(format!(
-            "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
-        )));
-    };
-    let Some(metric) = discovery::diagnose::Metric::parse(&metric) else {
-        return Err(MoreauError::new_err(format!(
-            "invalid value '{metric}' for '--metric <METRIC>' [possible values: auto, fit, rmse]"
-        )));
-    };
-    let o =
-        DiagnoseOptions { estimation_fraction, max_effects, input_hold, estimate_x0, metric, refit_nominal: !no_refit };
+    let o = diagnose_options(estimation_fraction, max_effects, &input_hold, estimate_x0, &metric, no_refit)?;
     let files = |v: Vec<PathBuf>| v.into_iter().map(RecordingSource::File).collect::<Vec<_>>();
     let (fit, val) = (files(data), files(validate_on));
     let run = move || -> anyhow::Result<discovery::diagnose::JointReport> {

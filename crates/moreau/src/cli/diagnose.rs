@@ -119,13 +119,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         );
     }
     for v in &r.nominal_refit {
-        println!(
-            "  {}: {} -> {} +- {} (refitted plant parameter)",
-            v.name,
-            sig4(v.nominal),
-            sig4(v.value),
-            sig4(v.std)
-        );
+        print_refitted(&v.name, v.nominal, v.value, v.std);
     }
     if !r.fit_before.constant_outputs.is_empty() {
         println!("fit % undefined: the validation output is constant; judge by the RMSE");
@@ -154,13 +148,7 @@ fn run_joint(a: &Args, o: &DiagnoseOptions, staged: StagedDir) -> anyhow::Result
     write_joint_outputs(r, staged)?;
     println!("{}", r.verdict);
     for v in &r.nominal_refit {
-        println!(
-            "  {}: {} -> {} +- {} (refitted plant parameter)",
-            v.name,
-            sig4(v.nominal),
-            sig4(v.value),
-            sig4(v.std)
-        );
+        print_refitted(&v.name, v.nominal, v.value, v.std);
     }
     for e in &r.effects {
         let params: Vec<String> = e
@@ -176,6 +164,11 @@ fn run_joint(a: &Args, o: &DiagnoseOptions, staged: StagedDir) -> anyhow::Result
     }
     println!("{} recording(s) diagnosed in {:.2} s; report in {}", r.recordings.len(), run.seconds, a.out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// `  M: 4.2 -> 4.76 +- 0.01 (refitted plant parameter)`.
+fn print_refitted(name: &str, nominal: f64, value: f64, std: f64) {
+    println!("  {name}: {} -> {} +- {} (refitted plant parameter)", sig4(nominal), sig4(value), sig4(std));
 }
 
 /// 4 significant digits, as the sweep tables write numbers.
