@@ -6,7 +6,7 @@
 //! inputs with amplitude 10^[0, 1.5], mu in [-2, -0.3]). A system counts when its measured
 //! exponent's 95 % interval lies below 0 (a periodic regime attracts). For each: the enclosure
 //! (verified or not, its relative width, its time), the measured exponent (3 pairs, 30 periods
-//! after 10, separation 1e-6, with `step_check`: dt = 2e-3 (`FLOQUET_DT=...` to change), its half
+//! after 10, separation 1e-6 (`FLOQUET_SEPARATION=...` to change), with `step_check`: dt = 2e-3 (`FLOQUET_DT=...` to change), its half
 //! and its quarter, the quarter's values with every interval widened by the larger change):
 //! the regression of `ln V` (largest pair) and the dominant multiplier fitted to the same pairs'
 //! differences (`dynamics::rate::multipliers`, free of the wobble of `ln V` when the slowest
@@ -138,7 +138,7 @@ fn main() {
         transient_periods: 10,
         pairs: 3,
         step_check: true,
-        separation: 1e-6,
+        separation: std::env::var("FLOQUET_SEPARATION").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-6),
         renorm_below: 1e-2,
         dt: std::env::var("FLOQUET_DT").ok().and_then(|v| v.parse().ok()).unwrap_or(2e-3),
         ..Default::default()

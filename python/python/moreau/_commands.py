@@ -66,8 +66,9 @@ def theta(
     guidance : bool, default True
         Add design guidance when nothing is certified (``False`` is ``--no-guidance``).
     step_check : bool, default False
-        Measure again at a half and a quarter of the step and widen the measured intervals by
-        the change (``--step-check``; seven times the measurement's work).
+        Measure again at a half and a quarter of the step, and at the quarter with a 100 times
+        smaller separation, and widen the measured intervals by the changes (``--step-check``;
+        eleven times the measurement's work).
 
     Returns
     -------

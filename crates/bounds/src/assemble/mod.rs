@@ -377,6 +377,7 @@ fn measured(
                     h: r.h,
                     multiplier: r.multiplier.map(|u| [u.exponent, u.ci_low, u.ci_high]),
                     step_error: r.step_error,
+                    separation_error: r.separation_error,
                 }),
                 Err(e) => {
                     notes.push(format!("measured side not computed: {e}"));

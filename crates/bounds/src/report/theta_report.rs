@@ -28,13 +28,19 @@ pub struct MeasuredSide {
     /// The stepping error added to both intervals (`RateSettings::step_check`); `None`: not
     /// estimated, the intervals are the regression's and the blocks' only.
     pub step_error: Option<f64>,
+    /// The change at a 100 times smaller separation, added to both intervals too
+    /// (`RateSettings::step_check`); `None`: not estimated.
+    pub separation_error: Option<f64>,
 }
 
 /// What a measured interval says about the stepping error.
 fn step_note(m: &MeasuredSide) -> String {
-    match m.step_error {
-        Some(e) => format!(", step h = {:.2e} (stepping error {e:.1e} included)", m.h),
-        None => format!(", step h = {:.2e} (stepping error not included: --step-check)", m.h),
+    match (m.step_error, m.separation_error) {
+        (Some(e), Some(s)) => {
+            format!(", step h = {:.2e} (stepping error {e:.1e} and separation error {s:.1e} included)", m.h)
+        }
+        (Some(e), None) => format!(", step h = {:.2e} (stepping error {e:.1e} included)", m.h),
+        _ => format!(", step h = {:.2e} (stepping and separation errors not included: --step-check)", m.h),
     }
 }
 

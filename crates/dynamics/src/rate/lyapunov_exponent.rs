@@ -48,8 +48,11 @@ pub struct RateSettings {
     pub pi: Option<DMatrix<f64>>,
     /// Measure again at a half and a quarter of the step, report the quarter step's values and
     /// widen every interval by the larger change from the two coarser steps (the catching-up
-    /// step's error is first order but erratic, so one halving can show no change at all).
-    /// Seven times the work. Default `false`.
+    /// step's error is first order but erratic, so one halving can show no change at all), and
+    /// once more at the quarter step with a [`SEPARATION_CHECK`] times smaller separation,
+    /// widening by that change too (a pair whose second trajectory switches a step before or
+    /// after the first is not on the regime's linearisation). Eleven times the work. Default
+    /// `false`.
     pub step_check: bool,
 }
 
@@ -158,7 +161,15 @@ pub struct MeasuredRate {
     /// times), already added to both intervals (that of `multiplier` by its own change).
     /// `None` without.
     pub step_error: Option<f64>,
+    /// With `step_check`: `|exponent(s) - exponent(s / SEPARATION_CHECK)|` at the quarter step
+    /// (`s` the separation), already added to both intervals (that of `multiplier` by its own
+    /// change). `None` without.
+    pub separation_error: Option<f64>,
 }
+
+/// With `step_check`, the separation is also divided by this to see how far the pairs are from
+/// the regime's linearisation.
+pub const SEPARATION_CHECK: f64 = 100.0;
 
 /// `V = |X|_Pi^2 + |Q|^2`, eq. (V_Gamma).
 pub fn lyapunov_v(sys: &System, pi: Option<&DMatrix<f64>>, x1: &[f64], z1: &[f64], x2: &[f64], z2: &[f64]) -> f64 {
@@ -191,22 +202,35 @@ pub fn measure_rate(
     let at = |dt: f64| measure_once(sys, &RateSettings { dt, step_check: false, ..settings.clone() }, start);
     let half = at(0.5 * coarse.h)?;
     let mut fine = at(0.25 * coarse.h)?;
+    let thin = measure_once(
+        sys,
+        &RateSettings {
+            dt: 0.25 * coarse.h,
+            separation: settings.separation / SEPARATION_CHECK,
+            step_check: false,
+            ..settings.clone()
+        },
+        start,
+    )?;
     // the catching-up step's error is first order but erratic (it depends on where the switches
     // fall between steps): the larger change from the two coarser steps bounds the finest's
-    let change = |e: &dyn Fn(&MeasuredRate) -> Option<f64>| -> Option<f64> {
-        let f = e(&fine)?;
-        Some((e(&coarse)? - f).abs().max((e(&half)? - f).abs()))
+    let change = |e: &dyn Fn(&MeasuredRate) -> Option<f64>, others: &[&MeasuredRate]| -> f64 {
+        let Some(f) = e(&fine) else { return f64::INFINITY };
+        others.iter().map(|o| e(o).map_or(f64::INFINITY, |v| (v - f).abs())).fold(0.0, f64::max)
     };
-    let step = change(&|m| Some(m.exponent)).unwrap_or(f64::INFINITY);
-    let step_multiplier = change(&|m| m.multiplier.as_ref().map(|u| u.exponent));
-    fine.ci_low -= step;
-    fine.ci_high += step;
+    let exponent = |m: &MeasuredRate| Some(m.exponent);
+    let multiplier = |m: &MeasuredRate| m.multiplier.as_ref().map(|u| u.exponent);
+    let step = change(&exponent, &[&coarse, &half]);
+    let separation = change(&exponent, &[&thin]);
+    let widen_multiplier = change(&multiplier, &[&coarse, &half]) + change(&multiplier, &[&thin]);
+    fine.ci_low -= step + separation;
+    fine.ci_high += step + separation;
     if let Some(u) = fine.multiplier.as_mut() {
-        let d = step_multiplier.unwrap_or(f64::INFINITY);
-        u.ci_low -= d;
-        u.ci_high += d;
+        u.ci_low -= widen_multiplier;
+        u.ci_high += widen_multiplier;
     }
     fine.step_error = Some(step);
+    fine.separation_error = Some(separation);
     Ok(fine)
 }
 
@@ -324,6 +348,7 @@ fn measure_once(
         pairs,
         multiplier,
         step_error: None,
+        separation_error: None,
     })
 }
 

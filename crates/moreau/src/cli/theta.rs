@@ -27,8 +27,9 @@ pub struct Args {
     /// Skip the measured side (simulated pairs of trajectories).
     #[arg(long)]
     pub no_measure: bool,
-    /// Measure again at a half and a quarter of the step and widen the measured intervals by
-    /// the change (the catching-up step's error; seven times the measurement's work).
+    /// Measure again at a half and a quarter of the step, and at the quarter with a 100 times
+    /// smaller separation, and widen the measured intervals by the changes (the catching-up
+    /// step's error and the pairs' distance from the linearisation; eleven times the work).
     #[arg(long, conflicts_with = "no_measure")]
     pub step_check: bool,
     /// Skip the stationary set of Theorem 1.

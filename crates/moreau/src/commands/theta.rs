@@ -17,8 +17,9 @@ pub struct ThetaOptions {
     pub stationary: bool,
     /// Design guidance when nothing is certified (and the model has no effects).
     pub guidance: bool,
-    /// Measure at the step, its half and its quarter and widen the measured intervals by the
-    /// change (`dynamics::rate::lyapunov_exponent::RateSettings::step_check`).
+    /// Measure at the step, its half and its quarter (and the quarter at a 100 times smaller
+    /// separation) and widen the measured intervals by the changes
+    /// (`dynamics::rate::lyapunov_exponent::RateSettings::step_check`).
     pub step_check: bool,
 }
 

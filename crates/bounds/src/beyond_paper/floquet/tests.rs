@@ -45,6 +45,7 @@ fn the_step_checked_multiplier_measurement_overlaps_the_enclosure() {
     assert!(m.ci_low <= hi && lo <= m.ci_high, "measured [{}, {}] vs proven [{lo}, {hi}]", m.ci_low, m.ci_high);
     assert!(m.ci_high - m.ci_low < 2e-3, "an interval this wide says nothing: [{}, {}]", m.ci_low, m.ci_high);
     assert!(checked.step_error.is_some_and(|e| e > 0.0));
+    assert!(checked.separation_error.is_some_and(|e| e.is_finite() && e >= 0.0), "{:?}", checked.separation_error);
     let plain = measure_rate(&sys, &settings, None).unwrap().multiplier.unwrap();
     assert!(plain.ci_high < lo || hi < plain.ci_low, "[{}, {}] vs [{lo}, {hi}]", plain.ci_low, plain.ci_high);
 }
