@@ -1,5 +1,6 @@
 //! The generator's own simulator (independent of [`dynamics::extended`]): explicit midpoint
-//! (RK2) on a grid 20 times finer than the samples, forces and the play held over each fine
+//! (RK2) on a grid 20 times finer than the samples (the recording's truth: finer until it is
+//! converged, [`simulate_converged`]), forces and the play held over each fine
 //! step, Coulomb friction by a semi-implicit velocity update (stick when the friction-free
 //! velocity change cannot reverse the sign), the friction library likewise (the static level
 //! from rest or through a reversal, the Stribeck level at the old speed while sliding, levels
@@ -9,7 +10,10 @@
 use super::{Plant, Signal};
 use model::effects::{Effect, PlayLocation};
 
+/// Fine steps per sample of [`simulate_effects`] (enough for RK2 on the linear part).
 const FINE: usize = 20;
+/// Most fine steps per sample of [`simulate_converged`].
+const FINE_MAX: usize = 2560;
 
 /// Simulates the plant (play half-width `hw`, 0 = none) with at most one effect and returns
 /// `y` at the `ns` sample times `k dt`. With `zoh`, the plant sees the input sampled at `k dt`
@@ -43,8 +47,75 @@ pub fn simulate_effects(
     ns: usize,
     zoh: bool,
 ) -> Vec<f64> {
+    simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, FINE)
+}
+
+/// [`simulate_effects`] with its truth converged: the play, the friction laws and backlash
+/// inertia are stepped to first order, so the fine grid is doubled (from 20 per sample, at most
+/// [`FINE_MAX`]) until doubling changes `y` by less than `tol` (RMS over the samples), and the
+/// finer run is returned. A change `d` of the output biases a fitted parameter by at most about
+/// `d sqrt(N) / noise` of its sigma (`N` samples of white noise), so `tol = 0.1 noise / sqrt(N)`
+/// keeps the truth within a tenth of a sigma of the converged one. A smooth truth (no play, no friction, no inertia) is second order
+/// at 20 and returned as it is. Returns `y` and the fine steps per sample used.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_converged(
+    pl: &Plant,
+    hw: f64,
+    effs: &[&Effect],
+    sig: &Signal,
+    x0: &[f64],
+    dt: f64,
+    ns: usize,
+    zoh: bool,
+    tol: f64,
+) -> (Vec<f64>, usize) {
+    let mut fine = FINE;
+    let mut y = simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
+    if !first_order(hw, effs) {
+        return (y, fine);
+    }
+    while fine < FINE_MAX {
+        fine *= 2;
+        let finer = simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
+        let change = (finer.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / ns.max(1) as f64).sqrt();
+        y = finer;
+        if change <= tol {
+            break;
+        }
+    }
+    (y, fine)
+}
+
+/// Whether the truth has an update that [`simulate_fine`] steps to first order.
+fn first_order(hw: f64, effs: &[&Effect]) -> bool {
+    hw > 0.0
+        || effs.iter().any(|e| {
+            matches!(
+                e,
+                Effect::Backlash { .. }
+                    | Effect::BacklashInertia { .. }
+                    | Effect::CoulombFriction { .. }
+                    | Effect::StribeckFriction { .. }
+                    | Effect::AsymmetricCoulomb { .. }
+            )
+        })
+}
+
+/// The simulation at `fine` steps per sample.
+#[allow(clippy::too_many_arguments)]
+fn simulate_fine(
+    pl: &Plant,
+    hw: f64,
+    effs: &[&Effect],
+    sig: &Signal,
+    x0: &[f64],
+    dt: f64,
+    ns: usize,
+    zoh: bool,
+    fine: usize,
+) -> Vec<f64> {
     let n = pl.A.nrows();
-    let h = dt / FINE as f64;
+    let h = dt / fine as f64;
     let mut hw = hw;
     let (mut delay, mut sat, mut force, mut fric, mut tau, mut offset) = (0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0);
     let mut gap = 1.0;
@@ -106,11 +177,11 @@ pub fn simulate_effects(
         // instant added where it falls between grid points (the midpoint rule then sees a
         // constant input on every piece: the delay is integrated exactly, not rounded to h).
         let t_k = k as f64 * dt;
-        let mut pieces: Vec<(f64, f64)> = (0..FINE).map(|jf| (t_k + jf as f64 * h, h)).collect();
+        let mut pieces: Vec<(f64, f64)> = (0..fine).map(|jf| (t_k + jf as f64 * h, h)).collect();
         let split = zoh && delay > 0.0;
         if split {
             let off = (delay / dt).fract() * dt;
-            let j = ((off / h).floor() as usize).min(FINE - 1);
+            let j = ((off / h).floor() as usize).min(fine - 1);
             let a = off - j as f64 * h;
             if a > 1e-9 * h && a < h * (1.0 - 1e-9) {
                 let t = pieces[j].0;
@@ -172,4 +243,67 @@ pub fn simulate_effects(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    /// A damped oscillator (position, velocity) behind a play of half-width 0.2, with Coulomb
+    /// friction: two first-order updates in the truth.
+    fn case() -> (Plant, Signal, Effect) {
+        let plant = Plant {
+            A: DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -4.0, -0.8]),
+            B: DMatrix::from_row_slice(2, 1, &[0.0, 4.0]),
+            C: DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+            E: DMatrix::from_row_slice(2, 1, &[0.0, 0.0]),
+            half_width: 0.2,
+            vel: 1,
+            omega0: 2.0,
+            zeta: 0.2,
+        };
+        let sig = Signal::Multisine { a: vec![1.0, 0.4], omega: vec![0.7, 2.3], phi: vec![0.0, 1.0] };
+        let fric = Effect::CoulombFriction { state: 1, level: 1.5 };
+        (plant, sig, fric)
+    }
+
+    /// RMS of `y` about its mean.
+    fn rms_spread(y: &[f64]) -> f64 {
+        let m = y.iter().sum::<f64>() / y.len().max(1) as f64;
+        (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / y.len().max(1) as f64).sqrt()
+    }
+
+    fn rms_diff(a: &[f64], b: &[f64]) -> f64 {
+        (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    }
+
+    /// The converged truth moves by less than its tolerance when the step is halved once more;
+    /// negative control: the 20-per-sample grid the generator used before is off by far more
+    /// (the friction's first-order update), so the check can fail.
+    #[test]
+    fn the_generators_truth_is_converged_under_halving_the_step() {
+        let (pl, sig, fric) = case();
+        let (dt, ns) = (0.05, 1500);
+        let x0 = [0.1, 0.0];
+        // the generator's tolerance at 30 dB SNR
+        let tol = 0.1 * rms_spread(&simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false)) * 10f64.powf(-1.5)
+            / (ns as f64).sqrt();
+        let (y, fine) = simulate_converged(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, tol);
+        assert!(fine > FINE && fine < FINE_MAX, "doubled to {fine}");
+        let halved = simulate_fine(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, 2 * fine);
+        let change = rms_diff(&y, &halved);
+        assert!(change <= tol, "halving moves y by {change:e} > {tol:e}");
+        let coarse = simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false);
+        let off = rms_diff(&coarse, &y);
+        assert!(off > 3.0 * tol, "20 per sample is already converged? {off:e} against {tol:e}");
+    }
+
+    /// A smooth truth (no play, no friction) is second order at 20 per sample and not refined.
+    #[test]
+    fn a_smooth_truth_is_not_refined() {
+        let (pl, sig, _) = case();
+        let (_, fine) = simulate_converged(&pl, 0.0, &[], &sig, &[0.1, 0.0], 0.02, 500, false, 1e-12);
+        assert_eq!(fine, FINE);
+    }
 }
