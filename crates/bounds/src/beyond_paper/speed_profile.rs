@@ -325,6 +325,36 @@ impl SpeedProfile {
     }
 }
 
+/// The profile a report's `theta_engaged` (or, with no engaged cell, `theta_profile`) was
+/// computed from, with its partition and the certified `(lambda, b_hat)` points it was minimised
+/// over: the evidence of the bound, for diagnostics (which input of the profile loses most:
+/// `theta_benchmark`'s near-threshold mode puts measured speeds or tube widths in its place).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileEvidence {
+    pub profile: SpeedProfile,
+    /// Partition (cell boundary indices from `0` to `cells`).
+    pub nodes: Vec<usize>,
+    /// `alpha` from below and the certified `(lambda, b_hat)` points.
+    pub alpha: f64,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl ProfileEvidence {
+    /// The smallest bound of `prof` over the certified points, with the partition chosen for it
+    /// at the point where the evidence's own profile is smallest (`prof` = the evidence's profile:
+    /// the reported bound, up to the partition's lambda).
+    pub fn bound_of(&self, prof: &SpeedProfile) -> f64 {
+        let psi = |&(lambda, beta): &(f64, f64)| Psi { alpha: self.alpha, lambda, beta };
+        let Some(best) = self.points.iter().min_by(|a, b| {
+            self.profile.bound(&psi(a), &self.nodes).total_cmp(&self.profile.bound(&psi(b), &self.nodes))
+        }) else {
+            return f64::INFINITY;
+        };
+        let nodes = prof.best_partition(&psi(best), 4);
+        self.points.iter().map(|p| prof.bound(&psi(p), &nodes)).fold(f64::INFINITY, f64::min)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

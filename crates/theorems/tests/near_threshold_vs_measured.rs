@@ -1,0 +1,149 @@
+//! The certified bounds just above the amplitude where certification starts (issue 29 item 4):
+//! every verified bound `< 0` lies above the measured exponent's 95 % interval there, and the
+//! report's speed profile ([`bounds::beyond_paper::ProfileEvidence`]) reproduces its bound.
+//!
+//! Systems: the worked example and random systems of `theorems::strategies::systems` (p = 1,
+//! intervals, sine inputs). Each is scaled to the smallest scale `s0` of its amplitudes at which
+//! `theta_best` is verified `< 0` (grid `2^k`, then bisection in `ln s`), times a factor drawn in
+//! `[1, 1.5]` from a fixed seed (`theta_benchmark`'s `THETA_BENCHMARK_NEAR=1` family, smaller).
+//! Negative control: the same profile evaluated at a certificate that cannot exist, `lambda =
+//! 2 |mu|` (the Lyapunov inequality needs `lambda < |mu|`) with the curve's smallest `b_hat`, and
+//! every floor raised to its cell's ceiling (the claim that the backlash always moves at its
+//! largest proven speed), must fall below the measured interval on some case. (With a true
+//! certificate no psi-based value can: `psi > -lambda > mu`, and near the threshold the measured
+//! exponent is often beyond `mu`.)
+//!
+//! Default: 3 random systems (from at most 12 candidates); `NEAR_THRESHOLD_CASES=N` for more.
+use bounds::{assemble, ThetaReport, ThetaSettings};
+use dynamics::rate::lyapunov_exponent::RateSettings;
+use theorems::strategies::inputs::InputStrategyConfig;
+use theorems::strategies::sets::{SetKind, SetStrategyConfig};
+use theorems::strategies::systems::{system_params, SystemStrategyConfig};
+
+fn wanted() -> usize {
+    std::env::var("NEAR_THRESHOLD_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(3).max(1)
+}
+
+fn config() -> SystemStrategyConfig {
+    SystemStrategyConfig {
+        max_n: 3,
+        max_p: 1,
+        mu: (-2.0, -0.3),
+        theta: SetStrategyConfig { kinds: vec![SetKind::Interval], max_dim: 1, max_cond: 4.0, scale_exp: 0.75 },
+        input: InputStrategyConfig { amp_exp: (0.0, 1.5), ..Default::default() },
+        ..Default::default()
+    }
+}
+
+fn scaled(sys: &model::System, s: f64) -> model::System {
+    let mut out = sys.clone();
+    if let model::Input::Sine { amplitudes, .. } = &mut out.input {
+        amplitudes.iter_mut().for_each(|a| *a *= s);
+    }
+    out
+}
+
+fn certified(sys: &model::System, s: f64) -> bool {
+    assemble(&scaled(sys, s), &ThetaSettings::bound_only()).is_ok_and(|r| r.theta_best_verified && r.theta_best < 0.0)
+}
+
+/// The smallest certified scale on the grid `2^k`, `k = -4..=5`, refined by 6 bisections in
+/// `ln s`; `None` when no grid point is certified or the lowest one already is.
+fn threshold(sys: &model::System) -> Option<f64> {
+    let k = (-4..=5).find(|&k| certified(sys, 2f64.powi(k)))?;
+    if k == -4 {
+        return None;
+    }
+    let (mut lo, mut hi) = (2f64.powi(k - 1), 2f64.powi(k));
+    for _ in 0..6 {
+        let mid = (lo * hi).sqrt();
+        if certified(sys, mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
+/// The near-threshold cases: `(name, report with the measured side)`, convergent ones only.
+fn near_cases() -> Vec<(String, ThetaReport)> {
+    let want = wanted();
+    let mut systems = vec![(
+        "worked example".to_string(),
+        model::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml")))
+            .expect("worked example"),
+    )];
+    systems.extend(
+        theorems::strategies::draw(&system_params(&config()), 29, 4 * want)
+            .into_iter()
+            .enumerate()
+            .filter(|(_, c)| c.n >= 2)
+            .map(|(i, c)| (format!("case {i}"), c.build())),
+    );
+    // factors in [1, 1.5], fixed: the first, the middle and the far end of the band recur
+    let factors = [1.0, 1.25, 1.5, 1.1, 1.4];
+    let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
+    let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
+    let mut out = Vec::new();
+    for (k, (name, sys)) in systems.iter().enumerate() {
+        if out.len() > want {
+            break;
+        }
+        let Some(s0) = threshold(sys) else { continue };
+        let factor = factors[k % factors.len()];
+        let Ok(rep) = assemble(&scaled(sys, s0 * factor), &settings) else { continue };
+        if rep.measured.as_ref().is_some_and(|m| m.ci_high < 0.0) {
+            out.push((format!("{name} (n = {}, s0 = {s0:.4}, x {factor})", sys.n()), rep));
+        }
+    }
+    out
+}
+
+#[test]
+fn bounds_hold_near_the_threshold_and_unsound_floors_are_caught() {
+    let cases = near_cases();
+    assert!(cases.len() >= 2, "too few near-threshold cases ({})", cases.len());
+    let mut caught = 0;
+    for (name, rep) in &cases {
+        let m = rep.measured.as_ref().expect("measured");
+        let bounds = [
+            ("theta", rep.theta, rep.theta_verified),
+            ("theta*", rep.theta_star, rep.theta_star_verified),
+            ("theta_profile", rep.theta_profile, rep.theta_profile_verified),
+            ("theta_engaged", rep.theta_engaged, rep.theta_engaged_verified),
+            ("theta_best", rep.theta_best, rep.theta_best_verified),
+        ];
+        eprintln!(
+            "{name}: theta_best = {:.5} ({}), measured {:.5} [{:.5}, {:.5}]",
+            rep.theta_best, rep.theta_best_method, m.rate, m.ci_low, m.ci_high
+        );
+        for (b, v, ok) in bounds {
+            if ok && v < 0.0 {
+                assert!(m.ci_high <= v, "{name}: {b} = {v} below the measured interval's upper end {}", m.ci_high);
+            }
+        }
+        let ev = rep.profile_evidence.as_ref().expect("a profile");
+        // the evidence's bound: a valid bound (re-partitioned at its best point), never above the
+        // reported one it was computed for
+        let own = ev.bound_of(&ev.profile);
+        let reported = if rep.engaged_cells > 0 { rep.theta_engaged } else { rep.theta_profile };
+        assert!(own <= reported + 1e-9, "{name}: evidence {own} above the reported {reported}");
+        assert!(m.ci_high <= own, "{name}: evidence bound {own} below the measured {}", m.ci_high);
+        // negative control: floors at the ceilings, at a certificate beyond the spectral abscissa
+        let mut wrong = ev.clone();
+        wrong.profile.floor = wrong.profile.g.clone();
+        let b_min = ev.points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        wrong.points = vec![(-2.0 * rep.mu, b_min)];
+        let w = wrong.bound_of(&wrong.profile);
+        eprintln!("  evidence {own:.5}; floors at the ceilings, lambda = 2 |mu| (unsound) {w:.5}");
+        if w < m.ci_low {
+            caught += 1;
+        }
+    }
+    assert!(
+        caught > 0,
+        "negative control (floors at the ceilings, lambda = 2 |mu|) not caught on any of {}",
+        cases.len()
+    );
+}
