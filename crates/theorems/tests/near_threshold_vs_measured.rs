@@ -13,6 +13,14 @@
 //! certificate no psi-based value can: `psi > -lambda > mu`, and near the threshold the measured
 //! exponent is often beyond `mu`.)
 //!
+//! A second test checks the engaged floors and ceilings cell by cell against the simulated
+//! regime (catching-up, 50 steps per cell, after `e^{rate t} < e^{-14}`): the floors of the runs
+//! continued through the engaged band and of the rise measured through the tube
+//! (proofs-notes/theta-engaged.md) lie below the smallest simulated `|z'|` of their cells
+//! (relative tolerance `1e-2` for the scheme's first-order error). Negative control: the
+//! continuation with the band's offsets taken `|D|` too favourable, and the tube rise with no
+//! room for the deviation, put floors above the simulated speed on some cell.
+//!
 //! Default: 3 random systems (from at most 12 candidates); `NEAR_THRESHOLD_CASES=N` for more.
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
@@ -146,4 +154,83 @@ fn bounds_hold_near_the_threshold_and_unsound_floors_are_caught() {
         "negative control (floors at the ceilings, lambda = 2 |mu|) not caught on any of {}",
         cases.len()
     );
+}
+
+/// Smallest and largest simulated `|z'|` per cell of `eta.len() - 1` cells over one period of the
+/// regime (catching-up, 50 steps per cell, after 14 e-folds of the slower of `mu` and the
+/// measured exponent, at least 5 and at most 300 periods).
+fn regime_speeds(sys: &model::System, rep: &ThetaReport, cells: usize) -> (Vec<f64>, Vec<f64>) {
+    use dynamics::integrators::catching_up::{CatchingUpSettings, Simulator};
+    let (sub, T) = (50usize, rep.period);
+    let steps = cells * sub;
+    let h = T / steps as f64;
+    let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, ..Default::default() }).expect("simulator");
+    let (mut x, mut z) = (vec![0.0; sys.n()], vec![0.0; sys.p()]);
+    let slow = rep.measured.as_ref().map_or(rep.mu, |m| m.rate.max(rep.mu)).min(-1e-3);
+    let transient = ((14.0 / -slow) / T).ceil().clamp(5.0, 300.0) as usize;
+    sim.run(0.0, &mut x, &mut z, transient * steps, |_, _, _, _| {});
+    let (mut lo, mut hi) = (vec![f64::INFINITY; cells], vec![0.0f64; cells]);
+    let mut prev = z.clone();
+    sim.run(transient as f64 * T, &mut x, &mut z, steps, |k, _, _, zk| {
+        let c = (k - 1) / sub;
+        let v = prev.iter().zip(zk).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / h;
+        lo[c] = lo[c].min(v);
+        hi[c] = hi[c].max(v);
+        prev.copy_from_slice(zk);
+    });
+    (lo, hi)
+}
+
+#[test]
+fn engaged_floors_hold_cell_by_cell_near_the_threshold_and_unsound_ones_are_caught() {
+    let mut systems = vec![model::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/worked-example.toml"
+    )))
+    .expect("worked example")];
+    systems.extend(
+        theorems::strategies::draw(&system_params(&config()), 29, 4 * wanted())
+            .into_iter()
+            .filter(|c| c.n >= 2)
+            .map(|c| c.build()),
+    );
+    let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
+    let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
+    let (mut checked, mut engaged, mut caught_cont, mut caught_tube) = (0usize, 0usize, 0usize, 0usize);
+    for sys in systems.iter().take(wanted() + 2) {
+        let Some(s0) = threshold(sys) else { continue };
+        let sys = scaled(sys, 1.2 * s0);
+        let Ok(rep) = assemble(&sys, &settings) else { continue };
+        let Some(ev) = rep.profile_evidence.as_ref().filter(|_| rep.engaged_cells > 0) else { continue };
+        let prof = &ev.profile;
+        let (lo, hi) = regime_speeds(&sys, &rep, prof.cells());
+        let r_up = prof.R;
+        let tol = |f: f64| f * (1.0 - 1e-2) - 1e-6 * rep.eta_dot_inf;
+        for c in 0..prof.cells() {
+            let (floor, ceil) = (prof.floor[c] * r_up, prof.g[c] * r_up);
+            assert!(lo[c] >= tol(floor), "cell {c}: simulated |z'| {} below the floor {floor}", lo[c]);
+            assert!(hi[c] <= ceil * (1.0 + 1e-2) + 1e-6 * rep.eta_dot_inf, "cell {c}: {} above {ceil}", hi[c]);
+        }
+        checked += 1;
+        engaged += prof.engaged_cells();
+        // negative controls (p = 1 only: the runs of an interval)
+        let orbit = bounds::orbit::EtaOrbit::new(&sys, &bounds::orbit::OrbitSettings::default()).expect("orbit");
+        let Some((low, high)) = orbit.deta_cells_scalar(prof.cells()) else { continue };
+        let (l, u) = (-sys.theta.support_upper(&[-1.0]), sys.theta.support_upper(&[1.0]));
+        let mut wrong = prof.clone();
+        wrong.engaged_offsets = Some((-rep.d_ftheta, -rep.d_ftheta));
+        let wrong = wrong.with_continued_runs(&low, &high, None, l, u);
+        caught_cont += (0..prof.cells()).filter(|&c| lo[c] < tol(wrong.floor[c] * r_up)).count();
+        let mut none = prof.clone();
+        none.floor.iter_mut().for_each(|f| *f = 0.0);
+        none.engaged_age.iter_mut().for_each(|a| *a = None);
+        let no_room = none.with_floors_tube(&low, &high, rep.d_ftheta, u - l, 0.0);
+        caught_tube += (0..prof.cells()).filter(|&c| lo[c] < tol(no_room.floor[c] * r_up)).count();
+    }
+    eprintln!(
+        "{checked} near-threshold systems, {engaged} engaged cells held; controls caught on {caught_cont} (continuation) and {caught_tube} (tube rise) cells"
+    );
+    assert!(checked >= 2, "too few near-threshold systems with engaged cells ({checked})");
+    assert!(caught_cont > 0, "negative control (continuation with offsets -D) not caught");
+    assert!(caught_tube > 0, "negative control (tube rise with no room) not caught");
 }

@@ -193,7 +193,10 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
     let engaged = match (&profile, orbit.deta_cells_scalar(cells), pinned.lo_hi) {
         (Some(prof), Some((low, high)), Some((lo, hi))) => {
             let width = (hi - lo) * (1.0 + 1e-12);
-            let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
+            // diam(C Xi_inf) = d - (hi - lo) for p = 1 (the diameter of a sum of intervals), from
+            // above: hi - lo are support values rounded outward by a few ulps at most
+            let dev_diam = ((d - (hi - lo) * (1.0 - 1e-10)) * (1.0 + 1e-12)).max(0.0);
+            let prof = prof.clone().with_floors_tube(&low, &high, d_ftheta, width, dev_diam);
             // the engaged history narrows the band of z' - eta_T' on engaged cells
             // (beyond_paper::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
             // tau_j = j T / (2 history_steps) up to the longest engaged history of the profile
@@ -225,6 +228,9 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
                 Some(h) => prof.with_history(&low, &high, h, lo, hi),
                 None => prof,
             };
+            // runs continue while the engaged band keeps the backlash moving (proofs-notes/theta-engaged.md,
+            // "Continued engagement")
+            let prof = prof.with_continued_runs(&low, &high, history.as_ref(), lo, hi);
             (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
         }
         // p >= 2, a ball or an ellipsoid: floors from the normal component of y' at the contact
