@@ -722,15 +722,18 @@ fn near_main(want: usize, seed: u64, min_p: usize) {
     println!("|---|---|");
     println!("| the certified inputs (the report's theta_engaged or theta_profile) | {:.3} |", med(|d| d.base));
     println!("| tube width d -> the width the regime uses | {:.3} |", med(|d| d.width));
-    println!("| cell ceilings -> the regime's largest |z'| per cell | {:.3} |", med(|d| d.ceilings));
-    println!("| cell floors -> the regime's smallest |z'| per cell | {:.3} |", med(|d| d.floors));
+    println!("| cell ceilings -> the regime's largest \\|z'\\| per cell | {:.3} |", med(|d| d.ceilings));
+    println!("| cell floors -> the regime's smallest \\|z'\\| per cell | {:.3} |", med(|d| d.floors));
     println!(
         "| cell floors -> the regime's, only on the cells the report proves engaged | {:.3} |",
         med(|d| d.floors_engaged)
     );
     println!("| cell floors -> the regime's, only on the other cells | {:.3} |", med(|d| d.floors_other));
     println!("| all three | {:.3} |", med(|d| d.all));
-    println!("| mean of psi(|z'|/R) over the regime (no chord), the report's points | {:.3} |", med(|d| d.psi_mean));
+    println!(
+        "| mean of psi(\\|z'\\|/R) over the regime (no chord), the report's points | {:.3} |",
+        med(|d| d.psi_mean)
+    );
     println!("| the same, with a lambda search of its own | {:.3} |", med(|d| d.psi_mean_own));
     println!("| mu (every psi-based bound is above -lambda > mu) | {:.3} |", med(|d| d.mu));
     println!();

@@ -161,17 +161,17 @@ fn bounds_hold_near_the_threshold_and_unsound_floors_are_caught() {
 /// measured exponent, at least 5 and at most 300 periods).
 fn regime_speeds(sys: &model::System, rep: &ThetaReport, cells: usize) -> (Vec<f64>, Vec<f64>) {
     use dynamics::integrators::catching_up::{CatchingUpSettings, Simulator};
-    let (sub, T) = (50usize, rep.period);
+    let (sub, period) = (50usize, rep.period);
     let steps = cells * sub;
-    let h = T / steps as f64;
+    let h = period / steps as f64;
     let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, ..Default::default() }).expect("simulator");
     let (mut x, mut z) = (vec![0.0; sys.n()], vec![0.0; sys.p()]);
     let slow = rep.measured.as_ref().map_or(rep.mu, |m| m.rate.max(rep.mu)).min(-1e-3);
-    let transient = ((14.0 / -slow) / T).ceil().clamp(5.0, 300.0) as usize;
+    let transient = ((14.0 / -slow) / period).ceil().clamp(5.0, 300.0) as usize;
     sim.run(0.0, &mut x, &mut z, transient * steps, |_, _, _, _| {});
     let (mut lo, mut hi) = (vec![f64::INFINITY; cells], vec![0.0f64; cells]);
     let mut prev = z.clone();
-    sim.run(transient as f64 * T, &mut x, &mut z, steps, |k, _, _, zk| {
+    sim.run(transient as f64 * period, &mut x, &mut z, steps, |k, _, _, zk| {
         let c = (k - 1) / sub;
         let v = prev.iter().zip(zk).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / h;
         lo[c] = lo[c].min(v);
