@@ -12,6 +12,11 @@
 //! period and phase instead of its sine (issue 29 item 2: the same systems, another input).
 //! `THETA_BENCHMARK_MIN_P=2` keeps only the drawn systems with `p >= 2` (issue 29 item 3: balls
 //! and ellipsoids in R^2 and R^3); the tables end with a breakdown by `p`.
+//! `THETA_BENCHMARK_NEAR=1` (issue 29 item 4) scales each drawn system to its smallest amplitude
+//! where `theta_best` is certified (grid `2^k`, then bisection) times a factor drawn uniformly in
+//! `[1, 1.5]` (deterministic per seed) and reports the bounds there, and where the profile bound
+//! loses: the report's speed profile with the simulated regime's tube width, cell ceilings and
+//! floors in place of the certified ones (not bounds).
 use bounds::{assemble, ThetaReport, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use rayon::prelude::*;
@@ -190,6 +195,9 @@ fn main() {
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
     let square = std::env::var("THETA_BENCHMARK_INPUT").is_ok_and(|v| v == "square");
     let min_p: usize = std::env::var("THETA_BENCHMARK_MIN_P").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
+    if std::env::var("THETA_BENCHMARK_NEAR").is_ok_and(|v| v == "1") {
+        return near_main(want, seed, min_p);
+    }
     let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
@@ -330,4 +338,418 @@ fn kind(r: &Row) -> &'static str {
         (_, true) => "ball/ellipsoid",
         _ => "other",
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Near the threshold (issue 29 item 4): `THETA_BENCHMARK_NEAR=1`.
+// ---------------------------------------------------------------------------------------------
+
+/// The system with every input amplitude multiplied by `s` (sine and square inputs).
+fn scaled(sys: &model::System, s: f64) -> model::System {
+    let mut out = sys.clone();
+    match &mut out.input {
+        model::Input::Sine { amplitudes, .. } | model::Input::Square { amplitudes, .. } => {
+            amplitudes.iter_mut().for_each(|a| *a *= s)
+        }
+        _ => {}
+    }
+    out
+}
+
+/// `theta_best` verified `< 0` for `sys` at scale `s` (bound only).
+fn certified_at(sys: &model::System, s: f64) -> bool {
+    assemble(&scaled(sys, s), &ThetaSettings::bound_only()).is_ok_and(|r| r.theta_best_verified && r.theta_best < 0.0)
+}
+
+/// Grid of the threshold search: `2^k` times the drawn amplitudes, `k = NEAR_K.0..=NEAR_K.1`.
+const NEAR_K: (i32, i32) = (-4, 5);
+/// Bisection steps (in `ln s`) after the grid: relative precision `2^(-NEAR_BISECT)` of `ln 2`.
+const NEAR_BISECT: usize = 10;
+
+/// Where the threshold search ended for one system.
+enum Threshold {
+    /// The smallest certified scale found (certified there; not certified at `s / (1 + 7e-4)`).
+    At(f64),
+    /// Certified already at the bottom of the grid (the threshold lies below the search).
+    BelowGrid,
+    /// Not certified at any grid point.
+    Never,
+}
+
+/// The smallest scale `s` of the drawn amplitudes at which `theta_best` is certified: the first
+/// certified point of the grid `2^k` (from below), then bisection in `ln s` against the grid
+/// point below it. Certification need not be monotone in `s`; this finds the first crossing on
+/// the grid's resolution.
+fn threshold(sys: &model::System) -> Threshold {
+    let mut below = None;
+    for k in NEAR_K.0..=NEAR_K.1 {
+        let s = 2f64.powi(k);
+        if certified_at(sys, s) {
+            below = Some((s / 2.0, s));
+            break;
+        }
+    }
+    let Some((mut lo, mut hi)) = below else { return Threshold::Never };
+    if hi == 2f64.powi(NEAR_K.0) {
+        return Threshold::BelowGrid;
+    }
+    for _ in 0..NEAR_BISECT {
+        let mid = (lo * hi).sqrt();
+        if certified_at(sys, mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Threshold::At(hi)
+}
+
+/// A uniform number in `[0, 1)` from `(seed, index)` (SplitMix64): the scale factor of system
+/// `index` is `1 + 0.5 u`, deterministic per seed.
+fn unit(seed: u64, index: u64) -> f64 {
+    let mut z = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index.wrapping_add(0x6A09_E667_F3BC_C909);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The simulated periodic regime on the cells of a profile (catching-up, `h = T / (50 cells)`,
+/// after the transient): per cell the smallest and largest `|z'|`, the width of the tube it
+/// actually uses (`diam { z - eta_T }` over the cell boundaries), and the speeds of every step.
+struct Regime {
+    speed_min: Vec<f64>,
+    speed_max: Vec<f64>,
+    width: f64,
+    speeds: Vec<f64>,
+}
+
+fn simulate_regime(sys: &model::System, rep: &ThetaReport, eta: &[Vec<f64>]) -> Option<Regime> {
+    use dynamics::integrators::catching_up::{CatchingUpSettings, Simulator};
+    let cells = eta.len() - 1;
+    let sub = 50usize;
+    let steps = cells * sub;
+    let period = rep.period;
+    let h = period / steps as f64;
+    let mut sim = Simulator::new(sys, &CatchingUpSettings { dt: h, ..Default::default() }).ok()?;
+    let (mut x, mut z) = (vec![0.0; sys.n()], vec![0.0; sys.p()]);
+    // settle: 14 e-folds of the slower of mu and the measured exponent, at least 5, at most 300
+    let slow = rep.measured.as_ref().map_or(rep.mu, |m| m.rate.max(rep.mu)).min(-1e-3);
+    let transient = ((14.0 / -slow) / period).ceil().clamp(5.0, 300.0) as usize;
+    sim.run(0.0, &mut x, &mut z, transient * steps, |_, _, _, _| {});
+    let (mut speed_min, mut speed_max) = (vec![f64::INFINITY; cells], vec![0.0f64; cells]);
+    let mut speeds = Vec::with_capacity(steps);
+    let mut q = vec![z.iter().zip(&eta[0]).map(|(a, b)| a - b).collect::<Vec<f64>>()];
+    let mut prev = z.clone();
+    sim.run(transient as f64 * period, &mut x, &mut z, steps, |k, _, _, zk| {
+        let c = (k - 1) / sub;
+        let v = prev.iter().zip(zk).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt() / h;
+        speed_min[c] = speed_min[c].min(v);
+        speed_max[c] = speed_max[c].max(v);
+        speeds.push(v);
+        prev.copy_from_slice(zk);
+        if k % sub == 0 {
+            q.push(zk.iter().zip(&eta[k / sub]).map(|(a, b)| a - b).collect());
+        }
+    });
+    let mut width = 0.0f64;
+    for i in 0..q.len() {
+        for j in 0..i {
+            width = width.max(geometry::linalg::dist(&q[i], &q[j]));
+        }
+    }
+    Some(Regime { speed_min, speed_max, width, speeds })
+}
+
+/// Where the profile bound loses (not bounds): the report's profile with one input at a time
+/// replaced by the simulated regime's, and all of them, and the mean of `psi(|z'| / R)` over the
+/// regime itself; each minimised over the report's certified `(lambda, b_hat)` points.
+#[derive(Clone, Copy)]
+struct Decomposition {
+    /// The evidence's own bound (the report's theta_engaged or theta_profile).
+    base: f64,
+    /// `d` -> the width the regime uses.
+    width: f64,
+    /// Cell ceilings -> the regime's largest `|z'|` per cell.
+    ceilings: f64,
+    /// Cell floors -> the regime's smallest `|z'|` per cell.
+    floors: f64,
+    /// Floors -> the regime's only on the cells the report proves engaged / only on the others.
+    floors_engaged: f64,
+    floors_other: f64,
+    /// All three.
+    all: f64,
+    /// Mean of `psi(u(t))` over the regime: no chord, no profile (the psi ceiling), over the
+    /// report's points and over a lambda search of its own with this objective.
+    psi_mean: f64,
+    psi_mean_own: f64,
+    /// `mu`: every psi-based bound is above `-lambda > mu`.
+    mu: f64,
+    /// `d` and `D` of the report, the regime's width, the largest ceiling and the regime's
+    /// largest `|z'|` (for the table).
+    d: f64,
+    d_ftheta: f64,
+    regime_width: f64,
+    engaged_cells: usize,
+    moving_cells: usize,
+}
+
+fn decompose(sys: &model::System, rep: &ThetaReport) -> Option<Decomposition> {
+    let ev = rep.profile_evidence.as_ref()?;
+    let prof = &ev.profile;
+    let reg = simulate_regime(sys, rep, &prof.eta)?;
+    let r_up = prof.R;
+    let with = |d: Option<f64>, ceil: bool, floor: Option<bool>| {
+        let mut p = prof.clone();
+        if let Some(d) = d {
+            p.d = d;
+        }
+        if ceil {
+            p.g = reg.speed_max.iter().map(|v| v / r_up).collect();
+        }
+        // Some(true): every cell; Some(false): only the cells without a certified floor
+        if let Some(all) = floor {
+            for (c, f) in p.floor.iter_mut().enumerate() {
+                if all || *f <= 0.0 {
+                    *f = reg.speed_min[c] / r_up;
+                }
+            }
+        }
+        for (f, g) in p.floor.iter_mut().zip(&p.g) {
+            *f = f.min(*g);
+        }
+        ev.bound_of(&p)
+    };
+    let mean_psi = |lambda: f64, beta: f64| {
+        let psi = bounds::Psi { alpha: ev.alpha, lambda, beta };
+        reg.speeds.iter().map(|v| psi.eval(v / r_up)).sum::<f64>() / reg.speeds.len() as f64
+    };
+    let psi_mean = ev.points.iter().map(|&(l, b)| mean_psi(l, b)).fold(f64::INFINITY, f64::min);
+    let own = lmi::optimise_lambda(&sys.F(), &sys.E, &sys.C, mean_psi, &ThetaSettings::default().lambda).ok();
+    let psi_mean_own = own
+        .iter()
+        .flat_map(|o| o.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| mean_psi(v.lambda, v.beta))))
+        .fold(psi_mean, f64::min);
+    // floors only where the report has none: the engaged cells' variant is all minus this
+    let mut engaged_only = prof.clone();
+    for (c, f) in engaged_only.floor.iter_mut().enumerate() {
+        if *f > 0.0 {
+            *f = (reg.speed_min[c] / r_up).min(engaged_only.g[c]);
+        }
+    }
+    Some(Decomposition {
+        base: ev.bound_of(prof),
+        width: with(Some(reg.width), false, None),
+        ceilings: with(None, true, None),
+        floors: with(None, false, Some(true)),
+        floors_engaged: ev.bound_of(&engaged_only),
+        floors_other: with(None, false, Some(false)),
+        all: with(Some(reg.width), true, Some(true)),
+        psi_mean,
+        psi_mean_own,
+        mu: rep.mu,
+        d: rep.d,
+        d_ftheta: rep.d_ftheta,
+        regime_width: reg.width,
+        engaged_cells: prof.engaged_cells(),
+        moving_cells: reg.speed_min.iter().filter(|&&v| v > 1e-9).count(),
+    })
+}
+
+/// One near-threshold system: its threshold scale, the drawn factor, the report at the scaled
+/// amplitude with the measured side, and the decomposition.
+struct NearRow {
+    row: Row,
+    s0: f64,
+    factor: f64,
+    dec: Option<Decomposition>,
+}
+
+/// Why a drawn system is not in the near-threshold family.
+enum NearSkip {
+    NotSine,
+    Never,
+    BelowGrid,
+    NotConvergent,
+}
+
+fn near_system(c: &theorems::strategies::systems::SystemParams, index: u64, seed: u64) -> Result<NearRow, NearSkip> {
+    let sys0 = c.build();
+    if !matches!(sys0.input, model::Input::Sine { .. }) {
+        return Err(NearSkip::NotSine);
+    }
+    let s0 = match threshold(&sys0) {
+        Threshold::At(s) => s,
+        Threshold::BelowGrid => return Err(NearSkip::BelowGrid),
+        Threshold::Never => return Err(NearSkip::Never),
+    };
+    let factor = 1.0 + 0.5 * unit(seed, index);
+    let sys = scaled(&sys0, s0 * factor);
+    let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
+    let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
+    let rep = assemble(&sys, &settings).map_err(|_| NearSkip::NotConvergent)?;
+    let m = rep.measured.clone().ok_or(NearSkip::NotConvergent)?;
+    if m.ci_high >= 0.0 {
+        return Err(NearSkip::NotConvergent);
+    }
+    let dec = decompose(&sys, &rep);
+    let row = Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling: None, floor_ceiling: None };
+    Ok(NearRow { row, s0, factor, dec })
+}
+
+/// `THETA_BENCHMARK_NEAR=1`: each drawn system (n >= 2, p >= `min_p`) scaled to its smallest
+/// certified amplitude times a factor drawn uniformly in `[1, 1.5]`; the bounds against the
+/// measured exponent there, and where the profile bound loses.
+fn near_main(want: usize, seed: u64, min_p: usize) {
+    let params = theorems::strategies::draw(&system_params(&config()), seed, 40 * want);
+    let start = std::time::Instant::now();
+    let (mut rows, mut drawn) = (Vec::<NearRow>::new(), 0usize);
+    let (mut never, mut below, mut divergent) = (0usize, 0usize, 0usize);
+    let indexed: Vec<(u64, &theorems::strategies::systems::SystemParams)> =
+        params.iter().enumerate().map(|(i, c)| (i as u64, c)).filter(|(_, c)| c.n >= 2 && c.p >= min_p).collect();
+    for chunk in indexed.chunks(16) {
+        if rows.len() >= want {
+            break;
+        }
+        drawn += chunk.len();
+        let got: Vec<Result<NearRow, NearSkip>> = chunk.par_iter().map(|(i, c)| near_system(c, *i, seed)).collect();
+        for g in got {
+            match g {
+                Ok(r) => rows.push(r),
+                Err(NearSkip::Never) => never += 1,
+                Err(NearSkip::BelowGrid) => below += 1,
+                Err(NearSkip::NotConvergent) => divergent += 1,
+                Err(NearSkip::NotSine) => {}
+            }
+        }
+    }
+    let secs = start.elapsed().as_secs_f64();
+    println!(
+        "Near-threshold family, seed {seed}: {drawn} systems drawn (n >= 2, p >= {min_p}); {never} never certified on the grid 2^[{}, {}] x the drawn amplitudes, {below} certified already at its bottom, {divergent} not convergent at the drawn scale; {} in the family; {secs:.0} s on this machine.",
+        NEAR_K.0,
+        NEAR_K.1,
+        rows.len()
+    );
+    println!();
+    if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
+        println!("| # | n | p | s0 | factor | measured | theta_best (method) | ratio | base | d->width | g->max | l->min | all | mean psi (own) | mu | d | width | D | engaged / moving cells |");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        for (i, r) in rows.iter().enumerate() {
+            let rep = &r.row.rep;
+            let best = if rep.theta_best_verified && rep.theta_best < 0.0 {
+                format!("{:.4} ({})", rep.theta_best, rep.theta_best_method)
+            } else {
+                format!("({:.3})", rep.theta_best)
+            };
+            let dec = r.dec.map_or("| - | - | - | - | - | - | - | - | - | - | - |".to_string(), |d| {
+                format!(
+                    "| {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} | {:.4} | {:.4} | {:.4} | {} / {} |",
+                    d.base,
+                    d.width,
+                    d.ceilings,
+                    d.floors,
+                    d.all,
+                    d.psi_mean_own,
+                    d.mu,
+                    d.d,
+                    d.regime_width,
+                    d.d_ftheta,
+                    d.engaged_cells,
+                    d.moving_cells
+                )
+            });
+            println!(
+                "| {i} | {} | {} | {:.4} | {:.3} | {:.4} | {best} | {:.3} {dec}",
+                r.row.n,
+                r.row.p,
+                r.s0,
+                r.factor,
+                r.row.rate,
+                rep.theta_best / r.row.rate
+            );
+        }
+        println!();
+    }
+    let bounds: [(&str, Get); 5] = [
+        ("theta (paper)", |r| (r.theta, r.theta_verified)),
+        ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
+        ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
+        ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
+        ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
+    ];
+    println!("| bound | certified (verified < 0) | median bound / measured | min | max | violations |");
+    println!("|---|---|---|---|---|---|");
+    for (name, get) in bounds {
+        let cert: Vec<&NearRow> = rows.iter().filter(|r| get(&r.row.rep).1 && get(&r.row.rep).0 < 0.0).collect();
+        let ratios: Vec<f64> = cert.iter().map(|r| get(&r.row.rep).0 / r.row.rate).collect();
+        let violations = cert.iter().filter(|r| get(&r.row.rep).0 < r.row.hi).count();
+        let (lo, hi) = ratios.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        println!(
+            "| {name} | {} of {} | {:.3} | {lo:.3} | {hi:.3} | {violations} |",
+            cert.len(),
+            rows.len(),
+            median(ratios)
+        );
+    }
+    println!();
+    // theta_best / measured over the whole family (0 where not certified at the drawn scale:
+    // certification need not be monotone in the amplitude)
+    let all: Vec<f64> = rows
+        .iter()
+        .map(|r| {
+            let rep = &r.row.rep;
+            if rep.theta_best_verified && rep.theta_best < 0.0 {
+                rep.theta_best / r.row.rate
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    println!("theta_best / measured over all {} (0 where not certified): median {:.3}.", all.len(), median(all));
+    let methods = ["theta", "theta_star", "theta_profile", "theta_engaged"];
+    let counts: Vec<String> = methods
+        .iter()
+        .map(|m| format!("{m} {}", rows.iter().filter(|r| r.row.rep.theta_best_method == *m).count()))
+        .collect();
+    println!("theta_best attained by: {}.", counts.join(", "));
+    println!();
+    // the decomposition: medians of (what-if) / measured over the systems with a profile
+    let decs: Vec<(Decomposition, f64)> = rows.iter().filter_map(|r| r.dec.map(|d| (d, r.row.rate))).collect();
+    let med = |f: fn(&Decomposition) -> f64| median(decs.iter().map(|(d, m)| f(d) / m).collect());
+    println!("Where the profile bound loses ({} systems; not bounds: simulated inputs in place of certified ones, medians of value / measured):", decs.len());
+    println!();
+    println!("| profile bound with | median / measured |");
+    println!("|---|---|");
+    println!("| the certified inputs (the report's theta_engaged or theta_profile) | {:.3} |", med(|d| d.base));
+    println!("| tube width d -> the width the regime uses | {:.3} |", med(|d| d.width));
+    println!("| cell ceilings -> the regime's largest \\|z'\\| per cell | {:.3} |", med(|d| d.ceilings));
+    println!("| cell floors -> the regime's smallest \\|z'\\| per cell | {:.3} |", med(|d| d.floors));
+    println!(
+        "| cell floors -> the regime's, only on the cells the report proves engaged | {:.3} |",
+        med(|d| d.floors_engaged)
+    );
+    println!("| cell floors -> the regime's, only on the other cells | {:.3} |", med(|d| d.floors_other));
+    println!("| all three | {:.3} |", med(|d| d.all));
+    println!(
+        "| mean of psi(\\|z'\\|/R) over the regime (no chord), the report's points | {:.3} |",
+        med(|d| d.psi_mean)
+    );
+    println!("| the same, with a lambda search of its own | {:.3} |", med(|d| d.psi_mean_own));
+    println!("| mu (every psi-based bound is above -lambda > mu) | {:.3} |", med(|d| d.mu));
+    println!();
+    let mr = |f: fn(&Decomposition) -> f64| median(decs.iter().map(|(d, _)| f(d)).collect());
+    println!(
+        "Medians: d {:.4}, regime width {:.4} (width / d {:.3}), D {:.4}; engaged cells {:.0}, moving cells {:.0}.",
+        mr(|d| d.d),
+        mr(|d| d.regime_width),
+        mr(|d| d.regime_width / d.d),
+        mr(|d| d.d_ftheta),
+        mr(|d| d.engaged_cells as f64),
+        mr(|d| d.moving_cells as f64)
+    );
+    let viol = rows
+        .iter()
+        .filter(|r| bounds.iter().any(|(_, g)| g(&r.row.rep).1 && g(&r.row.rep).0 < 0.0 && g(&r.row.rep).0 < r.row.hi))
+        .count();
+    println!("Violations over all {} systems and all bounds: {viol}.", rows.len());
 }

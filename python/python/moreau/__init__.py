@@ -7,7 +7,7 @@ Bindings of the Rust workspace (the same numbers as the ``moreau`` command):
 ...                     theta=moreau.Interval(0.1), input=moreau.Sine([1.0], omega=1.0))
 >>> rep = moreau.theta(sys)            # `moreau theta FILE --json`: a dict, keys also attributes
 >>> rep.theta_best, rep["theta_verified"]  # doctest: +SKIP
-(-0.2055..., True)
+(-0.2067..., True)
 
 Every error is a :class:`MoreauError` (a ``ValueError``) carrying the one-line message the
 command prints after ``error:``.

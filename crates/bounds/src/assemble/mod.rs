@@ -491,5 +491,6 @@ fn report(
         tube_s_max: tube_C.s_max,
         tube_tail: tube_C.tail_bound(),
         notes,
+        profile_evidence: ext.evidence,
     }
 }

@@ -10,7 +10,7 @@
 //! earlier, right after the paper's tube stage whose kernels it shares.
 use crate::beyond_paper::contact_floors::{contact_floors, Band, ContactGeometry};
 use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
-use crate::beyond_paper::speed_profile::SpeedProfile;
+use crate::beyond_paper::speed_profile::{ProfileEvidence, SpeedProfile};
 use crate::error::BoundsError;
 use crate::exponent::psi::Psi;
 use crate::orbit::{partition_bound_local, EtaOrbit};
@@ -113,6 +113,9 @@ pub(crate) struct Extensions {
     pub theta_best: f64,
     pub theta_best_method: &'static str,
     pub theta_best_verified: bool,
+    /// The profile, partition and points of `theta_engaged` (of `theta_profile` when no cell is
+    /// engaged).
+    pub evidence: Option<ProfileEvidence>,
 }
 
 /// `theta*`, `theta_profile`, `theta_engaged` and the best verified bound.
@@ -128,6 +131,7 @@ pub(crate) fn extensions(
     let profile = theta_profile(paper, &profiles, &star, settings);
     let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, notes);
     let (theta_best, theta_best_method, theta_best_verified) = best(paper, &star, &profile, &engaged);
+    let evidence = engaged.evidence.or(profile.evidence);
     Extensions {
         path_local: speeds.path_local,
         path_best_method: speeds.path_best_method,
@@ -151,6 +155,7 @@ pub(crate) fn extensions(
         theta_best,
         theta_best_method,
         theta_best_verified,
+        evidence,
     }
 }
 
@@ -188,7 +193,10 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
     let engaged = match (&profile, orbit.deta_cells_scalar(cells), pinned.lo_hi) {
         (Some(prof), Some((low, high)), Some((lo, hi))) => {
             let width = (hi - lo) * (1.0 + 1e-12);
-            let prof = prof.clone().with_floors(&low, &high, d_ftheta, width);
+            // diam(C Xi_inf) = d - (hi - lo) for p = 1 (the diameter of a sum of intervals), from
+            // above: hi - lo are support values rounded outward by a few ulps at most
+            let dev_diam = ((d - (hi - lo) * (1.0 - 1e-10)) * (1.0 + 1e-12)).max(0.0);
+            let prof = prof.clone().with_floors_tube(&low, &high, d_ftheta, width, dev_diam);
             // the engaged history narrows the band of z' - eta_T' on engaged cells
             // (beyond_paper::EngagedHistory; proofs-notes/theta-engaged.md), tabulated on
             // tau_j = j T / (2 history_steps) up to the longest engaged history of the profile
@@ -220,6 +228,9 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
                 Some(h) => prof.with_history(&low, &high, h, lo, hi),
                 None => prof,
             };
+            // runs continue while the engaged band keeps the backlash moving (proofs-notes/theta-engaged.md,
+            // "Continued engagement")
+            let prof = prof.with_continued_runs(&low, &high, history.as_ref(), lo, hi);
             (prof.engaged_cells() > 0 && width.is_finite()).then_some(prof)
         }
         // p >= 2, a ball or an ellipsoid: floors from the normal component of y' at the contact
@@ -362,6 +373,7 @@ struct ProfileBound {
     lambda: f64,
     beta: f64,
     intervals: usize,
+    evidence: Option<ProfileEvidence>,
 }
 
 /// `theta_profile`: the best partition of the speed profile at `theta*`'s point, then the best
@@ -369,14 +381,16 @@ struct ProfileBound {
 fn theta_profile(paper: &FromPaper, profiles: &Profiles, star: &Star, settings: &ThetaSettings) -> ProfileBound {
     let a_low = paper.alpha;
     let (theta_star, lambda_star, beta_star) = (star.theta, star.lambda, star.beta);
-    let (theta_profile, (lambda_profile, beta_profile), profile_intervals) = match &profiles.profile {
+    let (theta_profile, (lambda_profile, beta_profile), profile_intervals, evidence) = match &profiles.profile {
         Some(prof) => {
             let nodes = prof
                 .best_partition(&Psi { alpha: a_low, lambda: lambda_star, beta: beta_star }, settings.profile_stride);
             let (v, at) = best_certified_point(prof, &nodes, a_low, &star.points);
-            (v.min(theta_star), if v <= theta_star { at } else { (lambda_star, beta_star) }, nodes.len() - 1)
+            let intervals = nodes.len() - 1;
+            let evidence = ProfileEvidence { profile: prof.clone(), nodes, alpha: a_low, points: star.points.clone() };
+            (v.min(theta_star), if v <= theta_star { at } else { (lambda_star, beta_star) }, intervals, Some(evidence))
         }
-        None => (theta_star, (lambda_star, beta_star), 0),
+        None => (theta_star, (lambda_star, beta_star), 0, None),
     };
     ProfileBound {
         theta: theta_profile,
@@ -384,6 +398,7 @@ fn theta_profile(paper: &FromPaper, profiles: &Profiles, star: &Star, settings: 
         lambda: lambda_profile,
         beta: beta_profile,
         intervals: profile_intervals,
+        evidence,
     }
 }
 
@@ -393,6 +408,7 @@ struct EngagedBound {
     verified: bool,
     lambda: f64,
     cells: usize,
+    evidence: Option<ProfileEvidence>,
 }
 
 /// `theta_engaged`: the engaged profile's best partition and a lambda search of its own
@@ -408,7 +424,7 @@ fn theta_engaged(
     let a_low = paper.alpha;
     let sys = paper.sys;
     let (theta_profile, lambda_profile, beta_profile) = (profile.theta, profile.lambda, profile.beta);
-    let (theta_engaged, lambda_engaged, engaged_cells) = match &profiles.engaged {
+    let (theta_engaged, lambda_engaged, engaged_cells, evidence) = match &profiles.engaged {
         Some(prof) => {
             let nodes = prof.best_partition(
                 &Psi { alpha: a_low, lambda: lambda_profile, beta: beta_profile },
@@ -430,15 +446,22 @@ fn theta_engaged(
                 Err(e) => notes.push(format!("third lambda search (for theta_engaged) failed: {e}")),
             }
             let (v, (l, _)) = best_certified_point(prof, &nodes, a_low, &points);
-            (v.min(theta_profile), if v <= theta_profile { l } else { lambda_profile }, prof.engaged_cells())
+            let evidence = ProfileEvidence { profile: prof.clone(), nodes, alpha: a_low, points };
+            (
+                v.min(theta_profile),
+                if v <= theta_profile { l } else { lambda_profile },
+                prof.engaged_cells(),
+                Some(evidence),
+            )
         }
-        None => (theta_profile, lambda_profile, 0),
+        None => (theta_profile, lambda_profile, 0, None),
     };
     EngagedBound {
         theta: theta_engaged,
         verified: profile.verified && profiles.engaged.is_some(),
         lambda: lambda_engaged,
         cells: engaged_cells,
+        evidence,
     }
 }
 

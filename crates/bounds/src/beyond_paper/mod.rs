@@ -29,4 +29,4 @@ pub use contact_floors::{ContactFloors, ContactGeometry};
 pub use engaged_speed::{EngagedHistory, EngagedSpeed};
 
 pub(crate) use extensions::{extensions, pinned_speed, Extensions, FromPaper};
-pub use speed_profile::SpeedProfile;
+pub use speed_profile::{ProfileEvidence, SpeedProfile};

@@ -105,7 +105,24 @@ impl SpeedProfile {
     /// `(min_c sigma eta_T' - D) / R` (rounded down) when, for one sign `sigma`, every cell of a
     /// cyclic run ending with it has `min sigma eta_T' > D` and the run's cells before it carry
     /// at least `width` of guaranteed monotone motion of `sigma y`.
-    pub fn with_floors(mut self, deta_low: &[f64], deta_high: &[f64], d_ftheta: f64, width: f64) -> Self {
+    pub fn with_floors(self, deta_low: &[f64], deta_high: &[f64], d_ftheta: f64, width: f64) -> Self {
+        self.with_floors_tube(deta_low, deta_high, d_ftheta, width, f64::INFINITY)
+    }
+
+    /// [`SpeedProfile::with_floors`] where the guaranteed motion of `sigma y` over the cells of a
+    /// run before cell `c` is also measured through the tube (proofs-notes/theta-engaged.md,
+    /// "Rise through the tube"): `sigma (y(t') - y(a)) >= sum min sigma eta_T' h - dev_diam`
+    /// with `dev_diam >= diam(C Xi_inf)` (`y - eta_T = C (x - xi_T)` lies in `C Xi_inf`
+    /// asymptotically at both ends), the larger of this and `sum (min sigma eta_T' - D) h`.
+    /// `dev_diam = inf` gives [`SpeedProfile::with_floors`].
+    pub fn with_floors_tube(
+        mut self,
+        deta_low: &[f64],
+        deta_high: &[f64],
+        d_ftheta: f64,
+        width: f64,
+        dev_diam: f64,
+    ) -> Self {
         let K = self.cells();
         assert!(deta_low.len() == K && deta_high.len() == K, "one enclosure per cell");
         let mut floor = vec![0.0f64; K];
@@ -127,20 +144,25 @@ impl SpeedProfile {
             // unless rate is positive everywhere, which would make the run a full cycle: skip.
             let Some(start) = (0..K).find(|&c| rate[c] <= 0.0) else { continue };
             let mut moved = 0.0f64;
+            // sum of min sigma eta_T' h over the run, rounded down
+            let mut rise = 0.0f64;
             let mut engaged_before = 0usize;
             for k in 1..=K {
                 let c = (start + k) % K;
                 if rate[c] <= 0.0 {
                     moved = 0.0;
+                    rise = 0.0;
                     engaged_before = 0;
                     continue;
                 }
-                if moved > width {
+                let through_tube = rise - dev_diam - 4.0 * f64::EPSILON * (rise.abs() + dev_diam.abs());
+                if moved.max(through_tube) > width {
                     floor[c] = floor[c].max(engaged_rate[c] / self.R * (1.0 - 1e-12));
                     age[c] = Some((sigma, engaged_before));
                     engaged_before += 1;
                 }
                 moved += rate[c] * self.h * (1.0 - 1e-12);
+                rise += m[c] * self.h * (1.0 - 1e-12);
             }
         }
         // a floor never exceeds the cell's speed bound (both are bounds of the same u)
@@ -149,6 +171,62 @@ impl SpeedProfile {
         }
         self.floor = floor;
         self.engaged_age = age;
+        self
+    }
+
+    /// Continued engagement (p = 1; proofs-notes/theta-engaged.md, "Continued engagement"): the
+    /// cell after an engaged cell (sign `sigma`, engaged for at least `age` cell lengths at its
+    /// start) is engaged too when the band of an engagement of `age + 1` cell lengths
+    /// (`hist.band`, or the pinned offsets without a history) proves `sigma z' > 0` on it: while
+    /// the backlash is engaged, `sigma y' = sigma z'` stays positive, so it cannot leave the side
+    /// it is pushed from. Such cells get the band's floor and ceiling and continue the run,
+    /// also across cells where `min sigma eta_T' <= D` (which end a run of
+    /// [`SpeedProfile::with_floors`]). Call after [`SpeedProfile::with_history`].
+    pub fn with_continued_runs(
+        mut self,
+        deta_low: &[f64],
+        deta_high: &[f64],
+        hist: Option<&EngagedHistory>,
+        lo: f64,
+        hi: f64,
+    ) -> Self {
+        let K = self.cells();
+        assert!(deta_low.len() == K && deta_high.len() == K, "one enclosure per cell");
+        let Some((off_up, off_down)) = self.engaged_offsets else { return self };
+        // two passes: a run that crosses the end of the period continues at its start
+        for _ in 0..2 {
+            for c in 0..K {
+                let prev = (c + K - 1) % K;
+                let (Some((sigma, age)), None) = (self.engaged_age[prev], self.engaged_age[c]) else { continue };
+                if self.floor[prev] <= 0.0 {
+                    continue;
+                }
+                let age = age + 1;
+                // sigma z' in [sl, sh] while engaged for at least age h
+                let (sl, sh) = match hist {
+                    Some(h) => {
+                        let (a, b) = h.band(age as f64 * self.h * (1.0 - 1e-12), if sigma > 0.0 { lo } else { hi });
+                        let (zl, zh) = (deta_low[c] + a, deta_high[c] + b);
+                        if sigma > 0.0 {
+                            (zl, zh)
+                        } else {
+                            (-zh, -zl)
+                        }
+                    }
+                    None if sigma > 0.0 => (deta_low[c] - off_up, f64::INFINITY),
+                    None => (-deta_high[c] - off_down, f64::INFINITY),
+                };
+                let (sl, sh) = (sl - 4.0 * f64::EPSILON * sl.abs(), sh + 4.0 * f64::EPSILON * sh.abs());
+                if sl <= 0.0 {
+                    continue;
+                }
+                if sh.is_finite() {
+                    self.g[c] = self.g[c].min(scale_up(sh.max(0.0) / self.R, MARGIN));
+                }
+                self.floor[c] = self.floor[c].max(sl / self.R * (1.0 - 1e-12)).min(self.g[c]);
+                self.engaged_age[c] = Some((sigma, age));
+            }
+        }
         self
     }
 
@@ -325,6 +403,36 @@ impl SpeedProfile {
     }
 }
 
+/// The profile a report's `theta_engaged` (or, with no engaged cell, `theta_profile`) was
+/// computed from, with its partition and the certified `(lambda, b_hat)` points it was minimised
+/// over: the evidence of the bound, for diagnostics (which input of the profile loses most:
+/// `theta_benchmark`'s near-threshold mode puts measured speeds or tube widths in its place).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileEvidence {
+    pub profile: SpeedProfile,
+    /// Partition (cell boundary indices from `0` to `cells`).
+    pub nodes: Vec<usize>,
+    /// `alpha` from below and the certified `(lambda, b_hat)` points.
+    pub alpha: f64,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl ProfileEvidence {
+    /// The smallest bound of `prof` over the certified points, with the partition chosen for it
+    /// at the point where the evidence's own profile is smallest (`prof` = the evidence's profile:
+    /// the reported bound, up to the partition's lambda).
+    pub fn bound_of(&self, prof: &SpeedProfile) -> f64 {
+        let psi = |&(lambda, beta): &(f64, f64)| Psi { alpha: self.alpha, lambda, beta };
+        let Some(best) = self.points.iter().min_by(|a, b| {
+            self.profile.bound(&psi(a), &self.nodes).total_cmp(&self.profile.bound(&psi(b), &self.nodes))
+        }) else {
+            return f64::INFINITY;
+        };
+        let nodes = prof.best_partition(&psi(best), 4);
+        self.points.iter().map(|p| prof.bound(&psi(p), &nodes)).fold(f64::INFINITY, f64::min)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -426,6 +534,72 @@ mod tests {
         none.floor.iter_mut().for_each(|l| *l = 0.0);
         let (with, without) = (prof.bound(&psi, &nodes), none.bound(&psi, &nodes));
         assert!(with < without - 0.05, "floors must help: {with} vs {without}");
+    }
+
+    /// The play of [`play_case`] with a claimed band `D = 0.3` of `y' - eta_T'` (conservative:
+    /// the play has none) and enclosures of `y'` per cell.
+    fn play_with_band(dev_diam: f64) -> (SpeedProfile, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (prof, speed) = play_case(0.2);
+        let (cells, h) = (prof.cells(), prof.h);
+        let (low, high): (Vec<f64>, Vec<f64>) = (0..cells)
+            .map(|c| {
+                let (a, b) = ((c as f64 * h).cos(), ((c + 1) as f64 * h).cos());
+                (a.min(b) - h, a.max(b) + h)
+            })
+            .unzip();
+        let mut p = prof;
+        p.floor.iter_mut().for_each(|f| *f = 0.0);
+        p.engaged_age.iter_mut().for_each(|a| *a = None);
+        (p.with_floors_tube(&low, &high, 0.3, 0.2, dev_diam), speed, low, high)
+    }
+
+    #[test]
+    fn rise_through_the_tube_and_continued_runs_engage_more_cells_below_the_true_speed() {
+        let (plain, speed, low, high) = play_with_band(f64::INFINITY);
+        let (tube, ..) = play_with_band(0.05);
+        assert!(
+            tube.engaged_cells() > plain.engaged_cells() + 5,
+            "{} vs {}",
+            tube.engaged_cells(),
+            plain.engaged_cells()
+        );
+        // the play's y' is eta_T' exactly: engaged offsets 0 are its pinned band
+        let mut cont = tube.clone();
+        cont.engaged_offsets = Some((0.0, 0.0));
+        let cont = cont.with_continued_runs(&low, &high, None, -0.1, 0.1);
+        assert!(
+            cont.engaged_cells() > tube.engaged_cells() + 5,
+            "{} vs {}",
+            cont.engaged_cells(),
+            tube.engaged_cells()
+        );
+        for p in [&plain, &tube, &cont] {
+            for (c, (floor, sp)) in p.floor.iter().zip(&speed).enumerate() {
+                assert!(*floor <= sp + 0.05, "cell {c}: floor {floor} above speed {sp}");
+            }
+        }
+        // with dev_diam = inf the tube variant is with_floors itself
+        let (prof, ..) = play_case(0.2);
+        let mut again = prof.clone();
+        again.floor.iter_mut().for_each(|f| *f = 0.0);
+        let again = again.with_floors_tube(&low, &high, 0.3, 0.2, f64::INFINITY);
+        assert_eq!(again.floor, plain.floor);
+    }
+
+    #[test]
+    fn negative_control_continued_runs_without_the_band_claim_a_stopped_backlash_moves() {
+        // offsets far below the truth (y' taken 0.5 above eta_T' while engaged): the runs continue
+        // past the turning point of the play, where z rests, and the play refutes those floors
+        let (tube, speed, low, high) = play_with_band(0.05);
+        let mut wrong = tube.clone();
+        wrong.engaged_offsets = Some((-0.5, -0.5));
+        let wrong = wrong.with_continued_runs(&low, &high, None, -0.1, 0.1);
+        let bad = (0..wrong.cells()).filter(|&c| wrong.floor[c] > speed[c] + 0.05).count();
+        assert!(bad > 5, "the unsound continuation must be caught: {bad} cells");
+        // and the tube rise with no room for the deviation at all engages where z still rests
+        let (no_room, ..) = play_with_band(-0.19);
+        let bad = (0..no_room.cells()).filter(|&c| no_room.floor[c] > speed[c] + 0.05).count();
+        assert!(bad > 5, "the unsound tube rise must be caught: {bad} cells");
     }
 
     #[test]

@@ -162,6 +162,10 @@ pub struct ThetaReport {
     pub tube_s_max: f64,
     pub tube_tail: f64,
     pub notes: Vec<String>,
+    /// The speed profile, partition and certified points `theta_engaged` (or `theta_profile`)
+    /// was computed from ([`crate::beyond_paper::ProfileEvidence`]; diagnostics, not rendered).
+    #[serde(skip)]
+    pub profile_evidence: Option<crate::beyond_paper::ProfileEvidence>,
 }
 
 impl ThetaReport {
