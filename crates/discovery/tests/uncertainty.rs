@@ -140,14 +140,16 @@ fn the_report_states_both_parts_of_the_sigma() {
     assert!(r0.uncertainty_method.contains("not computed"), "{}", r0.uncertainty_method);
 }
 
-/// Issue 27 item 2: backlash inertia read 2-8 % low with a sigma of 0.4-1.3 %. On this case
-/// (two-state plant, 48 ms sampling) the fitter steps the play with 2 sub-steps per sample and
-/// reads the time constant 3.9 % low, 3 sigma (statistical and jackknife) off; refitted at 8
-/// sub-steps it moves a third of the way to the truth. The reported sigma now includes that
-/// stepping bias (extrapolated, first order) and covers the truth within 2 sigma.
+/// Issue 27 item 2: backlash inertia read 2-8 % off with a sigma of 0.4-1.3 %. On this case
+/// (two-state plant, the generator's converged truth) the fitter steps the play with 2 sub-steps
+/// per sample and reads the time constant 5.3 % high, 2.6 sigma (statistical and jackknife)
+/// off; refitted at 8 sub-steps it moves towards the truth. The reported sigma includes that
+/// stepping bias (extrapolated, first order) and covers the truth within 2 sigma. (The case
+/// of the first version of this test, seed 7001 case 1, no longer needs the stepping part once
+/// the generator's own truth is converged: part of its bias was the generator's.)
 #[test]
 fn backlash_inertia_sigma_includes_the_fitters_stepping_bias() {
-    let case = discovery::bench_gen::generate("backlash_inertia", 7001, 1);
+    let case = discovery::bench_gen::generate("backlash_inertia", 8103, 2);
     let s = discovery::DiagnoseSettings {
         initial_state: Some(discovery::InitialState {
             x0: case.nominal.x0.iter().copied().collect(),
