@@ -58,3 +58,33 @@ fn parallel_fit_equals_the_serial_fit_and_the_estimate_alone_equals_the_fit() {
     let c = fit::fit(&pb, &x0, &xs, None, &FitSettings { max_iter: 1, ..Default::default() });
     assert_ne!(bits(&c.theta), bits(&a.theta), "a different fit must not compare equal");
 }
+
+/// The whole diagnosis with and without rayon: the same verdict, estimates and sigmas, bit for
+/// bit (the parallel levels only distribute independent fits and simulations).
+#[test]
+fn a_diagnosis_reads_the_same_with_and_without_parallelism() {
+    let case = discovery::bench_gen::generate_profile("backlash", 5101, 0, discovery::bench_gen::Profile::Digital);
+    let s = discovery::DiagnoseSettings {
+        initial_state: Some(discovery::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        }),
+        ..Default::default()
+    };
+    let run = |parallel: bool| {
+        let s = discovery::DiagnoseSettings { parallel, ..s.clone() };
+        discovery::diagnose(&case.nominal, &case.recording, &s).expect("the case diagnoses")
+    };
+    let (a, b) = (run(true), run(false));
+    assert_eq!(a.selected(), "backlash");
+    assert_eq!(a.selected(), b.selected());
+    let numbers = |r: &discovery::Report| -> Vec<u64> {
+        r.effects
+            .iter()
+            .flat_map(|e| e.params.iter().chain(&e.uncertainty).map(|(_, v)| v.to_bits()))
+            .chain(r.ranking.iter().map(|h| h.bic.to_bits()))
+            .collect()
+    };
+    assert!(!numbers(&a).is_empty());
+    assert_eq!(numbers(&a), numbers(&b));
+}

@@ -83,13 +83,8 @@ pub(crate) fn diagnose_selected(
 ) -> Result<(Report, Selected), DiscoveryError> {
     s.validate(sys, rec)?;
     // `parallel: false` holds for the fits' Jacobians and starts too.
-    let serial;
-    let s = if !s.parallel && s.fit.parallel {
-        serial = DiagnoseSettings { fit: crate::fit::FitSettings { parallel: false, ..s.fit.clone() }, ..s.clone() };
-        &serial
-    } else {
-        s
-    };
+    let serial = s.serial_fits();
+    let s = serial.as_ref().unwrap_or(s);
     let data = Setup::new(sys, rec, s)?;
     // Hold and discretisation, then the nominal fit under them.
     let mut pass = Pass::first(&data);
