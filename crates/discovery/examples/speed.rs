@@ -160,6 +160,11 @@ fn long_recording_with(n: usize, white: bool) -> (model::System, Recording) {
     (sys, rec)
 }
 
+/// One simulator run of the `simulator` section: name, model, effects, input, sample time,
+/// sub-steps, hold.
+type SimRun<'a> =
+    (&'a str, &'a model::System, Vec<model::effects::Effect>, &'a [f64], f64, usize, dynamics::extended::InputHold);
+
 struct Args {
     sections: Vec<String>,
     cases: usize,
@@ -384,15 +389,7 @@ fn main() {
         let w: Vec<f64> = rec.w.iter().flatten().copied().collect();
         let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
         let wc: Vec<f64> = case.recording.w.iter().flatten().copied().collect();
-        let runs: [(
-            &str,
-            &model::System,
-            Vec<model::effects::Effect>,
-            &[f64],
-            f64,
-            usize,
-            dynamics::extended::InputHold,
-        ); 3] = [
+        let runs: [SimRun; 3] = [
             ("friction, foh", &sys, truth.clone(), &w, rec.dt, 5, dynamics::extended::InputHold::Foh),
             ("friction, zoh", &sys, truth, &w, rec.dt, 5, dynamics::extended::InputHold::Zoh),
             (

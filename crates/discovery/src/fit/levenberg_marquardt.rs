@@ -509,6 +509,13 @@ fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64
     starts
 }
 
+/// Where [`lm`] ends: `(v, r, cost, converged)`.
+type LmEnd = (Vec<f64>, Vec<f64>, f64, bool);
+
+/// A start kept by [`best_start`] and its residual: `None` not evaluated yet, `Some(None)` its
+/// simulation failed (in the screening).
+type KeptStart = (Vec<f64>, Option<Option<Vec<f64>>>);
+
 /// Screens the starts (more than [`SCREENED_STARTS`]: the best by their first cost), runs
 /// `max_iter_start` iterations from each kept one and returns the best end point (the first
 /// of equals). The kept starts are iterated in parallel where the settings say so (the same
@@ -520,7 +527,7 @@ fn best_start(
     evals: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
     // Each start with its residual where already evaluated (by the screening).
-    let kept: Vec<(Vec<f64>, Option<Option<Vec<f64>>>)> = if starts.len() > SCREENED_STARTS {
+    let kept: Vec<KeptStart> = if starts.len() > SCREENED_STARTS {
         let mut scored: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = starts
             .into_iter()
             .map(|v| {
@@ -542,7 +549,7 @@ fn best_start(
         };
         (out, e)
     };
-    let done: Vec<(Option<(Vec<f64>, Vec<f64>, f64, bool)>, usize)> = if s.parallel && kept.len() > 1 {
+    let done: Vec<(Option<LmEnd>, usize)> = if s.parallel && kept.len() > 1 {
         kept.into_par_iter().map(run).collect()
     } else {
         kept.into_iter().map(run).collect()

@@ -108,8 +108,11 @@ pub(super) struct Pieces<'a> {
     split: Option<(usize, f64, Piece<'a>, Piece<'a>)>,
     /// Per sub-step: its pieces `(fa, fb, which)` (`which`: 0 the regular piece, 1 and 2 the
     /// split's parts) and their count.
-    table: Vec<([(f64, f64, u8); 2], usize)>,
+    table: Vec<SubstepPieces>,
 }
+
+/// The pieces `(fa, fb, which)` of one sub-step and their count (see [`Pieces`]).
+type SubstepPieces = ([(f64, f64, u8); 2], usize);
 
 impl<'a> Pieces<'a> {
     pub(super) fn new(model: &'a ExtendedModel) -> Self {
