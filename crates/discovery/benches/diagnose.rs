@@ -1,5 +1,7 @@
 //! Speed of `diagnose` on a 50,000-sample recording against all hypotheses (rayon over
-//! hypotheses; run with RAYON_NUM_THREADS=2 for the 2-core target of <= 30 s).
+//! hypotheses, folds, starts and Jacobian columns; run with RAYON_NUM_THREADS=2 for the 2-core
+//! target of issue 27 item 5, <= 8 s). The per-case, record-length, hypotheses and threads
+//! tables are `examples/speed.rs` (BENCHMARKS.md, "Speed (issue 27 item 5)").
 use criterion::{criterion_group, criterion_main, Criterion};
 use discovery::{diagnose, DiagnoseSettings, Recording};
 use dynamics::extended::ExtendedModel;

@@ -25,14 +25,17 @@ use crate::hypothesis::Kind;
 use crate::select::{self, candidate, FitContext, Ranked};
 use dynamics::extended::InputHold;
 
-/// The hold (requested, or `auto` by the nominal fit), its report and the sub-steps under it.
-pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck) {
+/// The hold (requested, or `auto` by the nominal fit), its report and the sub-steps under it;
+/// with `auto`, the nominal fits it compared `(hold, sub-steps, fit)` (the pass reuses the one
+/// of its own hold and sub-steps instead of fitting it again).
+pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck, Vec<(InputHold, usize, FitResult)>) {
     let s = data.s;
     let first_hold = match s.input_hold {
         HoldChoice::Fixed(h) => h,
         HoldChoice::Auto => InputHold::Foh,
     };
     let mut disc = data.converge_nominal(first_hold, data.k0);
+    let mut fits = Vec::new();
     let (hold, hold_report) = match s.input_hold {
         HoldChoice::Fixed(_) => (
             first_hold,
@@ -51,18 +54,24 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
             },
         ),
         HoldChoice::Auto => {
-            let fz = data.fit_nominal(&data.context(InputHold::Zoh, disc.substeps, data.x_scale.clone()));
-            let ff = data.fit_nominal(&data.context(InputHold::Foh, disc.substeps, data.x_scale.clone()));
+            let fit_under = |h: InputHold| data.fit_nominal(&data.context(h, disc.substeps, data.x_scale.clone()));
+            let (fz, ff) = if s.parallel {
+                rayon::join(|| fit_under(InputHold::Zoh), || fit_under(InputHold::Foh))
+            } else {
+                (fit_under(InputHold::Zoh), fit_under(InputHold::Foh))
+            };
             let (bz, bf) = (select::bic(fz.sse, data.n_res, 0), select::bic(ff.sse, data.n_res, 0));
             let hold = if bz < bf { InputHold::Zoh } else { InputHold::Foh };
             let d = (bz - bf).abs();
+            let (sse_zoh, sse_foh) = (fz.sse, ff.sse);
+            fits = vec![(InputHold::Zoh, disc.substeps, fz), (InputHold::Foh, disc.substeps, ff)];
             (
                 hold,
                 HoldReport {
                     requested: HoldChoice::Auto,
                     chosen: hold.name(),
-                    sse_zoh: Some(fz.sse),
-                    sse_foh: Some(ff.sse),
+                    sse_zoh: Some(sse_zoh),
+                    sse_foh: Some(sse_foh),
                     delta_bic: Some(d),
                     decisive: d >= s.select.tie_bic,
                     effect_delta_bic: None,
@@ -77,7 +86,7 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
     if hold != first_hold {
         disc = data.converge_nominal(hold, disc.substeps);
     }
-    (hold, hold_report, disc)
+    (hold, hold_report, disc, fits)
 }
 
 /// Auto hold: do the best effects confirm the nominal's choice `hold`? The nominal's
@@ -105,7 +114,8 @@ pub(super) fn overturned_by_effects(
     let n_res = data.n_res;
     // Another hold must beat the best single of this one (not only the effect's own fit).
     let best_bic = singles.first().map_or(f64::INFINITY, |b| b.bic);
-    let leading = singles.iter().filter(|c| candidate::nominal_scores(ctx, nom).0 - c.bic >= margin).take(3);
+    let bic_nom = candidate::nominal_scores(ctx, nom).0;
+    let leading = singles.iter().filter(|c| bic_nom - c.bic >= margin).take(3);
     for (i, c) in leading.enumerate() {
         let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
         let ctx_o = data.context(other, ctx.substeps, data.x_scale.clone());

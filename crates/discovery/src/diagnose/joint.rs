@@ -164,6 +164,9 @@ pub fn diagnose_recordings(
     validate_on: &[Recording],
     s: &DiagnoseSettings,
 ) -> Result<JointReport, DiscoveryError> {
+    // `parallel: false` holds for the fits' Jacobians and starts too.
+    let serial = s.serial_fits();
+    let s = serial.as_ref().unwrap_or(s);
     let Some(first) = recs.first() else {
         return Err(DiscoveryError::NoRecording);
     };

@@ -82,6 +82,9 @@ pub(crate) fn diagnose_selected(
     s: &DiagnoseSettings,
 ) -> Result<(Report, Selected), DiscoveryError> {
     s.validate(sys, rec)?;
+    // `parallel: false` holds for the fits' Jacobians and starts too.
+    let serial = s.serial_fits();
+    let s = serial.as_ref().unwrap_or(s);
     let data = Setup::new(sys, rec, s)?;
     // Hold and discretisation, then the nominal fit under them.
     let mut pass = Pass::first(&data);

@@ -80,9 +80,11 @@ enum Step {
 impl<'a> Pass<'a> {
     /// Hold and discretisation, then the nominal fit under them.
     pub(super) fn first(data: &'a Setup<'a>) -> Self {
-        let (hold, hold_report, disc) = hold::first_choice(data);
+        let (hold, hold_report, disc, fits) = hold::first_choice(data);
         let ctx = data.context(hold, disc.substeps, data.x_scale.clone());
-        let nom = data.fit_nominal(&ctx);
+        // The hold's choice fitted the nominal under this hold and sub-steps already, where auto.
+        let done = fits.into_iter().find(|(h, k, _)| *h == hold && *k == disc.substeps).map(|f| f.2);
+        let nom = done.unwrap_or_else(|| data.fit_nominal(&ctx));
         Self {
             hold,
             hold_report,
@@ -214,9 +216,10 @@ impl<'a> Pass<'a> {
             return None;
         }
         let ctx_f = data.context(self.hold, kf, data.x_scale.clone());
-        let nom_f = fit::fit(&ctx_f.problem(vec![], vec![]), &self.nom.x0, &ctx_f.x_scale, None, &s.fit);
         let warm = FitSettings { max_iter: 20, ..s.fit.clone() };
-        let c_f = fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, Some(&c.params), &warm);
+        let nominal_f = || fit::fit(&ctx_f.problem(vec![], vec![]), &self.nom.x0, &ctx_f.x_scale, None, &s.fit);
+        let chosen_f = || fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, Some(&c.params), &warm);
+        let (nom_f, c_f) = if s.parallel { rayon::join(nominal_f, chosen_f) } else { (nominal_f(), chosen_f()) };
         let (n, nx) = (data.n_res, ctx_f.x_scale.len());
         let k_c = c.params.len() + if c.refit { c.nominal.len() } else { 0 };
         let g = select::bic(self.nom.sse, n, nx) - c.bic;

@@ -163,6 +163,13 @@ impl DiagnoseSettings {
         Ok(())
     }
 
+    /// These settings with the fits' own parallelism (`fit.parallel`: Jacobian columns and
+    /// starts) off where `parallel` is; `None` where that changes nothing.
+    pub(crate) fn serial_fits(&self) -> Option<Self> {
+        (!self.parallel && self.fit.parallel)
+            .then(|| Self { fit: FitSettings { parallel: false, ..self.fit.clone() }, ..self.clone() })
+    }
+
     /// The settings of fitting, cross-validation and forward selection.
     pub fn plan(&self) -> Plan<'_> {
         Plan {
@@ -219,4 +226,19 @@ pub struct InitialState {
     pub x0: Vec<f64>,
     /// Backlash output `z0` when stated (else at rest in the play, `z0 = C x0`).
     pub z0: Option<Vec<f64>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn serial_diagnosis_makes_its_fits_serial_too() {
+        let s = DiagnoseSettings { parallel: false, ..Default::default() };
+        let serial = s.serial_fits().expect("parallel = false must reach the fits");
+        assert!(!serial.fit.parallel && !serial.parallel);
+        // the default (parallel) and an already serial fit change nothing
+        assert!(DiagnoseSettings::default().serial_fits().is_none());
+        assert!(serial.serial_fits().is_none());
+    }
 }

@@ -24,7 +24,7 @@
 //! is conservative by at most `sqrt(1 + c^2)`; on a wrong model the jackknife term dominates.
 //! A model error that shifts every fold alike (a bias constant over the record) is seen by no
 //! resampling and is not covered; the report says so.
-use crate::fit::{fit, FitSettings, FitStatus, Problem};
+use crate::fit::{fit_estimate, FitSettings, FitStatus, Problem};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -139,7 +139,7 @@ where
         if let Some(r) = pb.refit.as_mut() {
             r.values = full.nominal.to_vec();
         }
-        let r = fit(&pb, full.x0, x_scale, Some(full.theta), &fs);
+        let r = fit_estimate(&pb, full.x0, x_scale, Some(full.theta), &fs);
         if !r.sse.is_finite() || r.status == FitStatus::Failed {
             return None;
         }

@@ -161,7 +161,7 @@ pub fn fit_joint(
     let (mut std, mut nominal_std) = (vec![f64::NAN; k], vec![f64::NAN; kn]);
     let mut nominal_correlation = vec![];
     if k + kn > 0 {
-        let J = jacobian(&joint, &v, &r, s.tol_fd, &mut evals);
+        let J = jacobian(&joint, &v, &r, s.tol_fd, s.parallel, &mut evals);
         let dof = (r.len() as f64 - v.len() as f64).max(1.0);
         // s^2 of the scaled residual: exact where the recordings have equal residual counts,
         // their mean where not (white residuals; no sandwich here).

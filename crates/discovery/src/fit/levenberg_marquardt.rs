@@ -14,6 +14,7 @@
 //! units. Model error that biases the estimate is not covered by either.
 use crate::fit::Problem;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Settings of the solver.
@@ -30,11 +31,14 @@ pub struct FitSettings {
     /// Estimation segments of at least this many samples run the multi-start phase on a
     /// leading part (see [`LONG_RECORD`]); `usize::MAX` never. Default [`LONG_RECORD`].
     pub long_record: usize,
+    /// Evaluate the columns of the finite-difference Jacobian and the starts in parallel
+    /// (rayon; the result is the same either way). Default true.
+    pub parallel: bool,
 }
 
 impl Default for FitSettings {
     fn default() -> Self {
-        Self { max_iter_start: 6, max_iter: 40, tol_fd: 1e-3, tol_cost: 1e-7, long_record: LONG_RECORD }
+        Self { max_iter_start: 6, max_iter: 40, tol_fd: 1e-3, tol_cost: 1e-7, long_record: LONG_RECORD, parallel: true }
     }
 }
 
@@ -127,7 +131,7 @@ impl Vars<'_, '_> {
 /// A bounded least-squares objective of the solver ([`lm`]): the residual at a point, the
 /// projection on its box, and the side of a finite-difference step. [`fit`] solves one
 /// recording's [`Problem`]; [`crate::fit::joint`] several recordings with shared parameters.
-pub(crate) trait Objective {
+pub(crate) trait Objective: Sync {
     /// The residual at `v` (`None` where the simulation blew up); counts the evaluation.
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>>;
     /// Projects `v` on the box.
@@ -160,15 +164,33 @@ pub(crate) fn sse(r: &[f64]) -> f64 {
     r.iter().map(|x| x * x).sum()
 }
 
-pub(crate) fn jacobian<O: Objective>(vars: &O, v: &[f64], r0: &[f64], h: f64, evals: &mut usize) -> DMatrix<f64> {
+/// Forward-difference Jacobian of the residual at `v` (residual `r0` there), step `h` towards
+/// the interior of the box. The columns are independent simulations: with `parallel` they are
+/// evaluated on the rayon pool (the same numbers either way).
+pub(crate) fn jacobian<O: Objective>(
+    vars: &O,
+    v: &[f64],
+    r0: &[f64],
+    h: f64,
+    parallel: bool,
+    evals: &mut usize,
+) -> DMatrix<f64> {
     let nv = v.len();
     let mut J = DMatrix::zeros(r0.len(), nv);
-    for c in 0..nv {
+    let column = |c: usize| -> (f64, Option<Vec<f64>>, usize) {
         let mut vp = v.to_vec();
         // Step towards the interior for bounded variables.
         let step = if vars.step_back(v, c, h) { -h } else { h };
         vp[c] += step;
-        if let Some(rp) = vars.res(&vp, evals) {
+        let mut e = 0;
+        let rp = vars.res(&vp, &mut e);
+        (step, rp, e)
+    };
+    let cols: Vec<(f64, Option<Vec<f64>>, usize)> =
+        if parallel && nv > 1 { (0..nv).into_par_iter().map(column).collect() } else { (0..nv).map(column).collect() };
+    for (c, (step, rp, e)) in cols.into_iter().enumerate() {
+        *evals += e;
+        if let Some(rp) = rp {
             for i in 0..r0.len() {
                 J[(i, c)] = (rp[i] - r0[i]) / step;
             }
@@ -252,17 +274,29 @@ fn residual_correlation_length(r: &[f64], p: usize, max_lag: usize) -> usize {
 /// Runs LM from `v`, at most `iters` iterations. Returns (v, r, cost, converged).
 pub(crate) fn lm<O: Objective>(
     vars: &O,
-    mut v: Vec<f64>,
+    v: Vec<f64>,
     iters: usize,
     s: &FitSettings,
     evals: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
-    let mut r = vars.res(&v, evals)?;
+    let r = vars.res(&v, evals)?;
+    Some(lm_from(vars, v, r, iters, s, evals))
+}
+
+/// [`lm`] from `v` whose residual `r` is known (the same iterations, one simulation fewer).
+pub(crate) fn lm_from<O: Objective>(
+    vars: &O,
+    mut v: Vec<f64>,
+    mut r: Vec<f64>,
+    iters: usize,
+    s: &FitSettings,
+    evals: &mut usize,
+) -> (Vec<f64>, Vec<f64>, f64, bool) {
     let mut cost = sse(&r);
     let mut lambda = 1e-2;
     let mut converged = false;
     for _ in 0..iters {
-        let J = jacobian(vars, &v, &r, s.tol_fd, evals);
+        let J = jacobian(vars, &v, &r, s.tol_fd, s.parallel, evals);
         let JtJ = J.transpose() * &J;
         let g = J.transpose() * DVector::from_column_slice(&r);
         let mut improved = false;
@@ -299,7 +333,7 @@ pub(crate) fn lm<O: Objective>(
             break;
         }
     }
-    Some((v, r, cost, converged))
+    (v, r, cost, converged)
 }
 
 /// Fits `pb` from the starts of its parts (the cartesian product is avoided: start `i` of
@@ -312,6 +346,33 @@ pub(crate) fn lm<O: Objective>(
 /// Steps: `starts` -> `best_start` (screening and a few iterations from each) -> refinement
 /// of the best on the whole estimation segment -> `conclude` (covariance and status).
 pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>, s: &FitSettings) -> FitResult {
+    fit_with(pb, x0_init, x_scale, warm, s, true)
+}
+
+/// [`fit`]'s estimate alone: the same parameters, initial state and SSE, without the
+/// covariance and the stuck-fit checks of its end point (one Jacobian fewer): `std` and
+/// `nominal_std` are `NaN`, `nominal_correlation` is empty and the status is `Converged`,
+/// `MaxIterations` or `Failed`. For refits whose spread, not their own sigma, is wanted (the
+/// folds of the cross-validation and of the jackknife).
+pub fn fit_estimate(
+    pb: &Problem,
+    x0_init: &[f64],
+    x_scale: &[f64],
+    warm: Option<&[f64]>,
+    s: &FitSettings,
+) -> FitResult {
+    fit_with(pb, x0_init, x_scale, warm, s, false)
+}
+
+/// [`fit`] (`covariance`) or [`fit_estimate`].
+fn fit_with(
+    pb: &Problem,
+    x0_init: &[f64],
+    x_scale: &[f64],
+    warm: Option<&[f64]>,
+    s: &FitSettings,
+    covariance: bool,
+) -> FitResult {
     let lo = pb.lower();
     let k = lo.len();
     let xs: Vec<f64> = x_scale.iter().map(|v| v.max(1e-9)).collect();
@@ -357,18 +418,37 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
         evaluations: evals,
     };
     let Some(b) = best else { return failed(evals) };
-    let refined = match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
-        Some(done) => Some(done),
-        // the best start's residual is of the leading part after a short start phase: the
-        // fallback is evaluated on the whole segment
-        None if start_vars.k_end < vars.k_end => vars.res(&b.0, &mut evals).map(|r| {
-            let c = sse(&r);
-            (b.0, r, c, false)
-        }),
-        None => Some(b),
+    let refined = match start_vars.k_end == vars.k_end {
+        // the best start's residual is that of the whole segment already
+        true => Some(lm_from(&vars, b.0, b.1, s.max_iter, s, &mut evals)),
+        false => match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
+            Some(done) => Some(done),
+            // the best start's residual is of the leading part after a short start phase: the
+            // fallback is evaluated on the whole segment
+            None => vars.res(&b.0, &mut evals).map(|r| {
+                let c = sse(&r);
+                (b.0, r, c, false)
+            }),
+        },
     };
     let Some(done) = refined else { return failed(evals) };
-    conclude(&vars, done, s, evals)
+    if covariance {
+        return conclude(&vars, done, s, evals);
+    }
+    let (v, r, cost, conv) = done;
+    let (theta, nominal, x0) = vars.split(&v);
+    FitResult {
+        theta,
+        std: vec![f64::NAN; k],
+        nominal,
+        nominal_std: vec![f64::NAN; kn],
+        nominal_correlation: vec![],
+        x0,
+        sse: cost,
+        n_res: r.len(),
+        status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations },
+        evaluations: evals,
+    }
 }
 
 /// Nothing to fit: the nominal model from a known initial state.
@@ -429,23 +509,55 @@ fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64
     starts
 }
 
+/// Where [`lm`] ends: `(v, r, cost, converged)`.
+type LmEnd = (Vec<f64>, Vec<f64>, f64, bool);
+
+/// A start kept by [`best_start`] and its residual: `None` not evaluated yet, `Some(None)` its
+/// simulation failed (in the screening).
+type KeptStart = (Vec<f64>, Option<Option<Vec<f64>>>);
+
 /// Screens the starts (more than [`SCREENED_STARTS`]: the best by their first cost), runs
-/// `max_iter_start` iterations from each kept one and returns the best end point.
+/// `max_iter_start` iterations from each kept one and returns the best end point (the first
+/// of equals). The kept starts are iterated in parallel where the settings say so (the same
+/// result either way).
 fn best_start(
     vars: &Vars,
-    mut starts: Vec<Vec<f64>>,
+    starts: Vec<Vec<f64>>,
     s: &FitSettings,
     evals: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
-    if starts.len() > SCREENED_STARTS {
-        let mut scored: Vec<(f64, Vec<f64>)> =
-            starts.into_iter().map(|v| (vars.res(&v, evals).map_or(f64::INFINITY, |r| sse(&r)), v)).collect();
+    // Each start with its residual where already evaluated (by the screening).
+    let kept: Vec<KeptStart> = if starts.len() > SCREENED_STARTS {
+        let mut scored: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = starts
+            .into_iter()
+            .map(|v| {
+                let r = vars.res(&v, evals);
+                (r.as_deref().map_or(f64::INFINITY, sse), v, r)
+            })
+            .collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-        starts = scored.into_iter().take(SCREENED_STARTS).map(|(_, v)| v).collect();
-    }
+        scored.into_iter().take(SCREENED_STARTS).map(|(_, v, r)| (v, Some(r))).collect()
+    } else {
+        starts.into_iter().map(|v| (v, None)).collect()
+    };
+    let run = |(v, r): (Vec<f64>, Option<Option<Vec<f64>>>)| {
+        let mut e = 0;
+        let out = match r {
+            Some(Some(r)) => Some(lm_from(vars, v, r, s.max_iter_start, s, &mut e)),
+            Some(None) => None,
+            None => lm(vars, v, s.max_iter_start, s, &mut e),
+        };
+        (out, e)
+    };
+    let done: Vec<(Option<LmEnd>, usize)> = if s.parallel && kept.len() > 1 {
+        kept.into_par_iter().map(run).collect()
+    } else {
+        kept.into_iter().map(run).collect()
+    };
     let mut best: Option<(Vec<f64>, Vec<f64>, f64, bool)> = None;
-    for v in starts {
-        if let Some(res) = lm(vars, v, s.max_iter_start, s, evals) {
+    for (res, e) in done {
+        *evals += e;
+        if let Some(res) = res {
             if best.as_ref().is_none_or(|b| res.2 < b.2) {
                 best = Some(res);
             }
@@ -460,7 +572,7 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
     let (v, r, cost, conv) = done;
     let (pb, k, kn) = (vars.pb, vars.k, vars.kn);
     // Gauss-Newton covariance of the effect parameters.
-    let J = jacobian(vars, &v, &r, s.tol_fd, &mut evals);
+    let J = jacobian(vars, &v, &r, s.tol_fd, s.parallel, &mut evals);
     let nres = r.len();
     let dof = (nres as f64 - v.len() as f64).max(1.0);
     let s2 = cost / dof;

@@ -40,7 +40,7 @@ pub(crate) fn cv_sse(
             // error would measure that, not the effect. It stays at the estimation fit's value
             // there (the same for every hypothesis, the nominal included).
             let x_scale: &[f64] = if b0 == 0 { &[] } else { &ctx.x_scale };
-            let r = fit::fit(&pb, x0, x_scale, Some(params), &fs);
+            let r = fit::fit_estimate(&pb, x0, x_scale, Some(params), &fs);
             (r.theta, r.nominal, r.x0)
         };
         let sim = pb.simulate_with(&theta, &nom, &x0f, None)?;

@@ -171,7 +171,7 @@ impl Forces {
 
     /// Adds the cogging forces, then the friction forces, to the end state `xn` of a linear
     /// step from `x` (`Psi` row-major `n x n`, the step's `int_0^h e^{sF} ds`).
-    #[inline]
+    #[inline(always)]
     pub(super) fn apply(&self, x: &[f64], xn: &mut [f64], Psi: &[f64]) {
         let n = self.n;
         for cg in &self.cogging {

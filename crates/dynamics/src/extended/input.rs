@@ -110,7 +110,8 @@ impl InputPath {
             let raw = if tau <= 0.0 {
                 w[j]
             } else {
-                let i = tau.floor() as usize;
+                // `tau > 0`: truncation is the floor (and no call into libm).
+                let i = tau as usize;
                 if i + 1 >= ns {
                     w[(ns - 1) * m + j]
                 } else {

@@ -101,11 +101,18 @@ impl<'a> Piece<'a> {
 }
 
 /// The pieces of one run: the regular sub-step and, with an input delay, the split sub-step's
-/// two parts (`(substep, at, first, second)`).
+/// two parts (`(substep, at, first, second)`), and each sub-step's pieces as fractions of the
+/// sample interval, computed once per run.
 pub(super) struct Pieces<'a> {
     main: Piece<'a>,
     split: Option<(usize, f64, Piece<'a>, Piece<'a>)>,
+    /// Per sub-step: its pieces `(fa, fb, which)` (`which`: 0 the regular piece, 1 and 2 the
+    /// split's parts) and their count.
+    table: Vec<SubstepPieces>,
 }
+
+/// The pieces `(fa, fb, which)` of one sub-step and their count (see [`Pieces`]).
+type SubstepPieces = ([(f64, f64, u8); 2], usize);
 
 impl<'a> Pieces<'a> {
     pub(super) fn new(model: &'a ExtendedModel) -> Self {
@@ -115,22 +122,36 @@ impl<'a> Pieces<'a> {
             .split
             .as_ref()
             .map(|sp| (sp.substep, sp.at, Piece::new(&sp.first, force, tau), Piece::new(&sp.second, force, tau)));
-        Self { main, split }
+        let sub = model.substeps;
+        let table = (0..sub)
+            .map(|s| {
+                let f0 = s as f64 / sub as f64;
+                let f1 = (s + 1) as f64 / sub as f64;
+                match &split {
+                    Some((ss, at, _, _)) if *ss == s => {
+                        let fm = f0 + at / sub as f64;
+                        ([(f0, fm, 1), (fm, f1, 2)], 2)
+                    }
+                    _ => ([(f0, f1, 0), (f1, f1, 0)], 1),
+                }
+            })
+            .collect();
+        Self { main, split, table }
     }
 
     /// Sub-step `s` of `sub` as one or two pieces `(fa, fb, piece)` (fractions of the sample
     /// interval); the count is the second value.
     #[inline]
     pub(super) fn of_substep(&self, s: usize, sub: usize) -> ([(f64, f64, &Piece<'a>); 2], usize) {
-        let f0 = s as f64 / sub as f64;
-        let f1 = (s + 1) as f64 / sub as f64;
-        match &self.split {
-            Some((ss, at, a, b)) if *ss == s => {
-                let fm = f0 + at / sub as f64;
-                ([(f0, fm, a), (fm, f1, b)], 2)
-            }
-            _ => ([(f0, f1, &self.main), (f1, f1, &self.main)], 1),
-        }
+        debug_assert_eq!(sub, self.table.len());
+        let (parts, np) = &self.table[s];
+        let piece = |w: u8| match (&self.split, w) {
+            (Some((_, _, a, _)), 1) => a,
+            (Some((_, _, _, b)), 2) => b,
+            _ => &self.main,
+        };
+        let [(a0, b0, w0), (a1, b1, w1)] = *parts;
+        ([(a0, b0, piece(w0)), (a1, b1, piece(w1))], *np)
     }
 }
 
@@ -183,15 +204,18 @@ impl<'w> InputDrive<'w> {
     }
 
     /// Sets `w0`, `dw` for the piece `[fa, fb]` of sample interval `k`.
-    #[inline]
+    #[inline(always)]
     fn advance(&mut self, input: &InputPath, k: usize, fa: f64, fb: f64) {
         let (m, ns) = (self.m, self.ns);
         match input.hold {
             InputHold::Zoh => {
                 let tau = k as f64 + 0.5 * (fa + fb) - self.shift;
-                let idx = if tau <= 0.0 { 0 } else { (tau.floor() as usize).min(ns - 1) };
-                self.w0.copy_from_slice(&self.held[idx * m..(idx + 1) * m]);
-                self.dw.iter_mut().for_each(|d| *d = 0.0);
+                // `tau > 0`: truncation is the floor (and no call into libm).
+                let idx = if tau <= 0.0 { 0 } else { (tau as usize).min(ns - 1) };
+                // (`dw` stays zero under this hold; a loop, not a `memcpy` call, for the few inputs)
+                for (a, b) in self.w0.iter_mut().zip(&self.held[idx * m..(idx + 1) * m]) {
+                    *a = *b;
+                }
             }
             InputHold::Foh => {
                 input.foh_at(self.w, m, ns, k as f64 + fb - self.shift, &mut self.uplay, &mut self.unext);
@@ -199,7 +223,8 @@ impl<'w> InputDrive<'w> {
                     self.w0[j] = self.ucur[j];
                     self.dw[j] = self.unext[j] - self.ucur[j];
                 }
-                self.ucur.copy_from_slice(&self.unext);
+                // `unext` is overwritten whole by the next `foh_at`.
+                std::mem::swap(&mut self.ucur, &mut self.unext);
             }
         }
     }
@@ -270,8 +295,9 @@ impl ExtendedModel {
     #[inline]
     fn output(&self, x: &[f64], y: &mut [f64]) {
         let n = self.n;
-        for i in 0..self.p {
-            y[i] = (0..n).map(|j| self.C[i * n + j] * x[j]).sum();
+        let x = &x[..n];
+        for (i, yi) in y[..self.p].iter_mut().enumerate() {
+            *yi = self.C[i * n..][..n].iter().zip(x).map(|(a, b)| a * b).sum();
         }
     }
 
@@ -301,26 +327,33 @@ impl ExtendedModel {
 
     /// The plant over one piece: the exact linear step with `q` and the forces held, then the
     /// cogging and friction forces; `x` advances and `y = C x`.
-    #[inline]
+    ///
+    /// The sums run in the order of the formula (`Phi x`, then `Psi B w0 + Psi1 B dw` per
+    /// input, then `Psi E q`, then `Psi b`); the slices are cut to their lengths once so that
+    /// the inner loops carry no bounds checks (the hot loop of every fit).
+    #[inline(always)]
     pub(super) fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
         let (n, m, p) = (self.n, self.m, self.p);
         let mp = pc.maps;
-        let (x, xn) = (&st.x, &mut st.xn);
-        for i in 0..n {
+        let (x, xn, q) = (&st.x[..n], &mut st.xn[..n], &st.q[..p]);
+        let (w0, dw) = (&w0[..m], &dw[..m]);
+        for (i, xn_i) in xn.iter_mut().enumerate() {
+            let (phi, pb, p1, pe) =
+                (&mp.Phi[i * n..][..n], &mp.PsiB[i * m..][..m], &mp.Psi1B[i * m..][..m], &mp.PsiE[i * p..][..p]);
             let mut acc = 0.0;
-            for j in 0..n {
-                acc += mp.Phi[i * n + j] * x[j];
+            for (a, b) in phi.iter().zip(x) {
+                acc += a * b;
             }
-            for j in 0..m {
-                acc += mp.PsiB[i * m + j] * w0[j] + mp.Psi1B[i * m + j] * dw[j];
+            for ((a, b), (c, d)) in pb.iter().zip(w0).zip(p1.iter().zip(dw)) {
+                acc += a * b + c * d;
             }
-            for j in 0..p {
-                acc += mp.PsiE[i * p + j] * st.q[j];
+            for (a, b) in pe.iter().zip(q) {
+                acc += a * b;
             }
             if self.forces.has_force {
                 acc += pc.fb[i];
             }
-            xn[i] = acc;
+            *xn_i = acc;
         }
         self.forces.apply(x, xn, &mp.Psi);
         std::mem::swap(&mut st.x, &mut st.xn);
@@ -329,7 +362,7 @@ impl ExtendedModel {
 
     /// The play over one piece: `z` coasts (with inertia), `q` is projected into `Theta` and
     /// `z = y + q`. Returns whether the play is in contact (`None` without a play: `z = y`).
-    #[inline]
+    #[inline(always)]
     pub(super) fn step_play(&self, st: &mut RunState, pc: &Piece) -> Option<bool> {
         if !self.has_play() {
             st.z.copy_from_slice(&st.y);
@@ -337,14 +370,14 @@ impl ExtendedModel {
         }
         let p = self.p;
         // z_pred: massless output stays; with inertia it coasts.
+        // `qp`: the deviation before projection: the contact is decided on `q` itself
+        // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
+        // a contact and slow the coasting decay spuriously).
         for i in 0..p {
             st.scratch[i] = st.z[i] + st.v[i] * pc.coast;
             st.q[i] = st.scratch[i] - st.y[i];
+            st.qp[i] = st.q[i];
         }
-        // The deviation before projection: the contact is decided on `q` itself
-        // (comparing `y + q` with `z_pred` would see rounding of `y + (z - y)` as
-        // a contact and slow the coasting decay spuriously).
-        st.qp.copy_from_slice(&st.q);
         let hit = self.play.project_q(&mut st.q, &mut st.scratch);
         for i in 0..p {
             let znew = st.y[i] + st.q[i];
