@@ -273,173 +273,179 @@ fn main() {
         loadavg()
     );
     if a.sections.iter().any(|s| s == "cases") {
-        let runs = run_cases(&a, max_threads);
-        println!(
-            "\n## Generator cases (seed {}, {} per class and profile, {max_threads} threads; load after: {})",
-            a.seed,
-            a.cases,
-            loadavg()
-        );
-        for r in &runs {
-            println!(
-                "{:<36} wall {:>7.2} s cpu {:>7.2} s singles {:>2} samples {:>6}",
-                r.key, r.t.wall, r.t.cpu, r.singles, r.samples
-            );
-        }
-        if a.verdicts {
-            for r in &runs {
-                println!("verdict {} :: {}", r.key, r.verdict);
-            }
-        }
-        println!("\n| set | cases | median wall / cpu (s) | p90 wall / cpu | max wall / cpu | total wall / cpu |");
-        println!("|---|---|---|---|---|---|");
-        print_summary("all", &runs);
-        for p in ["classic", "digital"] {
-            let sub: Vec<CaseRun> = runs
-                .iter()
-                .filter(|r| r.key.starts_with(p))
-                .map(|r| CaseRun {
-                    key: r.key.clone(),
-                    t: r.t,
-                    singles: r.singles,
-                    samples: r.samples,
-                    verdict: String::new(),
-                })
-                .collect();
-            print_summary(p, &sub);
-        }
-        // Number of hypotheses: cases binned by the single hypotheses their diagnosis fitted.
-        if a.sections.iter().any(|s| s == "hypotheses") {
-            println!("\n## Time per number of single hypotheses (same cases)");
-            println!("| singles | cases | median samples | median wall (s) | median cpu (s) | median cpu per single per 1000 samples (ms) |");
-            println!("|---|---|---|---|---|---|");
-            let mut counts: Vec<usize> = runs.iter().map(|r| r.singles).collect();
-            counts.sort();
-            counts.dedup();
-            for c in counts {
-                let sub: Vec<&CaseRun> = runs.iter().filter(|r| r.singles == c).collect();
-                let v = |f: &dyn Fn(&CaseRun) -> f64| quantile(&sub.iter().map(|r| f(r)).collect::<Vec<_>>(), 0.5);
-                println!(
-                    "| {c} | {} | {:.0} | {:.2} | {:.2} | {:.2} |",
-                    sub.len(),
-                    v(&|r| r.samples as f64),
-                    v(&|r| r.t.wall),
-                    v(&|r| r.t.cpu),
-                    v(&|r| 1e6 * r.t.cpu / (r.singles.max(1) as f64 * r.samples as f64)),
-                );
-            }
-        }
+        print_cases(&a, max_threads);
     }
     if a.sections.iter().any(|s| s == "length") {
-        let noise = if a.white { "white noise" } else { "its sawtooth pseudo-noise" };
-        println!(
-            "\n## Record length (recording of benches/diagnose.rs, {noise}, {max_threads} threads; load {})",
-            loadavg()
-        );
-        println!("| samples | wall (s) | cpu (s) | cpu per 1000 samples (s) | hypotheses fitted | verdict |");
-        println!("|---|---|---|---|---|---|");
-        for &n in &a.lengths {
-            let (sys, rec) = long_recording_with(n, a.white);
-            let s = DiagnoseSettings::default();
-            let (r, t) = timed(max_threads, || diagnose(&sys, &rec, &s));
-            let (sg, v) = match &r {
-                Ok(rep) => (rep.ranking.len(), verdict_line(rep)),
-                Err(e) => (0, format!("error: {e}")),
-            };
-            println!("| {n} | {:.2} | {:.2} | {:.3} | {sg} | {v} |", t.wall, t.cpu, 1000.0 * t.cpu / n as f64);
-        }
+        print_length(&a, max_threads);
     }
     if a.sections.iter().any(|s| s == "hypotheses") {
-        // Number of hypotheses fitted, controlled: the same recordings with `max_effects` 0
-        // (singles only, nothing selected), 1 (the best single cross-validated) and 2 (the
-        // default: second effects and, where the residual stays coloured, the pair search).
-        println!("\n## Hypotheses fitted against max_effects ({max_threads} threads; load {})", loadavg());
-        println!("| recording | max_effects | hypotheses fitted (singles + combinations) | wall (s) | cpu (s) | cpu per hypothesis (s) | verdict |");
-        println!("|---|---|---|---|---|---|---|");
-        let (sys, rec) = long_recording(10_000);
-        let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
-        for me in [0, 1, 2] {
-            for (name, sys, rec, base) in [
-                ("long record, 10,000 samples", &sys, &rec, DiagnoseSettings::default()),
-                ("digital backlash case 0", &case.nominal, &case.recording, case_settings(&case)),
-            ] {
-                let s = DiagnoseSettings { max_effects: me, ..base };
-                let (r, t) = timed(max_threads, || diagnose(sys, rec, &s));
-                let (nh, v) = match &r {
-                    Ok(rep) => (rep.ranking.len(), rep.selected()),
-                    Err(e) => (0, format!("error: {e}")),
-                };
-                println!(
-                    "| {name} | {me} | {nh} | {:.2} | {:.2} | {:.3} | {v} |",
-                    t.wall,
-                    t.cpu,
-                    t.cpu / nh.max(1) as f64
-                );
-            }
-        }
+        print_hypotheses(&a, max_threads);
     }
     if a.sections.iter().any(|s| s == "simulator") {
-        // The simulator alone (the inner loop of every fit): the 10,000-sample recording with
-        // its Coulomb friction, and the digital backlash case, at their diagnoses' sub-steps.
-        println!("\n## Simulator (load {})", loadavg());
-        println!("| run | samples x sub-steps | runs | cpu per run (ms) | ns per sub-step |");
-        println!("|---|---|---|---|---|");
-        let (sys, rec) = long_recording(10_000);
-        let truth = bench_gen::generate("coulomb_friction", 3, 0).truth.into_iter().collect::<Vec<_>>();
-        let w: Vec<f64> = rec.w.iter().flatten().copied().collect();
-        let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
-        let wc: Vec<f64> = case.recording.w.iter().flatten().copied().collect();
-        let runs: [SimRun; 3] = [
-            ("friction, foh", &sys, truth.clone(), &w, rec.dt, 5, dynamics::extended::InputHold::Foh),
-            ("friction, zoh", &sys, truth, &w, rec.dt, 5, dynamics::extended::InputHold::Zoh),
-            (
-                "digital backlash, zoh",
-                &case.nominal,
-                vec![],
-                &wc,
-                case.recording.dt,
-                8,
-                dynamics::extended::InputHold::Zoh,
-            ),
-        ];
-        for (name, sys, eff, w, dt, sub, hold) in runs {
-            let ext = ExtendedModel::new(sys, &eff, dt, sub).unwrap().with_hold(hold);
-            let reps = (2_000_000 / w.len()).max(1);
-            let (chk, t) =
-                timed(1, || (0..reps).map(|_| ext.simulate(w, dt, sys.x0.as_slice()).y[w.len() - 1]).sum::<f64>());
+        print_simulator(&a);
+    }
+    if a.sections.iter().any(|s| s == "threads") {
+        print_threads(&a);
+    }
+    println!("\n# load average at the end: {}", loadavg());
+}
+
+/// Per-case times over the generator's classes and profiles (and, with the `hypotheses` section, binned by the single hypotheses fitted).
+fn print_cases(a: &Args, max_threads: usize) {
+    let runs = run_cases(&a, max_threads);
+    println!(
+        "\n## Generator cases (seed {}, {} per class and profile, {max_threads} threads; load after: {})",
+        a.seed,
+        a.cases,
+        loadavg()
+    );
+    for r in &runs {
+        println!(
+            "{:<36} wall {:>7.2} s cpu {:>7.2} s singles {:>2} samples {:>6}",
+            r.key, r.t.wall, r.t.cpu, r.singles, r.samples
+        );
+    }
+    if a.verdicts {
+        for r in &runs {
+            println!("verdict {} :: {}", r.key, r.verdict);
+        }
+    }
+    println!("\n| set | cases | median wall / cpu (s) | p90 wall / cpu | max wall / cpu | total wall / cpu |");
+    println!("|---|---|---|---|---|---|");
+    print_summary("all", &runs);
+    for p in ["classic", "digital"] {
+        let sub: Vec<CaseRun> = runs
+            .iter()
+            .filter(|r| r.key.starts_with(p))
+            .map(|r| CaseRun {
+                key: r.key.clone(),
+                t: r.t,
+                singles: r.singles,
+                samples: r.samples,
+                verdict: String::new(),
+            })
+            .collect();
+        print_summary(p, &sub);
+    }
+    // Number of hypotheses: cases binned by the single hypotheses their diagnosis fitted.
+    if a.sections.iter().any(|s| s == "hypotheses") {
+        println!("\n## Time per number of single hypotheses (same cases)");
+        println!("| singles | cases | median samples | median wall (s) | median cpu (s) | median cpu per single per 1000 samples (ms) |");
+        println!("|---|---|---|---|---|---|");
+        let mut counts: Vec<usize> = runs.iter().map(|r| r.singles).collect();
+        counts.sort();
+        counts.dedup();
+        for c in counts {
+            let sub: Vec<&CaseRun> = runs.iter().filter(|r| r.singles == c).collect();
+            let v = |f: &dyn Fn(&CaseRun) -> f64| quantile(&sub.iter().map(|r| f(r)).collect::<Vec<_>>(), 0.5);
             println!(
-                "| {name} | {} x {sub} | {reps} | {:.3} | {:.1} | checksum {chk:?}",
-                w.len(),
-                1e3 * t.cpu / reps as f64,
-                1e9 * t.cpu / (reps * w.len() * sub) as f64
+                "| {c} | {} | {:.0} | {:.2} | {:.2} | {:.2} |",
+                sub.len(),
+                v(&|r| r.samples as f64),
+                v(&|r| r.t.wall),
+                v(&|r| r.t.cpu),
+                v(&|r| 1e6 * r.t.cpu / (r.singles.max(1) as f64 * r.samples as f64)),
             );
         }
     }
-    if a.sections.iter().any(|s| s == "threads") {
-        println!("\n## Threads (load {})", loadavg());
-        println!("| run | threads | wall (s) | cpu (s) | speed-up (wall, against 1 thread) | cpu / wall |");
-        println!("|---|---|---|---|---|---|");
-        let (sys, rec) = long_recording(*a.lengths.last().unwrap_or(&50_000));
-        let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
-        let cs = case_settings(&case);
-        let mut base: [Option<f64>; 2] = [None, None];
-        for &th in &a.threads {
-            for (j, name) in ["long record", "digital backlash case 0"].iter().enumerate() {
-                let t = if j == 0 {
-                    timed(th, || diagnose(&sys, &rec, &DiagnoseSettings::default())).1
-                } else {
-                    timed(th, || diagnose(&case.nominal, &case.recording, &cs)).1
-                };
-                let b = *base[j].get_or_insert(t.wall);
-                println!(
-                    "| {name} | {th} | {:.2} | {:.2} | {:.2} | {:.2} |",
-                    t.wall,
-                    t.cpu,
-                    b / t.wall,
-                    t.cpu / t.wall
-                );
-            }
+}
+
+/// Time against record length (the recording of `benches/diagnose.rs`).
+fn print_length(a: &Args, max_threads: usize) {
+    let noise = if a.white { "white noise" } else { "its sawtooth pseudo-noise" };
+    println!(
+        "\n## Record length (recording of benches/diagnose.rs, {noise}, {max_threads} threads; load {})",
+        loadavg()
+    );
+    println!("| samples | wall (s) | cpu (s) | cpu per 1000 samples (s) | hypotheses fitted | verdict |");
+    println!("|---|---|---|---|---|---|");
+    for &n in &a.lengths {
+        let (sys, rec) = long_recording_with(n, a.white);
+        let s = DiagnoseSettings::default();
+        let (r, t) = timed(max_threads, || diagnose(&sys, &rec, &s));
+        let (sg, v) = match &r {
+            Ok(rep) => (rep.ranking.len(), verdict_line(rep)),
+            Err(e) => (0, format!("error: {e}")),
+        };
+        println!("| {n} | {:.2} | {:.2} | {:.3} | {sg} | {v} |", t.wall, t.cpu, 1000.0 * t.cpu / n as f64);
+    }
+}
+
+/// Hypotheses fitted against `max_effects` on a long record and a generator case.
+fn print_hypotheses(a: &Args, max_threads: usize) {
+    // Number of hypotheses fitted, controlled: the same recordings with `max_effects` 0
+    // (singles only, nothing selected), 1 (the best single cross-validated) and 2 (the
+    // default: second effects and, where the residual stays coloured, the pair search).
+    println!("\n## Hypotheses fitted against max_effects ({max_threads} threads; load {})", loadavg());
+    println!("| recording | max_effects | hypotheses fitted (singles + combinations) | wall (s) | cpu (s) | cpu per hypothesis (s) | verdict |");
+    println!("|---|---|---|---|---|---|---|");
+    let (sys, rec) = long_recording(10_000);
+    let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
+    for me in [0, 1, 2] {
+        for (name, sys, rec, base) in [
+            ("long record, 10,000 samples", &sys, &rec, DiagnoseSettings::default()),
+            ("digital backlash case 0", &case.nominal, &case.recording, case_settings(&case)),
+        ] {
+            let s = DiagnoseSettings { max_effects: me, ..base };
+            let (r, t) = timed(max_threads, || diagnose(sys, rec, &s));
+            let (nh, v) = match &r {
+                Ok(rep) => (rep.ranking.len(), rep.selected()),
+                Err(e) => (0, format!("error: {e}")),
+            };
+            println!("| {name} | {me} | {nh} | {:.2} | {:.2} | {:.3} | {v} |", t.wall, t.cpu, t.cpu / nh.max(1) as f64);
         }
     }
-    println!("\n# load average at the end: {}", loadavg());
+}
+
+/// The simulator alone: CPU per run and per sub-step.
+fn print_simulator(a: &Args) {
+    // The simulator alone (the inner loop of every fit): the 10,000-sample recording with
+    // its Coulomb friction, and the digital backlash case, at their diagnoses' sub-steps.
+    println!("\n## Simulator (load {})", loadavg());
+    println!("| run | samples x sub-steps | runs | cpu per run (ms) | ns per sub-step |");
+    println!("|---|---|---|---|---|");
+    let (sys, rec) = long_recording(10_000);
+    let truth = bench_gen::generate("coulomb_friction", 3, 0).truth.into_iter().collect::<Vec<_>>();
+    let w: Vec<f64> = rec.w.iter().flatten().copied().collect();
+    let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
+    let wc: Vec<f64> = case.recording.w.iter().flatten().copied().collect();
+    let runs: [SimRun; 3] = [
+        ("friction, foh", &sys, truth.clone(), &w, rec.dt, 5, dynamics::extended::InputHold::Foh),
+        ("friction, zoh", &sys, truth, &w, rec.dt, 5, dynamics::extended::InputHold::Zoh),
+        ("digital backlash, zoh", &case.nominal, vec![], &wc, case.recording.dt, 8, dynamics::extended::InputHold::Zoh),
+    ];
+    for (name, sys, eff, w, dt, sub, hold) in runs {
+        let ext = ExtendedModel::new(sys, &eff, dt, sub).unwrap().with_hold(hold);
+        let reps = (2_000_000 / w.len()).max(1);
+        let (chk, t) =
+            timed(1, || (0..reps).map(|_| ext.simulate(w, dt, sys.x0.as_slice()).y[w.len() - 1]).sum::<f64>());
+        println!(
+            "| {name} | {} x {sub} | {reps} | {:.3} | {:.1} | checksum {chk:?}",
+            w.len(),
+            1e3 * t.cpu / reps as f64,
+            1e9 * t.cpu / (reps * w.len() * sub) as f64
+        );
+    }
+}
+
+/// Wall and CPU time against the rayon thread count.
+fn print_threads(a: &Args) {
+    println!("\n## Threads (load {})", loadavg());
+    println!("| run | threads | wall (s) | cpu (s) | speed-up (wall, against 1 thread) | cpu / wall |");
+    println!("|---|---|---|---|---|---|");
+    let (sys, rec) = long_recording(*a.lengths.last().unwrap_or(&50_000));
+    let case = bench_gen::generate_profile("backlash", a.seed, 0, Profile::Digital);
+    let cs = case_settings(&case);
+    let mut base: [Option<f64>; 2] = [None, None];
+    for &th in &a.threads {
+        for (j, name) in ["long record", "digital backlash case 0"].iter().enumerate() {
+            let t = if j == 0 {
+                timed(th, || diagnose(&sys, &rec, &DiagnoseSettings::default())).1
+            } else {
+                timed(th, || diagnose(&case.nominal, &case.recording, &cs)).1
+            };
+            let b = *base[j].get_or_insert(t.wall);
+            println!("| {name} | {th} | {:.2} | {:.2} | {:.2} | {:.2} |", t.wall, t.cpu, b / t.wall, t.cpu / t.wall);
+        }
+    }
 }
