@@ -25,6 +25,8 @@ pub struct CaseResult {
     pub correct: bool,
     /// The truth is the selected effect or one reported as tied with it.
     pub correct_or_tied: bool,
+    /// The report's `model_incomplete` (a single named effect must not be called incomplete).
+    pub model_incomplete: bool,
     /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right
     /// (an input delay: its reading under the generator's hold convention, which the report
     /// states beside the one of the hold used).
@@ -117,6 +119,7 @@ pub fn run_case_with(
         ties: vec![],
         correct: false,
         correct_or_tied: false,
+        model_incomplete: false,
         param_error: None,
         param_errors: vec![],
         true_param: case.truth.as_ref().map(main_param),
@@ -141,6 +144,7 @@ pub fn run_case_with(
             out.ties = rep.ties.clone();
             out.correct = out.predicted == class;
             out.correct_or_tied = out.correct || rep.ties.iter().any(|t| t.split('(').next() == Some(class));
+            out.model_incomplete = rep.model_incomplete;
             out.fit_before = rep.fit_before.fit_percent[0].unwrap_or(f64::NAN);
             out.fit_after = rep.fit_after.fit_percent[0].unwrap_or(f64::NAN);
             if out.correct {

@@ -162,3 +162,19 @@ fn a_missed_effect_within_the_noise_is_flagged_where_the_data_say_more() {
         assert!(r.verdict.contains("did not pass the held-out folds"), "{}", r.verdict);
     }
 }
+
+#[test]
+fn a_residual_off_zero_is_not_passed_as_coloured_noise() {
+    // An input delay and a sensor offset (seed 2792, digital, case 0, AR(1) noise 0.86): read as
+    // the delay + direction-dependent friction, the residual far from white (Q = 12015) but
+    // white once an AR(1) filter of coefficient 0.93 is removed, so it passed as coloured
+    // noise. Its mean is 9 times its zero-mean bound (5 with the bound widened for the colour):
+    // coloured noise has zero mean, so the model is called incomplete.
+    let case = bench_gen::generate_pair(["input_delay", "sensor_offset"], 2792, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    if named(&case, &r) < 2 {
+        assert!(r.model_incomplete, "{}", r.verdict);
+        assert!(r.remaining.as_ref().is_some_and(|m| m.mean_off_zero), "{:?}", r.remaining);
+        assert!(r.verdict.contains("its mean is off zero"), "{}", r.verdict);
+    }
+}

@@ -147,9 +147,13 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 /// adequate and no missing input was found: `Some` (the model is incomplete) where its residual
 /// is not white, unless one of two documented reasons says the colour is not missing physics:
 /// - coloured measurement noise: the residual with an AR(1) filter removed
-///   ([`crate::residual::prewhiten_ar1`]) is white (requiring it uncorrelated with the input
-///   too called the digital `none` case of development seed 2712 incomplete: its whitened
-///   nominal residual follows the input, an artefact of the hold, not physics);
+///   ([`crate::residual::prewhiten_ar1`]) is white, and its mean is within the zero-mean bound
+///   widened for that colour (`sqrt((1 + rho) / (1 - rho))`: coloured noise has zero mean; a
+///   missed sensor offset does not, and a filter with `rho` near 1 whitens any slow misfit:
+///   an input delay with a missed offset, fresh seed 2792, left Q = 12015 with a mean 9 times
+///   its bound, white once filtered). Requiring the filtered residual uncorrelated with the
+///   input too called the digital `none` case of development seed 2712 incomplete (its
+///   whitened nominal residual follows the input, an artefact of the hold, not physics);
 /// - a misfit within the noise: its RMS is at most [`INCOMPLETE_NOISE_RATIO`] times the noise
 ///   level, except where the residual is above the noise level at all (ratio above 1),
 ///   correlated with the input, **and** an extension of the selected model gains the selection
@@ -186,7 +190,9 @@ fn remaining(
     let unconfirmed = verdict::unconfirmed_extension(&outcome.ranking, outcome.chosen.as_ref(), margin);
     let within_noise = rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO);
     let above_noise = rms_over_noise.iter().any(|&r| r > 1.0);
-    if t_w.white || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)) {
+    let rho = ar1.first().copied().unwrap_or(0.0);
+    let mean_off_zero = t.mean.abs() > t.mean_bound * ((1.0 + rho) / (1.0 - rho)).sqrt();
+    if (t_w.white && !mean_off_zero) || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)) {
         return None;
     }
     let contact = fitted.fit_sim.contact.iter().any(|&c| c).then_some(&fitted.fit_sim.contact[..]);
@@ -199,6 +205,7 @@ fn remaining(
         rms_over_noise,
         uncorrelated: t.uncorrelated,
         uncorrelated_ar1: t_w.uncorrelated,
+        mean_off_zero,
         unconfirmed_extension: unconfirmed,
         windows: loc.windows,
         regimes: loc.regimes.into_iter().filter(|g| g.enriched).collect(),

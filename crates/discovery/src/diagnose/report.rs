@@ -164,6 +164,9 @@ pub struct Remaining {
     /// The same once the AR(1) filter is removed (coloured measurement noise is uncorrelated
     /// with the input; a whitened residual that is not says a model error, not noise).
     pub uncorrelated_ar1: bool,
+    /// Whether the final residual's mean (first output) exceeds its zero-mean bound widened for
+    /// the AR(1) colour (`sqrt((1 + rho) / (1 - rho))`): not coloured noise, which has zero mean.
+    pub mean_off_zero: bool,
     /// An extension of the selected model (label) that gains at least the selection margin in
     /// BIC over it (the gain) but did not pass the held-out folds: the estimation data say more
     /// is there.

@@ -201,11 +201,12 @@ pub(super) fn still_missing(r: &Remaining, chosen: Option<&Ranked>, max_effects:
         (None, _) => String::new(),
     };
     format!(
-        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed{}) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
+        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed{}{}) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
         r.q_auto,
         r.q_auto_threshold,
         r.q_auto_ar1,
         if r.uncorrelated_ar1 { "" } else { ", correlated with the input" },
+        if r.mean_off_zero { "; its mean is off zero beyond what the noise colour allows" } else { "" },
         r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ")
     )
 }
