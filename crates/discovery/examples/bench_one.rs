@@ -13,7 +13,7 @@ fn main() {
     let classes = discovery::bench::class_set(args.get(4).map_or("classic", |s| s.as_str()))
         .expect("classes: classic, friction, all or a comma-separated list of class names");
     let r = discovery::bench::run_classes(&classes, cases, seed, profile, &Default::default(), |c| {
-        println!("{:>18} -> {:<30} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
+        println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
     });
     println!("{}", r.to_text());
 }

@@ -3,6 +3,11 @@
 //! Usage: `cargo run --release -p discovery --example bench_pairs CASES SEED [classic|digital]
 //! [PAIRS]`, `PAIRS` `all` (default: every pair of `bench_gen::pairs`) or a comma-separated
 //! list of `a+b`.
+//!
+//! Per case: the selected model, how many of the two concealed effects it names (strict) and
+//! how many the best of it and its equivalent readings names, whether the report calls the
+//! model incomplete, the final residual's portmanteau statistic, the BIC gains of the selected
+//! model and of the true pair (where fitted), the time and the case.
 fn main() {
     use discovery::bench_gen;
     let args: Vec<String> = std::env::args().collect();
@@ -24,22 +29,29 @@ fn main() {
             })
             .collect(),
     };
-    let (mut n, mut both, mut missed, mut flagged) = (0, 0, 0, 0);
+    let (mut n, mut both, mut both_eq, mut missed, mut flagged, mut missed_eq, mut flagged_eq) = (0, 0, 0, 0, 0, 0, 0);
     for i in 0..cases {
         for &p in &pairs {
             let Some(r) = discovery::bench::run_pair_case(p, seed, i, profile, &Default::default()) else { continue };
             println!(
-                "{:>36} #{i} -> {:<40} named {} incomplete {} Q {:.1}/{:.1} {:.1}s {} {:?}",
+                "{:>36} #{i} -> {:<40} named {} (or equivalent {}) incomplete {} Q {:.1}/{:.1} dBIC {:.1} true pair {} {:.1}s {} equivalents {:?} {:?}",
                 format!("{}+{}", p[0], p[1]),
                 r.selected,
                 r.named,
+                r.named_or_equivalent,
                 r.model_incomplete,
                 r.q_final,
                 r.q_threshold,
+                r.delta_bic_selected,
+                r.delta_bic_true_pair.map_or("not fitted".into(), |v| format!("{v:.1}")),
                 r.seconds,
                 r.description,
+                r.equivalents,
                 r.error
             );
+            if std::env::var_os("BENCH_PAIRS_RANKING").is_some() {
+                print_ranking(p, seed, i, profile);
+            }
             n += 1;
             if r.named == 2 {
                 both += 1;
@@ -47,7 +59,33 @@ fn main() {
                 missed += 1;
                 flagged += r.model_incomplete as usize;
             }
+            if r.named_or_equivalent == 2 {
+                both_eq += 1;
+            } else {
+                missed_eq += 1;
+                flagged_eq += r.model_incomplete as usize;
+            }
         }
     }
     println!("cases {n}: both named {both}; one or both missed {missed}, of which flagged incomplete {flagged}");
+    println!(
+        "counting equivalent readings: both named {both_eq}; one or both missed {missed_eq}, of which flagged incomplete {flagged_eq}"
+    );
+}
+
+/// Development aid (`BENCH_PAIRS_RANKING` set): the case diagnosed again, its ranking printed.
+fn print_ranking(p: [&'static str; 2], seed: u64, i: usize, profile: discovery::bench_gen::Profile) {
+    let case = discovery::bench_gen::generate_pair(p, seed, i, profile).expect("a pair that can co-occur");
+    let s = discovery::DiagnoseSettings {
+        initial_state: Some(discovery::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        }),
+        ..Default::default()
+    };
+    let Ok(rep) = discovery::diagnose(&case.nominal, &case.recording, &s) else { return };
+    for r in &rep.ranking {
+        println!("    {:<50} dBIC {:>9.1} {:?} {}", r.label, r.delta_bic, r.status, r.evidence);
+    }
+    println!("    verdict: {}", rep.verdict);
 }

@@ -25,6 +25,8 @@ pub struct CaseResult {
     pub correct: bool,
     /// The truth is the selected effect or one reported as tied with it.
     pub correct_or_tied: bool,
+    /// The report's `model_incomplete` (a single named effect must not be called incomplete).
+    pub model_incomplete: bool,
     /// `|estimate - truth| / |truth|` of the effect's main parameter, when the name is right
     /// (an input delay: its reading under the generator's hold convention, which the report
     /// states beside the one of the hold used).
@@ -117,6 +119,7 @@ pub fn run_case_with(
         ties: vec![],
         correct: false,
         correct_or_tied: false,
+        model_incomplete: false,
         param_error: None,
         param_errors: vec![],
         true_param: case.truth.as_ref().map(main_param),
@@ -141,6 +144,7 @@ pub fn run_case_with(
             out.ties = rep.ties.clone();
             out.correct = out.predicted == class;
             out.correct_or_tied = out.correct || rep.ties.iter().any(|t| t.split('(').next() == Some(class));
+            out.model_incomplete = rep.model_incomplete;
             out.fit_before = rep.fit_before.fit_percent[0].unwrap_or(f64::NAN);
             out.fit_after = rep.fit_after.fit_percent[0].unwrap_or(f64::NAN);
             if out.correct {
@@ -426,6 +430,16 @@ pub struct PairResult {
     pub selected: String,
     /// How many of the two concealed classes the selected model names.
     pub named: usize,
+    /// The most of them that the selected model or one of the readings the report names as
+    /// fitting as well (`equivalents`) names: the truth is among the readings the recording
+    /// cannot tell apart.
+    pub named_or_equivalent: usize,
+    /// The report's equivalent readings (labels).
+    pub equivalents: Vec<String>,
+    /// BIC gain over the nominal of the selected model, and of the true pair of effects where
+    /// the diagnosis fitted it (the ranking's entry with exactly the two concealed kinds).
+    pub delta_bic_selected: f64,
+    pub delta_bic_true_pair: Option<f64>,
     /// The report's `model_incomplete`.
     pub model_incomplete: bool,
     /// Portmanteau statistic of the final residual and its threshold.
@@ -460,6 +474,10 @@ pub fn run_pair_case(
         description: case.description.clone(),
         selected: "error".into(),
         named: 0,
+        named_or_equivalent: 0,
+        equivalents: vec![],
+        delta_bic_selected: f64::NAN,
+        delta_bic_true_pair: None,
         model_incomplete: false,
         q_final: f64::NAN,
         q_threshold: f64::NAN,
@@ -470,7 +488,24 @@ pub fn run_pair_case(
         Err(e) => out.error = Some(e.to_string()),
         Ok(rep) => {
             out.selected = rep.selected();
-            out.named = case.truths.iter().filter(|t| rep.effects.iter().any(|e| e.kind == t.kind())).count();
+            let named_in =
+                |kinds: &[String]| case.truths.iter().filter(|t| kinds.iter().any(|k| k == t.kind())).count();
+            let selected: Vec<String> = rep.effects.iter().map(|e| e.kind.clone()).collect();
+            out.named = named_in(&selected);
+            out.named_or_equivalent = rep.equivalents.iter().map(|e| named_in(&e.kinds)).fold(out.named, usize::max);
+            out.equivalents = rep.equivalents.iter().map(|e| e.label.clone()).collect();
+            let chosen_label = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
+            out.delta_bic_selected = if rep.effects.is_empty() {
+                0.0
+            } else {
+                rep.ranking.iter().find(|r| r.label == chosen_label).map_or(f64::NAN, |r| r.delta_bic)
+            };
+            out.delta_bic_true_pair = rep
+                .ranking
+                .iter()
+                .filter(|r| !r.refit && r.kinds.len() == case.truths.len() && named_in(&r.kinds) == case.truths.len())
+                .map(|r| r.delta_bic)
+                .reduce(f64::max);
             out.model_incomplete = rep.model_incomplete;
             out.q_final = rep.residual_fitted.q_auto;
             out.q_threshold = rep.residual_fitted.q_auto_threshold;

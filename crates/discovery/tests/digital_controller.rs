@@ -106,8 +106,9 @@ fn full(text: &str, rec: &Recording) -> discovery::Report {
 #[test]
 fn with_the_digital_controller_no_spurious_effect_is_added() {
     // The continuous stand-in for the cascade (no sampling, hold or computation delay) has to
-    // explain the loop's phase lag by something (on this case Stribeck friction; input
-    // saturation on a fresh seed, BENCHMARKS.md); the model with `[controller]` needs none.
+    // explain the loop's phase lag by something (on this case Stribeck friction and an input
+    // delay; input saturation on a fresh seed, BENCHMARKS.md); the model with `[controller]`
+    // needs none.
     let (seed, idx) = (1, 0);
     let tr = sc::truth(seed, idx);
     let multi = sc::record(seed, idx, Experiment::Multisine);
@@ -123,7 +124,15 @@ fn with_the_digital_controller_no_spurious_effect_is_added() {
     );
     assert_eq!(digital.selected(), "none", "{}", digital.verdict);
     assert_ne!(stand_in.selected(), "none", "{}", stand_in.verdict);
-    assert!(stand_in.fit_after.rmse[0] > 2.0 * digital.fit_after.rmse[0]);
+    // The stand-in fits worse, or stands in for the controller's sampling and computation
+    // delay by an input delay (found since the selection goes on while the residual says
+    // something is left, issue 27 item 4).
+    assert!(
+        stand_in.fit_after.rmse[0] > 2.0 * digital.fit_after.rmse[0]
+            || stand_in.effects.iter().any(|e| e.kind == "input_delay"),
+        "{}",
+        stand_in.verdict
+    );
 }
 
 fn env_list(name: &str, default: &str) -> Vec<u64> {

@@ -71,8 +71,16 @@ fn two_effects_named_leave_a_complete_model() {
 #[test]
 fn one_named_effect_is_not_called_incomplete() {
     // Negative control: one concealed effect, named; the verdict does not say anything is missing.
-    for class in ["coulomb_friction", "gap_width"] {
-        let case = bench_gen::generate_profile(class, 27, 0, Profile::Classic);
+    // The gap width (seed 27) leaves a residual that is not white, correlated with the input, at
+    // 0.99 times the noise, with an extension 26 better in BIC that the held-out folds reject;
+    // the digital backlash inertia (seed 2712) one white once its AR(1) noise colour is removed,
+    // with such an extension too: neither is missing physics.
+    for (class, seed, profile) in [
+        ("coulomb_friction", 27, Profile::Classic),
+        ("gap_width", 27, Profile::Classic),
+        ("backlash_inertia", 2712, Profile::Digital),
+    ] {
+        let case = bench_gen::generate_profile(class, seed, 0, profile);
         let r = run(&case);
         assert_eq!(r.selected(), class, "{}", r.verdict);
         assert!(!r.model_incomplete, "{class}: {}", r.verdict);
@@ -92,4 +100,81 @@ fn pair_search_fits_both_effects_jointly() {
     assert!(kinds.contains(&"backlash"), "{}", r.verdict);
     assert!(kinds.iter().any(|k| k.contains("friction") || k.contains("coulomb")), "{}", r.verdict);
     assert!(r.residual_fitted.white && !r.model_incomplete, "{}", r.verdict);
+}
+
+#[test]
+fn a_masked_partner_is_paired_with_the_first_effect() {
+    // Backlash in the loop and Coulomb friction (development seed 2711, case 0): the loop
+    // backlash gains nothing alone (-7 in BIC: the friction's misfit swamps it), so it never
+    // entered the pair search's pool, and Stribeck friction + a backlash at the input was
+    // selected, 1.6 times the noise level. The full model's effects are now paired with every
+    // single: Coulomb friction + the loop backlash, white residual.
+    let case = bench_gen::generate_pair(["backlash", "coulomb_friction"], 2711, 0, Profile::Classic).unwrap();
+    let r = run(&case);
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+    assert!(r.residual_fitted.white && !r.model_incomplete, "{}", r.verdict);
+}
+
+#[test]
+fn a_generalisation_in_a_pair_gives_way_to_its_simpler_form() {
+    // Coulomb friction and a sensor offset (development seed 2711, case 0) were read as
+    // direction-dependent friction + the offset although Coulomb friction + the offset, one
+    // parameter fewer, fits 6 better in BIC: the simpler reading is selected.
+    let case = bench_gen::generate_pair(["coulomb_friction", "sensor_offset"], 2711, 0, Profile::Classic).unwrap();
+    let r = run(&case);
+    let kinds: Vec<&str> = r.effects.iter().map(|e| e.kind.as_str()).collect();
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+    assert!(!kinds.contains(&"asymmetric_coulomb"), "{}", r.verdict);
+}
+
+#[test]
+fn readings_that_fit_alike_are_named_together() {
+    // Coulomb friction and a constant force (development seed 2712, digital, case 0): while
+    // sliding they are direction-dependent friction, and with a sensor offset that reading fits
+    // within the tie margin. The verdict names both readings instead of silently picking one.
+    let case = bench_gen::generate_pair(["coulomb_friction", "constant_force"], 2712, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+    assert!(!r.equivalents.is_empty(), "{}", r.verdict);
+    assert!(r.verdict.contains(&format!("or equivalently {}", r.equivalents[0].label)), "{}", r.verdict);
+    for e in &r.equivalents {
+        assert!(e.delta_bic.abs() < 6.0, "{e:?}");
+        assert!(r.verdict.contains(&e.label), "{}", r.verdict);
+    }
+    assert!(r.equivalents.iter().any(|e| e.kinds.iter().any(|k| k == "asymmetric_coulomb")), "{:?}", r.equivalents);
+    assert!(r.to_markdown(&[]).contains("Other readings that fit as well"));
+}
+
+#[test]
+fn a_missed_effect_within_the_noise_is_flagged_where_the_data_say_more() {
+    // A constant force and a small input delay (development seed 2711, case 0): the delay alone
+    // gains nothing (-5 in BIC), the force + delay pair 16 over the force but not on the
+    // held-out folds. The force's residual, 1.03 times the noise level, correlated with the
+    // input, was exempt as "within 1.1 times the noise"; with an unconfirmed extension above
+    // the noise level the model is called incomplete, and the verdict names the extension.
+    let case = bench_gen::generate_pair(["constant_force", "input_delay"], 2711, 0, Profile::Classic).unwrap();
+    let r = run(&case);
+    if named(&case, &r) < 2 {
+        assert!(r.model_incomplete, "{}", r.verdict);
+        let rem = r.remaining.as_ref().expect("what is left");
+        let (label, gain) = rem.unconfirmed_extension.as_ref().expect("the extension the folds did not confirm");
+        assert!(label.contains("input_delay") && *gain >= 10.0, "{label} {gain}");
+        assert!(r.verdict.contains("did not pass the held-out folds"), "{}", r.verdict);
+    }
+}
+
+#[test]
+fn a_residual_off_zero_is_not_passed_as_coloured_noise() {
+    // An input delay and a sensor offset (seed 2792, digital, case 0, AR(1) noise 0.86): read as
+    // the delay + direction-dependent friction, the residual far from white (Q = 12015) but
+    // white once an AR(1) filter of coefficient 0.93 is removed, so it passed as coloured
+    // noise. Its mean is 9 times its zero-mean bound (5 with the bound widened for the colour):
+    // coloured noise has zero mean, so the model is called incomplete.
+    let case = bench_gen::generate_pair(["input_delay", "sensor_offset"], 2792, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    if named(&case, &r) < 2 {
+        assert!(r.model_incomplete, "{}", r.verdict);
+        assert!(r.remaining.as_ref().is_some_and(|m| m.mean_off_zero), "{:?}", r.remaining);
+        assert!(r.verdict.contains("its mean is off zero"), "{}", r.verdict);
+    }
 }

@@ -93,13 +93,14 @@ impl Report {
     fn md_remaining(&self) -> String {
         let Some(r) = &self.remaining else { return String::new() };
         let mut s = format!(
-            "\n## Still missing\n\nThe final model's residual is not white (Q = {:.1} against the 99 % threshold {:.1}; {:.1} with an AR(1) noise colour of {} removed; {} with the input) and its RMS is {} times the noise level: the model is incomplete. Where the residual left concentrates:\n\n",
+            "\n## Still missing\n\nThe final model's residual is not white (Q = {:.1} against the 99 % threshold {:.1}; {:.1} with an AR(1) noise colour of {} removed, {} with the input; {} with the input before) and its RMS is {} times the noise level: the model is incomplete. Where the residual left concentrates:\n\n",
             r.q_auto,
             r.q_auto_threshold,
             r.q_auto_ar1,
             r.ar1.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", "),
-            r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", "),
-            if r.uncorrelated { "uncorrelated" } else { "correlated" }
+            if r.uncorrelated_ar1 { "uncorrelated" } else { "correlated" },
+            if r.uncorrelated { "uncorrelated" } else { "correlated" },
+            r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ")
         );
         if r.windows.is_empty() {
             s += "- no window stands out (spread over the record)\n";
@@ -206,6 +207,16 @@ impl Report {
             s += &format!(
                 "\nIndistinguishable on this recording (BIC within the tie margin): {}.\n",
                 self.ties.join(", ")
+            );
+        }
+        if !self.equivalents.is_empty() {
+            s += &format!(
+                "\nOther readings that fit as well (BIC within the tie margin of the selected model; the recording cannot tell them apart): {}.\n",
+                self.equivalents
+                    .iter()
+                    .map(|e| format!("{} ({:+.1} in BIC)", e.label, e.delta_bic))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             );
         }
         s

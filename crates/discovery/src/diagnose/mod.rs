@@ -120,6 +120,7 @@ pub(crate) fn diagnose_selected(
         nominal.nominal_adequate,
         &outcome.missing_inputs,
         outcome.chosen.as_ref(),
+        &outcome.equivalents,
         &fitted.nominal_refit,
         &outcome.cv_rejected,
         &headline.text,
@@ -147,9 +148,26 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 
 /// What the final model (selected, else nominal) leaves unexplained where the nominal was not
 /// adequate and no missing input was found: `Some` (the model is incomplete) where its residual
-/// is not white, nor white once an AR(1) filter is removed (coloured measurement noise alone
-/// passes then, [`crate::residual::prewhiten_ar1`]), and its RMS exceeds the noise level by
-/// [`INCOMPLETE_NOISE_RATIO`]; with the localisation of that residual.
+/// is not white, unless one of two documented reasons says the colour is not missing physics:
+/// - coloured measurement noise: the residual with an AR(1) filter removed
+///   ([`crate::residual::prewhiten_ar1`]) is white, and its mean is within the zero-mean bound
+///   widened for that colour (`sqrt((1 + rho) / (1 - rho))`: coloured noise has zero mean; a
+///   missed sensor offset does not, and a filter with `rho` near 1 whitens any slow misfit:
+///   an input delay with a missed offset, fresh seed 2792, left Q = 12015 with a mean 9 times
+///   its bound, white once filtered). Requiring the filtered residual uncorrelated with the
+///   input too called the digital `none` case of development seed 2712 incomplete (its
+///   whitened nominal residual follows the input, an artefact of the hold, not physics);
+/// - a misfit within the noise: its RMS is at most [`INCOMPLETE_NOISE_RATIO`] times the noise
+///   level, except where the residual is above the noise level at all (ratio above 1),
+///   correlated with the input, **and** an extension of the selected model gains the selection
+///   margin in BIC but was not confirmed on held-out folds ([`verdict::unconfirmed_extension`]:
+///   the estimation data say more is there). Development seeds: Coulomb friction or a constant
+///   force with a missed input delay left 1.03-1.04 times the noise with the pair 16-77
+///   better in BIC; a correctly named gap width (seed 27, the negative control of
+///   `tests/two_effects.rs`) left 0.99 with an extension 26 better, not called incomplete. The
+///   line at 1 is thin (a noise level from 1000-2000 samples is uncertain by about 2 %).
+///
+/// With the localisation of that residual.
 fn remaining(
     data: &Setup,
     pass: &Pass,
@@ -171,7 +189,13 @@ fn remaining(
             ms.sqrt() / data.noise[i].max(1e-300)
         })
         .collect();
-    if t_w.white || rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO) {
+    let margin = data.s.select.margin_bic + nominal.delta_bic_disc;
+    let unconfirmed = verdict::unconfirmed_extension(&outcome.ranking, outcome.chosen.as_ref(), margin);
+    let within_noise = rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO);
+    let above_noise = rms_over_noise.iter().any(|&r| r > 1.0);
+    let rho = ar1.first().copied().unwrap_or(0.0);
+    let mean_off_zero = t.mean.abs() > t.mean_bound * ((1.0 + rho) / (1.0 - rho)).sqrt();
+    if (t_w.white && !mean_off_zero) || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)) {
         return None;
     }
     let contact = fitted.fit_sim.contact.iter().any(|&c| c).then_some(&fitted.fit_sim.contact[..]);
@@ -183,6 +207,9 @@ fn remaining(
         ar1,
         rms_over_noise,
         uncorrelated: t.uncorrelated,
+        uncorrelated_ar1: t_w.uncorrelated,
+        mean_off_zero,
+        unconfirmed_extension: unconfirmed,
         windows: loc.windows,
         regimes: loc.regimes.into_iter().filter(|g| g.enriched).collect(),
     })
@@ -196,6 +223,7 @@ struct Outcome {
     /// The selected model (`None` too where a recorded input is missing from the model).
     chosen: Option<Ranked>,
     ties: Vec<String>,
+    equivalents: Vec<select::Equivalent>,
     cv_rejected: Vec<(String, f64, String)>,
     missing_inputs: Vec<MissingInput>,
     initial_state: InitialStateReport,
@@ -216,15 +244,16 @@ fn conclude(
     let mut fit_before = metrics::fit(&ctx.y, &nom_sim.y, p, k_est, n_samp, data.dt);
     fit_before.tracking_fit_percent =
         metrics::tracking_fit(&ctx.y, &nom_sim.y, &ctx.w, (p, ctx.m), &data.sys.signals.reference, k_est, n_samp);
-    let Selection { ranking, mut chosen, mut ties, cv_rejected } = selection;
+    let Selection { ranking, mut chosen, mut ties, cv_rejected, mut equivalents } = selection;
     let missing_inputs = missing_inputs(data, pass, nominal, &ranking);
     if missing_inputs.iter().any(|c| c.missing) {
         // An input the model leaves out is not physics to be stood in for by an effect.
         chosen = None;
         ties.clear();
+        equivalents.clear();
     }
     let initial_state = initial_state(data, pass, chosen.is_none(), notes);
-    Outcome { fit_before, ranking, chosen, ties, cv_rejected, missing_inputs, initial_state }
+    Outcome { fit_before, ranking, chosen, ties, equivalents, cv_rejected, missing_inputs, initial_state }
 }
 
 /// Recorded columns the model does not use: does the residual follow one of them?
@@ -339,6 +368,7 @@ fn assemble(
         uncertainty_method: unc.method,
         jackknife: unc.jack,
         ties: outcome.ties,
+        equivalents: outcome.equivalents,
         windows: loc.windows,
         regimes: loc.regimes,
         velocity_windows: loc.velocity_windows,

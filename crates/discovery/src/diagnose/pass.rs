@@ -250,6 +250,7 @@ impl<'a> Pass<'a> {
         let label = c.label.clone();
         selection.chosen = None;
         selection.ties.clear();
+        selection.equivalents.clear();
         self.disc_final = None;
         Some(format!(
             "{label} gained {g:.1} in BIC over the nominal at {k} sub-steps per sample, but {g_f:.1} with both refitted at {kf} (of which up to {owed:.1} may still be stepping error): its gain is within the simulator's stepping error, not evidence of physics; it is not reported."

@@ -7,7 +7,7 @@ use super::settings::{Metric, SERVO_FIT_PERCENT};
 use super::setup::Setup;
 use crate::fit::missing_input::MissingInput;
 use crate::metrics::{self, Fit};
-use crate::select::Ranked;
+use crate::select::{Equivalent, Ranked};
 
 /// The verdict's metric part.
 pub(super) struct Headline {
@@ -56,6 +56,7 @@ pub(super) fn verdict(
     nominal_adequate: bool,
     missing_inputs: &[MissingInput],
     chosen: Option<&Ranked>,
+    equivalents: &[Equivalent],
     nominal_refit: &[NominalValue],
     cv_rejected: &[(String, f64, String)],
     headline: &str,
@@ -98,7 +99,7 @@ pub(super) fn verdict(
                 fmt_nominal(nominal_refit)
             )
         } else {
-            format!("missing physics: {}{tail} ({headline})", c.label)
+            format!("missing physics: {}{}{tail} ({headline})", c.label, or_equivalently(equivalents))
         }
     } else if !cv_rejected.is_empty() {
         format!(
@@ -108,6 +109,16 @@ pub(super) fn verdict(
     } else {
         "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library".to_string()
     }
+}
+
+/// The readings that fit as well as the selected one, for the verdict: `, or equivalently A
+/// (delta BIC), or B (...): the recording cannot tell these readings apart` (empty without).
+pub(super) fn or_equivalently(equivalents: &[Equivalent]) -> String {
+    if equivalents.is_empty() {
+        return String::new();
+    }
+    let alts: Vec<String> = equivalents.iter().map(|e| format!("{} ({:+.1} in BIC)", e.label, e.delta_bic)).collect();
+    format!(", or equivalently {}: the recording cannot tell these readings apart", alts.join(", or "))
 }
 
 /// Refitted nominal parameters for a verdict: `name nominal -> value +- std (change %)`.
@@ -125,6 +136,25 @@ fn fmt_nominal(v: &[NominalValue]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The best extension of the selected model `chosen` in the ranking (its effects and more,
+/// conclusive fit) that gains at least `margin` in BIC over it: label and gain. Such an
+/// extension was fitted but not accepted (the held-out folds did not confirm it).
+pub(super) fn unconfirmed_extension(ranking: &[Ranked], chosen: Option<&Ranked>, margin: f64) -> Option<(String, f64)> {
+    let c = chosen?;
+    let mine: Vec<String> = c.parts.iter().map(|h| h.kind.label()).collect();
+    ranking
+        .iter()
+        .filter(|r| r.refit == c.refit && r.parts.len() > c.parts.len())
+        .filter(|r| matches!(r.status, crate::fit::FitStatus::Converged | crate::fit::FitStatus::MaxIterations))
+        .filter(|r| {
+            let theirs: Vec<String> = r.parts.iter().map(|h| h.kind.label()).collect();
+            mine.iter().all(|l| theirs.contains(l))
+        })
+        .map(|r| (r.label.clone(), c.bic - r.bic))
+        .filter(|(_, gain)| *gain >= margin)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// The verdict's addition where the final model is incomplete (issue 27 item 4): something is
@@ -158,20 +188,25 @@ pub(super) fn still_missing(r: &Remaining, chosen: Option<&Ranked>, max_effects:
     if windows.is_empty() && regimes.is_empty() {
         at += "; spread over the record (no window or regime stands out)";
     }
-    let why = match chosen {
-        Some(c) if c.parts.len() >= max_effects => {
+    let why = match (chosen, &r.unconfirmed_extension) {
+        (Some(_), Some((label, gain))) => format!(
+            " ({label} gains {gain:.1} in BIC over it on the estimation segment but did not pass the held-out folds: see the ranking)"
+        ),
+        (Some(c), None) if c.parts.len() >= max_effects => {
             format!(" (the selection stops at --max-effects {max_effects})")
         }
-        Some(_) => {
+        (Some(_), None) => {
             " (no further effect of the library passed the BIC margin and the held-out folds: see the ranking)".into()
         }
-        None => String::new(),
+        (None, _) => String::new(),
     };
     format!(
-        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
+        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed{}{}) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
         r.q_auto,
         r.q_auto_threshold,
         r.q_auto_ar1,
+        if r.uncorrelated_ar1 { "" } else { ", correlated with the input" },
+        if r.mean_off_zero { "; its mean is off zero beyond what the noise colour allows" } else { "" },
         r.rms_over_noise.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ")
     )
 }

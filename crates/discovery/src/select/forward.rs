@@ -2,14 +2,20 @@
 //! cross-validated against the nominal model until one passes; a generalisation must also beat
 //! its simpler form on held-out folds; then greedy forward selection adds effects (or the
 //! grey-box refit) while a combination clears the margin against the current model and passes
-//! its cross-validation. Every fit ends in the ranking with its evidence.
+//! its cross-validation. Where the residual still says something is left (issue 27 item 4):
+//! pairs of the best singles fitted jointly from several starts, then every single beside the
+//! model (or, for a full model, beside each of its effects). Finally a generalisation in the
+//! selected model gives way to a simpler reading that fits as well, and the readings that fit
+//! as well as the selected one are named beside it ([`Equivalent`]). Every fit ends in the
+//! ranking with its evidence.
 use super::candidate::{failed_fit, fit_hypothesis, nominal_scores, Ranked};
 use super::context::FitContext;
 use super::cross_validation::{cross_validate, cv_sse_of};
 use super::Plan;
 use crate::fit::{self, FitResult};
-use crate::hypothesis;
+use crate::hypothesis::{self, Hypothesis};
 use rayon::prelude::*;
+use serde::Serialize;
 
 /// The outcome of selection.
 pub struct Selection {
@@ -22,6 +28,22 @@ pub struct Selection {
     /// Candidates that passed the BIC margin but failed cross-validation (label, CV ratio,
     /// the ratio required).
     pub cv_rejected: Vec<(String, f64, String)>,
+    /// Other readings of the recording that fit as well as the selected model (see
+    /// [`Equivalent`]), closest first.
+    pub equivalents: Vec<Equivalent>,
+}
+
+/// Another reading of the recording that fits as well as the selected model (issue 27 item 4):
+/// a different set of effects, neither a part nor an extension of the selected model, whose
+/// BIC is within `tie_bic` of the selected model's (e.g. direction-dependent friction, and
+/// Coulomb friction plus a constant force on the same state: the same forces while sliding).
+/// The recording cannot tell the two apart; the report names both.
+#[derive(Debug, Clone, Serialize)]
+pub struct Equivalent {
+    pub label: String,
+    pub kinds: Vec<String>,
+    /// `BIC(this reading) - BIC(selected model)`.
+    pub delta_bic: f64,
 }
 
 /// Selects among the fitted singles by BIC (margin `margin`) and blocked cross-validation,
@@ -41,6 +63,7 @@ pub(crate) fn select_all(
     let mut ties = Vec::new();
     let mut cv_rejected = Vec::new();
     let mut extra: Vec<Ranked> = Vec::new();
+    let mut equivalents = Vec::new();
     if !nominal_adequate {
         let base_sse = cv_sse_of(ctx, plan, &nominal_ranked);
         sel.accept_best_single(&mut singles, &nominal_ranked, &base_sse, &mut cv_rejected);
@@ -51,14 +74,35 @@ pub(crate) fn select_all(
             ties = sel.ties(&singles, best);
             let (mut cur, tried) = sel.forward(&singles, best.clone(), &base_sse);
             extra = tried;
-            // Something left after the greedy steps: pairs of the best singles, fitted jointly.
+            // Something left after the greedy steps: pairs of the best singles, fitted jointly;
+            // then, still something left and room for it, every single beside the model.
             if plan.max_effects >= 2 && sel.something_left(&cur) {
                 let (better, pairs) = sel.pair_search(&singles, &extra, &cur);
                 extra.extend(pairs);
                 if let Some(b) = better {
                     cur = b;
                 }
+                if sel.something_left(&cur) {
+                    let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| base_sse.clone());
+                    let (better, combos) = if cur.parts.len() < plan.max_effects {
+                        sel.extend_by_every_single(&singles, &extra, &cur, &cur_sse)
+                    } else {
+                        sel.swap_partner(&singles, &extra, &cur, &cur_sse)
+                    };
+                    extra.extend(combos);
+                    if let Some(b) = better {
+                        cur = b;
+                    }
+                }
             }
+            // Readings as good as the selected one: its generalisations' simpler forms, alone
+            // or with another best single, fitted too where not yet fitted.
+            let decomposed = sel.decompositions(&singles, &extra, &cur);
+            extra.extend(decomposed);
+            if let Some(simple) = sel.simpler_reading(&mut extra, &cur, &nominal_ranked, &base_sse) {
+                cur = simple;
+            }
+            equivalents = sel.equivalents(singles.iter().chain(&extra), &cur, &ties);
             chosen = Some(cur);
         }
     }
@@ -66,7 +110,7 @@ pub(crate) fn select_all(
     if let Some(c) = chosen.as_mut() {
         c.evidence = evidence_of(c);
     }
-    Selection { ranking, chosen, ties, cv_rejected }
+    Selection { ranking, chosen, ties, cv_rejected, equivalents }
 }
 
 /// What every step of the selection shares.
@@ -190,7 +234,7 @@ impl Selector<'_, '_> {
     /// counts as a step, it adds parameters, not as an effect): the selected model and every
     /// combination fitted on the way.
     fn forward(&self, singles: &[Ranked], best: Ranked, base_sse: &[f64]) -> (Ranked, Vec<Ranked>) {
-        let (ctx, plan) = (self.ctx, self.plan);
+        let plan = self.plan;
         let mut extra: Vec<Ranked> = Vec::new();
         let mut cur = best;
         while cur.parts.len() < plan.max_effects {
@@ -198,40 +242,70 @@ impl Selector<'_, '_> {
                 .iter()
                 .filter(|r| match r.parts.first() {
                     None => r.refit && !cur.refit,
-                    Some(h) => !cur.parts.iter().any(|p| p.kind.name() == h.kind.name()),
+                    // not a rival law of an effect of the model (two friction laws on one state)
+                    Some(h) => !cur.parts.iter().any(|p| rivals(p.kind, h.kind)),
                 })
                 .take(plan.max_second)
                 .collect();
-            let f = |r: &&Ranked| {
-                let mut parts = cur.parts.clone();
-                parts.extend(r.parts.first().cloned());
-                let refit = match (cur.refit, r.refit, ctx.free) {
-                    (true, _, _) => Some(cur.nominal.clone()),
-                    (false, true, Some(free)) => Some(free.nominal.clone()),
-                    _ => None,
-                };
-                fit_hypothesis(
-                    ctx,
-                    plan,
-                    parts,
-                    refit,
-                    Some(cur.params.clone()),
-                    &cur.x0,
-                    self.bic_nom,
-                    self.val_sse_nom,
-                )
-            };
-            let mut combos: Vec<Ranked> =
-                if plan.parallel { seconds.par_iter().map(f).collect() } else { seconds.iter().map(f).collect() };
-            combos.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-            let next = self.accept_combination(&mut combos, &cur, base_sse);
-            extra.extend(combos.iter().cloned());
+            let (next, combos) = self.extend(&cur, &seconds, base_sse);
+            extra.extend(combos);
             match next {
                 Some(nx) => cur = nx,
                 None => break,
             }
         }
         (cur, extra)
+    }
+
+    /// `cur` extended by each of `seconds` (fitted from `cur`'s estimate, the new effect at its
+    /// start grid), the best that clear the margin cross-validated against `cur` until one
+    /// passes: that one (if any) and every combination fitted.
+    fn extend(&self, cur: &Ranked, seconds: &[&Ranked], base_sse: &[f64]) -> (Option<Ranked>, Vec<Ranked>) {
+        let (ctx, plan) = (self.ctx, self.plan);
+        let f = |r: &&Ranked| {
+            let mut parts = cur.parts.clone();
+            parts.extend(r.parts.first().cloned());
+            let refit = match (cur.refit, r.refit, ctx.free) {
+                (true, _, _) => Some(cur.nominal.clone()),
+                (false, true, Some(free)) => Some(free.nominal.clone()),
+                _ => None,
+            };
+            fit_hypothesis(ctx, plan, parts, refit, Some(cur.params.clone()), &cur.x0, self.bic_nom, self.val_sse_nom)
+        };
+        let mut combos: Vec<Ranked> =
+            if plan.parallel { seconds.par_iter().map(f).collect() } else { seconds.iter().map(f).collect() };
+        combos.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+        let next = self.accept_combination(&mut combos, cur, base_sse);
+        (next, combos)
+    }
+
+    /// Where the greedy steps and the pair search leave something and room for an effect
+    /// (issue 27 item 4): `cur` extended by every single effect not tried beside it yet,
+    /// whatever its own fit alone (a small input delay beside a large constant force gains
+    /// nothing alone, its fit swamped by the force's misfit, and ranks far below the
+    /// [`Plan::max_second`] best singles the greedy step tries).
+    fn extend_by_every_single(
+        &self,
+        singles: &[Ranked],
+        fitted: &[Ranked],
+        cur: &Ranked,
+        base_sse: &[f64],
+    ) -> (Option<Ranked>, Vec<Ranked>) {
+        if cur.parts.len() >= self.plan.max_effects {
+            return (None, vec![]);
+        }
+        let mine = label_list(cur);
+        let seconds: Vec<&Ranked> = singles
+            .iter()
+            .filter(|r| r.parts.len() == 1 && !r.refit)
+            .filter(|r| !cur.parts.iter().any(|p| rivals(p.kind, r.parts[0].kind)))
+            .filter(|r| {
+                let mut labels = mine.clone();
+                labels.push(r.parts[0].kind.label());
+                !fitted.iter().any(|t| t.refit == cur.refit && same_label_set(&label_list(t), &labels))
+            })
+            .collect();
+        self.extend(cur, &seconds, base_sse)
     }
 
     /// Whether `cur`'s residual says something is left: not white, nor once an AR(1) noise
@@ -257,30 +331,17 @@ impl Selector<'_, '_> {
     /// it on held-out folds. Also returned: every pair fitted (for the ranking).
     fn pair_search(&self, singles: &[Ranked], tried: &[Ranked], cur: &Ranked) -> (Option<Ranked>, Vec<Ranked>) {
         let (ctx, plan) = (self.ctx, self.plan);
-        let pool: Vec<&Ranked> = singles
-            .iter()
-            .filter(|r| {
-                r.parts.len() == 1
-                    && !r.refit
-                    && self.bic_nom - r.bic >= self.margin
-                    && matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations)
-            })
-            .take(PAIR_POOL)
-            .collect();
-        let same_labels = |a: &[String], b: &[String]| {
-            let (mut a, mut b) = (a.to_vec(), b.to_vec());
-            a.sort();
-            b.sort();
-            a == b
-        };
-        let label_of = |r: &Ranked| r.parts.iter().map(|h| h.kind.label()).collect::<Vec<_>>();
+        let pool = self.pool(singles);
         let mut todo: Vec<(&Ranked, &Ranked)> = Vec::new();
         for (i, a) in pool.iter().enumerate() {
             for b in &pool[i + 1..] {
                 let (ka, kb) = (a.parts[0].kind, b.parts[0].kind);
                 let labels = vec![ka.label(), kb.label()];
                 if rivals(ka, kb)
-                    || tried.iter().chain(std::iter::once(cur)).any(|t| !t.refit && same_labels(&label_of(t), &labels))
+                    || tried
+                        .iter()
+                        .chain(std::iter::once(cur))
+                        .any(|t| !t.refit && same_label_set(&label_list(t), &labels))
                 {
                     continue;
                 }
@@ -288,22 +349,15 @@ impl Selector<'_, '_> {
             }
         }
         // Each single's estimate has absorbed part of the other effect: started from both
-        // estimates and from both scaled down (PAIR_START_SCALES), the best fit kept.
+        // estimates and from both scaled down (PAIR_START_SCALES), and from each effect's own
+        // estimate (its single's, and its part of every composite fitted on the way) with the
+        // other effect at its start grid (pair_starts); the best fit kept.
+        let fitted: Vec<&Ranked> = tried.iter().chain(std::iter::once(cur)).filter(|t| !t.refit).collect();
         let f = |(a, b): &(&Ranked, &Ranked)| {
-            PAIR_START_SCALES
-                .iter()
-                .map(|&c| {
-                    let warm: Vec<f64> = a.params.iter().chain(&b.params).map(|v| c * v).collect();
-                    fit_hypothesis(
-                        ctx,
-                        plan,
-                        vec![a.parts[0].clone(), b.parts[0].clone()],
-                        None,
-                        Some(warm),
-                        &a.x0,
-                        self.bic_nom,
-                        self.val_sse_nom,
-                    )
+            pair_starts(a, b, &fitted)
+                .into_iter()
+                .map(|(parts, warm)| {
+                    fit_hypothesis(ctx, plan, parts, None, Some(warm), &a.x0, self.bic_nom, self.val_sse_nom)
                 })
                 .min_by(|x, y| x.bic.total_cmp(&y.bic))
                 .expect("at least one start")
@@ -316,9 +370,9 @@ impl Selector<'_, '_> {
         // The simpler form of a generalisation in the pair, where it does as well.
         for (i, h) in best.parts.clone().iter().enumerate() {
             let Some(simple) = h.kind.simpler_form() else { continue };
-            let mut labels = label_of(&best);
+            let mut labels = label_list(&best);
             labels[i] = simple.label();
-            let Some(si) = pairs.iter().position(|r| same_labels(&label_of(r), &labels)) else { continue };
+            let Some(si) = pairs.iter().position(|r| same_label_set(&label_list(r), &labels)) else { continue };
             let sse_s = cv_sse_of(ctx, plan, &pairs[si]);
             let cv = cross_validate(ctx, plan, &best, &pairs[si], &sse_s);
             if cv.status == "not_testable" || hypothesis::nested_supported(&cv.sse, &sse_s) {
@@ -337,6 +391,269 @@ impl Selector<'_, '_> {
             }
         }
         (Some(best), pairs)
+    }
+
+    /// Where a full model (`max_effects` effects) still leaves something after the pair search
+    /// (issue 27 item 4): each of its effects (in its simpler form, Coulomb friction for
+    /// Stribeck friction) paired with every single effect not paired with it yet, whatever that
+    /// single's own fit (a loop backlash beside Coulomb friction gains nothing alone: the
+    /// friction's misfit swamps it, and it never enters the pool of the pair search), fitted
+    /// from that effect's estimate (its part in `cur`, else its single's) with the new one at
+    /// its start grid; the best that clear the margin against `cur` cross-validated against it
+    /// until one passes.
+    fn swap_partner(
+        &self,
+        singles: &[Ranked],
+        fitted: &[Ranked],
+        cur: &Ranked,
+        cur_sse: &[f64],
+    ) -> (Option<Ranked>, Vec<Ranked>) {
+        let (ctx, plan) = (self.ctx, self.plan);
+        if cur.refit || cur.parts.len() < 2 {
+            return (None, vec![]);
+        }
+        let mut todo: Vec<(Vec<Hypothesis>, Vec<f64>)> = Vec::new();
+        for p in &cur.parts {
+            let kind = p.kind.simpler_form().unwrap_or(p.kind);
+            let own = if kind == p.kind {
+                part_params(cur, kind)
+            } else {
+                singles.iter().find(|r| r.parts.len() == 1 && r.parts[0].kind == kind).map(|r| r.params.clone())
+            };
+            let (Some(own), Some(h)) = (
+                own,
+                singles.iter().find(|r| r.parts.len() == 1 && r.parts[0].kind == kind).map(|r| r.parts[0].clone()),
+            ) else {
+                continue;
+            };
+            for x in singles.iter().filter(|r| r.parts.len() == 1 && !r.refit) {
+                let hx = &x.parts[0];
+                let labels = vec![h.kind.label(), hx.kind.label()];
+                let seen = singles
+                    .iter()
+                    .chain(fitted)
+                    .chain(std::iter::once(cur))
+                    .any(|t| !t.refit && same_label_set(&label_list(t), &labels))
+                    || todo
+                        .iter()
+                        .any(|(ps, _)| same_label_set(&ps.iter().map(|q| q.kind.label()).collect::<Vec<_>>(), &labels));
+                if rivals(h.kind, hx.kind) || seen {
+                    continue;
+                }
+                todo.push((vec![h.clone(), hx.clone()], own.clone()));
+            }
+        }
+        let f = |(parts, warm): &(Vec<Hypothesis>, Vec<f64>)| {
+            fit_hypothesis(ctx, plan, parts.clone(), None, Some(warm.clone()), &cur.x0, self.bic_nom, self.val_sse_nom)
+        };
+        let mut pairs: Vec<Ranked> =
+            if plan.parallel { todo.par_iter().map(f).collect() } else { todo.iter().map(f).collect() };
+        pairs.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+        let next = self.accept_combination(&mut pairs, cur, cur_sse);
+        (next, pairs)
+    }
+
+    /// The readings of the recording that decompose a generalisation in `cur` (issue 27 item 4):
+    /// each part with a simpler form (direction-dependent or Stribeck friction over Coulomb
+    /// friction) replaced by its simpler form, alone, and (within `max_effects`) beside each
+    /// of the best singles that is not a rival of the model's other parts (direction-dependent
+    /// friction reads as Coulomb friction plus a constant force); for a composite, also the
+    /// simpler form beside each best single in place of the other parts. Only readings not
+    /// fitted yet (`fitted` besides the singles) are fitted: each from the other parts'
+    /// estimates in `cur`, the new single's estimate where there is one, and the simpler form
+    /// at its start grid.
+    fn decompositions(&self, singles: &[Ranked], fitted: &[Ranked], cur: &Ranked) -> Vec<Ranked> {
+        let (ctx, plan) = (self.ctx, self.plan);
+        if cur.refit {
+            return vec![];
+        }
+        let known = |labels: &[String]| {
+            singles
+                .iter()
+                .chain(fitted)
+                .chain(std::iter::once(cur))
+                .any(|t| !t.refit && same_label_set(&label_list(t), labels))
+        };
+        let pool = self.pool(singles);
+        let mut todo: Vec<(Vec<Hypothesis>, Vec<f64>)> = Vec::new();
+        for (i, g) in cur.parts.iter().enumerate() {
+            let Some(simple) = g.kind.simpler_form() else { continue };
+            if cur.parts.iter().enumerate().any(|(j, h)| j != i && rivals(h.kind, simple)) {
+                continue;
+            }
+            let Some(hs) = singles.iter().find(|r| r.parts.len() == 1 && r.parts[0].kind == simple) else { continue };
+            let others: Vec<(Hypothesis, Vec<f64>)> = cur
+                .parts
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .filter_map(|(_, h)| Some((h.clone(), part_params(cur, h.kind)?)))
+                .collect();
+            let mut base: Vec<Hypothesis> = others.iter().map(|o| o.0.clone()).collect();
+            let warm: Vec<f64> = others.iter().flat_map(|o| o.1.clone()).collect();
+            base.push(hs.parts[0].clone());
+            let mut add = |parts: Vec<Hypothesis>, warm: Vec<f64>| {
+                let labels: Vec<String> = parts.iter().map(|h| h.kind.label()).collect();
+                let dup = todo
+                    .iter()
+                    .any(|(p, _)| same_label_set(&p.iter().map(|h| h.kind.label()).collect::<Vec<_>>(), &labels));
+                if !known(&labels) && !dup {
+                    todo.push((parts, warm));
+                }
+            };
+            // the simpler form alone in place of the generalisation
+            add(base.clone(), warm.clone());
+            // the simpler form beside each best single in place of the other parts (Coulomb
+            // friction and a constant force read as direction-dependent friction and an offset)
+            if cur.parts.len() >= 2 {
+                for x in &pool {
+                    if rivals(x.parts[0].kind, simple) {
+                        continue;
+                    }
+                    add(vec![x.parts[0].clone(), hs.parts[0].clone()], x.params.clone());
+                }
+            }
+            if base.len() >= plan.max_effects {
+                continue;
+            }
+            for x in &pool {
+                let hx = &x.parts[0];
+                if base.iter().any(|h| rivals(h.kind, hx.kind)) {
+                    continue;
+                }
+                // the new single from its own estimate, the simpler form at its start grid
+                let mut parts: Vec<Hypothesis> = base[..base.len() - 1].to_vec();
+                parts.push(hx.clone());
+                parts.push(hs.parts[0].clone());
+                add(parts, warm.iter().chain(&x.params).copied().collect());
+            }
+        }
+        let f = |(parts, warm): &(Vec<Hypothesis>, Vec<f64>)| {
+            fit_hypothesis(ctx, plan, parts.clone(), None, Some(warm.clone()), &cur.x0, self.bic_nom, self.val_sse_nom)
+        };
+        if plan.parallel {
+            todo.par_iter().map(f).collect()
+        } else {
+            todo.iter().map(f).collect()
+        }
+    }
+
+    /// A composite `cur` with a generalisation (direction-dependent or Stribeck friction) gives
+    /// way to a reading with its simpler form (Coulomb friction) in its place (fitted by
+    /// [`Self::decompositions`] or on the way, in `fitted`): the best such reading with no more
+    /// parameters that fits at least as well in BIC (Coulomb friction and a constant force
+    /// over direction-dependent friction and a sensor offset); else the same composite with
+    /// the simpler form where the held-out folds do not support the generalisation over it
+    /// ([`hypothesis::nested_supported`], the rule of the singles). The simpler reading must
+    /// pass its own cross-validation against the nominal model. Returned (marked accepted in
+    /// `fitted`, `cur` marked not) where it replaces `cur`.
+    fn simpler_reading(
+        &self,
+        fitted: &mut [Ranked],
+        cur: &Ranked,
+        nominal_ranked: &Ranked,
+        base_sse: &[f64],
+    ) -> Option<Ranked> {
+        let (ctx, plan) = (self.ctx, self.plan);
+        if cur.refit || cur.parts.len() < 2 {
+            return None;
+        }
+        let conclusive = |r: &Ranked| matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations);
+        for (i, g) in cur.parts.iter().enumerate() {
+            let Some(simple) = g.kind.simpler_form() else { continue };
+            let mut labels = label_list(cur);
+            labels[i] = simple.label();
+            let (gl, sl) = (g.kind.label(), simple.label());
+            let no_better = fitted
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| {
+                    let l = label_list(r);
+                    !r.refit
+                        && conclusive(r)
+                        && l.contains(&sl)
+                        && !l.contains(&gl)
+                        && r.params.len() <= cur.params.len()
+                        && r.bic <= cur.bic
+                })
+                .min_by(|a, b| a.1.bic.total_cmp(&b.1.bic))
+                .map(|(j, _)| j);
+            let same = fitted.iter().position(|r| !r.refit && conclusive(r) && same_label_set(&label_list(r), &labels));
+            let si = match (no_better, same) {
+                (Some(j), _) => j,
+                (None, Some(j)) => {
+                    let sse_s = cv_sse_of(ctx, plan, &fitted[j]);
+                    let cv = cross_validate(ctx, plan, cur, &fitted[j], &sse_s);
+                    if cv.status == "not_testable" || hypothesis::nested_supported(&cv.sse, &sse_s) {
+                        continue;
+                    }
+                    j
+                }
+                (None, None) => continue,
+            };
+            let cv0 = cross_validate(ctx, plan, &fitted[si], nominal_ranked, base_sse);
+            if cv0.status == "failed" {
+                continue;
+            }
+            for r in fitted.iter_mut().filter(|r| r.label == cur.label) {
+                r.beats_nominal = false;
+            }
+            fitted[si].beats_nominal = true;
+            fitted[si].cv = Some(cv0);
+            return Some(fitted[si].clone());
+        }
+        None
+    }
+
+    /// The readings among `fitted` that fit as well as `cur` ([`Equivalent`]): conclusive fits
+    /// that clear the margin against the nominal, of a different set of effects that neither
+    /// contains nor is contained in `cur`'s, their BIC within `tie_bic` of `cur`'s; the
+    /// singles already reported as tied with the selected single (`ties`) left out. Closest
+    /// first.
+    fn equivalents<'r>(
+        &self,
+        fitted: impl Iterator<Item = &'r Ranked>,
+        cur: &Ranked,
+        ties: &[String],
+    ) -> Vec<Equivalent> {
+        if cur.refit {
+            return vec![];
+        }
+        let mine = label_list(cur);
+        let mut out: Vec<Equivalent> = Vec::new();
+        for r in fitted {
+            let theirs = label_list(r);
+            let nested = theirs.iter().all(|l| mine.contains(l)) || mine.iter().all(|l| theirs.contains(l));
+            if r.refit
+                || r.parts.is_empty()
+                || nested
+                || ties.contains(&r.label)
+                || !matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations)
+                || self.bic_nom - r.bic < self.margin
+                || (r.bic - cur.bic).abs() >= self.plan.select.tie_bic
+                || out.iter().any(|e| same_label_set(&e.kinds_labels(), &theirs))
+            {
+                continue;
+            }
+            out.push(Equivalent { label: r.label.clone(), kinds: r.kinds.clone(), delta_bic: r.bic - cur.bic });
+        }
+        out.sort_by(|a, b| a.delta_bic.abs().total_cmp(&b.delta_bic.abs()));
+        out
+    }
+
+    /// The best singles ([`PAIR_POOL`]) that clear the margin against the nominal with a
+    /// conclusive fit: what pairs and decompositions are drawn from.
+    fn pool<'s>(&self, singles: &'s [Ranked]) -> Vec<&'s Ranked> {
+        singles
+            .iter()
+            .filter(|r| {
+                r.parts.len() == 1
+                    && !r.refit
+                    && self.bic_nom - r.bic >= self.margin
+                    && matches!(r.status, fit::FitStatus::Converged | fit::FitStatus::MaxIterations)
+            })
+            .take(PAIR_POOL)
+            .collect()
     }
 
     /// Cross-validates the best few combinations that clear the margin against `cur`, until
@@ -365,6 +682,67 @@ pub const PAIR_POOL: usize = 6;
 
 /// The pair search's starts: both singles' estimates times each of these.
 pub const PAIR_START_SCALES: [f64; 3] = [1.0, 0.6, 0.3];
+
+/// The starts of the joint fit of singles `a` and `b` (issue 27 item 4): `(parts, leading
+/// parameters)`, the parts not covered by the leading parameters at their own start grid.
+/// - both singles' estimates, times each of [`PAIR_START_SCALES`];
+/// - each effect's own estimate, the other effect at its start grid: from its single, and from
+///   every composite in `fitted` that contains its kind (a gap width fitted beside Stribeck
+///   friction is a better start for the gap beside Coulomb friction than the gap's single,
+///   which has absorbed the friction). Such a start puts that effect first (the pair's label
+///   then lists it first).
+fn pair_starts(a: &Ranked, b: &Ranked, fitted: &[&Ranked]) -> Vec<(Vec<Hypothesis>, Vec<f64>)> {
+    let (ha, hb) = (a.parts[0].clone(), b.parts[0].clone());
+    let mut out: Vec<(Vec<Hypothesis>, Vec<f64>)> = PAIR_START_SCALES
+        .iter()
+        .map(|&c| (vec![ha.clone(), hb.clone()], a.params.iter().chain(&b.params).map(|v| c * v).collect()))
+        .collect();
+    for (h, other, single) in [(&ha, &hb, a), (&hb, &ha, b)] {
+        let mut seen: Vec<Vec<f64>> = Vec::new();
+        let own = std::iter::once(single.params.clone())
+            .chain(fitted.iter().filter(|t| t.parts.len() > 1).filter_map(|t| part_params(t, h.kind)));
+        for w in own {
+            if w.len() != h.k() || !w.iter().all(|v| v.is_finite()) || seen.contains(&w) {
+                continue;
+            }
+            seen.push(w.clone());
+            out.push((vec![h.clone(), other.clone()], w));
+        }
+    }
+    out
+}
+
+/// Whether two lists of effect labels name the same effects (in any order).
+fn same_label_set(a: &[String], b: &[String]) -> bool {
+    let (mut a, mut b) = (a.to_vec(), b.to_vec());
+    a.sort();
+    b.sort();
+    a == b
+}
+
+/// The effect labels of a fitted model, in its order.
+fn label_list(r: &Ranked) -> Vec<String> {
+    r.parts.iter().map(|h| h.kind.label()).collect()
+}
+
+impl Equivalent {
+    /// Its effects' labels.
+    fn kinds_labels(&self) -> Vec<String> {
+        self.label.split(" + ").map(String::from).collect()
+    }
+}
+
+/// The parameters of the part of kind `kind` in the fitted model `r`, if it has one.
+fn part_params(r: &Ranked, kind: hypothesis::Kind) -> Option<Vec<f64>> {
+    let mut off = 0;
+    for h in &r.parts {
+        if h.kind == kind {
+            return r.params.get(off..off + h.k()).map(<[f64]>::to_vec);
+        }
+        off += h.k();
+    }
+    None
+}
 
 /// Two kinds that stand for the same physics (the same kind, or one the simpler form of the
 /// other, or two generalisations of one simpler form): not paired.

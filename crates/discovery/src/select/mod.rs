@@ -25,7 +25,7 @@ pub mod forward;
 pub use candidate::{CvResult, Ranked, NOMINAL_REFIT};
 pub use context::FitContext;
 pub use cross_validation::NOT_TESTABLE_SHARE;
-pub use forward::Selection;
+pub use forward::{Equivalent, Selection};
 
 use crate::fit::FitSettings;
 use serde::Serialize;
