@@ -17,6 +17,7 @@
 //! `/proc/self/stat`; every thread of the process counted): on a shared machine the CPU time
 //! is what survives the load, and the load average (`/proc/loadavg`) is printed beside the
 //! tables. Threads: each run goes through a local rayon pool of the stated size.
+use discovery::bench_gen::long_record::LongNoise;
 use discovery::bench_gen::{self, Profile};
 use discovery::{diagnose, DiagnoseSettings, InitialState, Recording, Report};
 use dynamics::extended::ExtendedModel;
@@ -118,46 +119,16 @@ fn case_settings(case: &bench_gen::Case) -> DiagnoseSettings {
     }
 }
 
-/// The recording of `benches/diagnose.rs` at `n` samples: coulomb_friction (seed 3, case 0)
-/// under a three-sine input, simulated at 8 sub-steps, 1 % deterministic pseudo-noise (a
-/// sawtooth of period 1000 samples: strongly coloured, so the selected model's residual is never
-/// white and the pair search of the forward selection always runs); `white`: Gaussian white
-/// noise of the same standard deviation instead (seeded).
+/// The recording of `benches/diagnose.rs` at `n` samples ([`bench_gen::long_record`]), with
+/// its sawtooth pseudo-noise.
 fn long_recording(n: usize) -> (model::System, Recording) {
     long_recording_with(n, false)
 }
 
+/// The same with white noise (`white`) or the sawtooth.
 fn long_recording_with(n: usize, white: bool) -> (model::System, Recording) {
-    let case = bench_gen::generate("coulomb_friction", 3, 0);
-    let sys = case.nominal.clone();
-    let dt = case.recording.dt;
-    let w: Vec<f64> = (0..n)
-        .map(|k| {
-            let t = k as f64 * dt;
-            0.6 * (0.31 * t).sin() + 0.3 * (0.97 * t + 1.0).sin() + 0.2 * (2.3 * t + 2.0).sin()
-        })
-        .collect();
-    let truth = case.truth.clone().into_iter().collect::<Vec<_>>();
-    let y = ExtendedModel::new(&sys, &truth, dt, 8).unwrap().simulate(&w, dt, sys.x0.as_slice()).y;
-    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-    let yr = y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min);
-    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(27);
-    let mut gauss = || {
-        use rand::Rng;
-        let u1: f64 = rng.random::<f64>().max(1e-300);
-        let u2: f64 = rng.random();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    };
-    let ys: Vec<Vec<f64>> = y
-        .iter()
-        .enumerate()
-        .map(|(k, v)| match white {
-            false => vec![v + 0.01 * yr * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)],
-            true => vec![v + 0.01 * yr / 12f64.sqrt() * gauss()],
-        })
-        .collect();
-    let rec = Recording::from_samples("long", &t, w.iter().map(|v| vec![*v]).collect(), ys, None);
-    (sys, rec)
+    let noise = if white { LongNoise::White } else { LongNoise::Sawtooth };
+    bench_gen::long_record::long_recording(n, noise)
 }
 
 /// One simulator run of the `simulator` section: name, model, effects, input, sample time,

@@ -164,6 +164,15 @@ fn print_rows(rows: &[&Row]) {
 /// A bound of the report: its value and whether it is verified.
 type Get = fn(&ThetaReport) -> (f64, bool);
 
+/// Every bound of the report with its verified flag, in the order of the tables.
+const BOUNDS: [(&str, Get); 5] = [
+    ("theta (paper)", |r| (r.theta, r.theta_verified)),
+    ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
+    ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
+    ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
+    ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
+];
+
 /// Table `title` by output dimension p: for each bound, how many are certified, the median
 /// bound / measured, the smallest ratio and the violations.
 fn print_by_p(title: &str, set: &[&Row], bounds: &[(&str, Get)]) {
@@ -228,13 +237,7 @@ fn main() {
     if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
         print_rows(&table_a);
     }
-    let bounds: [(&str, Get); 5] = [
-        ("theta (paper)", |r| (r.theta, r.theta_verified)),
-        ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
-        ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
-        ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
-        ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
-    ];
+    let bounds = BOUNDS;
     let summary = |title: &str, set: &[&Row]| {
         println!("{title}");
         println!();
@@ -634,13 +637,7 @@ fn near_main(want: usize, seed: u64, min_p: usize) {
     if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
         print_near_rows(&rows);
     }
-    let bounds: [(&str, Get); 5] = [
-        ("theta (paper)", |r| (r.theta, r.theta_verified)),
-        ("theta_star", |r| (r.theta_star, r.theta_star_verified)),
-        ("theta_profile", |r| (r.theta_profile, r.theta_profile_verified)),
-        ("theta_engaged", |r| (r.theta_engaged, r.theta_engaged_verified)),
-        ("theta_best", |r| (r.theta_best, r.theta_best_verified)),
-    ];
+    let bounds = BOUNDS;
     println!("| bound | certified (verified < 0) | median bound / measured | min | max | violations |");
     println!("|---|---|---|---|---|---|");
     for (name, get) in bounds {

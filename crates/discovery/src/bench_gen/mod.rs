@@ -26,6 +26,7 @@
 //! the noisy recording to a target drawn from [86, 94] %; measurement noise at 30 dB SNR.
 //! The classic profile draws exactly the random numbers it always did (old seeds reproduce);
 //! the digital profile's extra draws come from a second stream.
+pub mod long_record;
 pub mod plant_sim;
 pub mod servo_cascade;
 pub mod servo_loop;
