@@ -608,3 +608,20 @@ fn import_writes_only_models_that_validate_accepts() {
     assert_refused(&o, &["big.json", "bytes, more than the 16777216 a model file may have"]);
     assert!(!p.join("big.toml").exists());
 }
+
+/// Issue 31 item 5 (a coverage-guided fuzzing finding of the `simulate` target): the
+/// event-driven reference on a diverging 6-state plant whose ellipsoidal contact (p = 3)
+/// chatters ran for over a minute (the event limit was 10^7 whatever the run); it now stops at
+/// 10 events per step of the run with a one-line error naming the limit and the way out.
+#[test]
+fn a_chattering_event_driven_run_stops_at_its_event_budget() {
+    let d = workdir();
+    let f = put(d.path(), "chatter.toml", include_str!("../../../fuzz/regressions/simulate/event-driven-chatter-p3"));
+    let args = ["simulate", &f, "--periods", "1", "--dt", "0.2094", "--max-rows", "50", "--integrator", "event"];
+    let o = moreau_in(d.path(), &[&args[..], &["--out", "o"]].concat());
+    assert_refused(&o, &["more than 10000 events", "--integrator catching-up"]);
+    assert_only(d.path(), &["chatter.toml", "w.toml"]);
+    // control: the worked example is simulated by the same reference within its budget
+    let o = moreau_in(d.path(), &["simulate", "w.toml", "--periods", "2", "--integrator", "event", "--out", "ok"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

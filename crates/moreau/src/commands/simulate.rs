@@ -2,13 +2,23 @@
 //! extended-model simulator for models with effects) or the event-driven reference. Budgets
 //! (all in [`simulate`]): the step against the input ([`crate::budget::step`]), the
 //! integration steps ([`crate::budget::steps`]) and the stored samples, `t, w, x, y, z` per
-//! kept row ([`crate::budget::samples`]).
+//! kept row ([`crate::budget::samples`]), and for the event-driven reference the events
+//! ([`EVENTS_PER_STEP`] per integration step).
 use super::Source;
 use crate::budget::num;
 use anyhow::bail;
 use dynamics::integrators::event_driven::{event_driven, EventDrivenSettings};
 use dynamics::trajectory::{simulate_model, Trajectory};
+use dynamics::DynamicsError;
 use model::System;
+
+/// Events the event-driven reference may locate per integration step of the run (at least
+/// [`EVENTS_FLOOR_STEPS`] steps counted): a contact that chatters (a smooth set grazed again and
+/// again, a diverging state) stops with "too many events" instead of running for minutes; each
+/// event costs a bisection of some 40 flows.
+pub const EVENTS_PER_STEP: usize = 10;
+/// See [`EVENTS_PER_STEP`].
+pub const EVENTS_FLOOR_STEPS: usize = 1000;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Integrator {
@@ -127,14 +137,20 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
             effects.join(", ")
         ),
         Integrator::Event => {
-            let (tr, events) = event_driven(
-                &sys,
-                &EventDrivenSettings {
-                    dt_out: h * every as f64,
-                    t_end: (steps / every) as f64 * every as f64 * h,
-                    ..Default::default()
-                },
-            )?;
+            let max_events = EVENTS_PER_STEP * steps.max(EVENTS_FLOOR_STEPS);
+            let settings = EventDrivenSettings {
+                dt_out: h * every as f64,
+                t_end: (steps / every) as f64 * every as f64 * h,
+                max_events,
+                ..Default::default()
+            };
+            let (tr, events) = event_driven(&sys, &settings).map_err(|e| match e {
+                DynamicsError::TooManyEvents { t, .. } => anyhow::anyhow!(
+                    "event-driven reference: more than {max_events} events before t = {} ({EVENTS_PER_STEP} per step of the run): the contact chatters or the state diverges; use --integrator catching-up",
+                    num(t)
+                ),
+                e => e.into(),
+            })?;
             (tr, format!("event-driven, {events} events"))
         }
     };
