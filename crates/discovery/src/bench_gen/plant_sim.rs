@@ -69,21 +69,27 @@ pub fn simulate_converged(
     zoh: bool,
     tol: f64,
 ) -> (Vec<f64>, usize) {
+    let at = |fine: usize| simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
     let mut fine = FINE;
-    let mut y = simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
+    let mut y = at(fine);
     if !first_order(hw, effs) {
         return (y, fine);
     }
     while fine < FINE_MAX {
         fine *= 2;
-        let finer = simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
-        let change = (finer.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / ns.max(1) as f64).sqrt();
+        let finer = at(fine);
+        let change = rms_difference(&finer, &y);
         y = finer;
         if change <= tol {
             break;
         }
     }
     (y, fine)
+}
+
+/// RMS over the samples of `a - b`.
+fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
+    (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len().max(1) as f64).sqrt()
 }
 
 /// Whether the truth has an update that [`simulate_fine`] steps to first order.
@@ -274,10 +280,6 @@ mod tests {
         (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / y.len().max(1) as f64).sqrt()
     }
 
-    fn rms_diff(a: &[f64], b: &[f64]) -> f64 {
-        (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
-    }
-
     /// The converged truth moves by less than its tolerance when the step is halved once more;
     /// negative control: the 20-per-sample grid the generator used before is off by far more
     /// (the friction's first-order update), so the check can fail.
@@ -292,10 +294,10 @@ mod tests {
         let (y, fine) = simulate_converged(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, tol);
         assert!(fine > FINE && fine < FINE_MAX, "doubled to {fine}");
         let halved = simulate_fine(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, 2 * fine);
-        let change = rms_diff(&y, &halved);
+        let change = rms_difference(&y, &halved);
         assert!(change <= tol, "halving moves y by {change:e} > {tol:e}");
         let coarse = simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false);
-        let off = rms_diff(&coarse, &y);
+        let off = rms_difference(&coarse, &y);
         assert!(off > 3.0 * tol, "20 per sample is already converged? {off:e} against {tol:e}");
     }
 

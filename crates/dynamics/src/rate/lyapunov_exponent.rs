@@ -199,19 +199,13 @@ pub fn measure_rate(
     if !settings.step_check {
         return Ok(coarse);
     }
-    let at = |dt: f64| measure_once(sys, &RateSettings { dt, step_check: false, ..settings.clone() }, start);
-    let half = at(0.5 * coarse.h)?;
-    let mut fine = at(0.25 * coarse.h)?;
-    let thin = measure_once(
-        sys,
-        &RateSettings {
-            dt: 0.25 * coarse.h,
-            separation: settings.separation / SEPARATION_CHECK,
-            step_check: false,
-            ..settings.clone()
-        },
-        start,
-    )?;
+    let at = |dt: f64, separation: f64| {
+        measure_once(sys, &RateSettings { dt, separation, step_check: false, ..settings.clone() }, start)
+    };
+    let s = settings.separation;
+    let half = at(0.5 * coarse.h, s)?;
+    let mut fine = at(0.25 * coarse.h, s)?;
+    let thin = at(0.25 * coarse.h, s / SEPARATION_CHECK)?;
     // the catching-up step's error is first order but erratic (it depends on where the switches
     // fall between steps): the larger change from the two coarser steps bounds the finest's
     let change = |e: &dyn Fn(&MeasuredRate) -> Option<f64>, others: &[&MeasuredRate]| -> f64 {
