@@ -1,5 +1,5 @@
 //! Runs a few benchmark cases and prints each result (development aid).
-//! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital]
+//! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital|mixed]
 //! [CLASSES]`, `CLASSES` one of `classic` (default: the original 9 classes), `friction`
 //! (none, coulomb_friction and the friction library), `all`, or a comma-separated list.
 fn main() {
@@ -8,7 +8,7 @@ fn main() {
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let profile = args
         .get(3)
-        .map(|s| discovery::bench_gen::Profile::parse(s).expect("profile: classic or digital"))
+        .map(|s| discovery::bench_gen::Profile::parse(s).expect("profile: classic, digital or mixed"))
         .unwrap_or(discovery::bench_gen::Profile::Classic);
     let classes = discovery::bench::class_set(args.get(4).map_or("classic", |s| s.as_str()))
         .expect("classes: classic, friction, all or a comma-separated list of class names");

@@ -1,6 +1,6 @@
 //! Runs cases with two concealed effects at once and prints each result (issue 27 item 4;
 //! development aid and the source of the BENCHMARKS.md table).
-//! Usage: `cargo run --release -p discovery --example bench_pairs CASES SEED [classic|digital]
+//! Usage: `cargo run --release -p discovery --example bench_pairs CASES SEED [classic|digital|mixed]
 //! [PAIRS]`, `PAIRS` `all` (default: every pair of `bench_gen::pairs`) or a comma-separated
 //! list of `a+b`.
 //!
@@ -15,7 +15,7 @@ fn main() {
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let profile = args
         .get(3)
-        .map(|s| bench_gen::Profile::parse(s).expect("profile: classic or digital"))
+        .map(|s| bench_gen::Profile::parse(s).expect("profile: classic, digital or mixed"))
         .unwrap_or(bench_gen::Profile::Classic);
     let all = bench_gen::pairs();
     let pairs: Vec<[&'static str; 2]> = match args.get(4).map(|s| s.as_str()) {

@@ -1,6 +1,6 @@
 //! Development aid: one benchmark case, its ranking, and a profile of the estimation cost
 //! along the true effect's main parameter (initial state refitted at each point).
-//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital] [profile]`.
+//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`.
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
@@ -11,7 +11,7 @@ fn main() {
     let a: Vec<String> = std::env::args().collect();
     if a.len() < 4 {
         eprintln!(
-            "usage: cargo run --release -p discovery --example probe CLASS SEED INDEX [classic|digital] [profile]"
+            "usage: cargo run --release -p discovery --example probe CLASS SEED INDEX [classic|digital|mixed] [profile]"
         );
         std::process::exit(2);
     }

@@ -179,7 +179,7 @@ fn parse_args() -> Args {
                     .next()
                     .expect("--profiles classic,digital")
                     .split(',')
-                    .map(|p| Profile::parse(p).expect("profile: classic or digital"))
+                    .map(|p| Profile::parse(p).expect("profile: classic, digital or mixed"))
                     .collect()
             }
             s if !s.starts_with("--") => a.sections = s.split(',').map(String::from).collect(),

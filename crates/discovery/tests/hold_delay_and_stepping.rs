@@ -35,40 +35,46 @@ fn oscillator() -> (Plant, model::System) {
 
 #[test]
 fn the_generator_integrates_a_delayed_held_input_exactly() {
-    // The benchmark's truth for a delay under a zero-order hold: the held input switches at
-    // k h + tau, between the generator's fine grid points. Reference: the exact ZOH
-    // discretisation with the delay split at the switching instant (dynamics::extended, exact
-    // to rounding, tests/hold_and_discretisation.rs).
+    // The benchmark's truth for a delay under a zero- or first-order hold: the held input
+    // switches (or bends) at k h + tau, between the generator's fine grid points. Reference:
+    // the exact discretisation under that hold with the delay split at that instant
+    // (dynamics::extended, exact to rounding, tests/hold_and_discretisation.rs).
     let (pl, sys) = oscillator();
     let sig = Signal::Multisine { a: vec![1.0, 0.4, 0.2], omega: vec![1.3, 4.1, 9.7], phi: vec![0.0, 1.0, 2.0] };
     let dt = 0.01;
     let ns = 1500;
     let w: Vec<f64> = (0..ns).map(|k| sig.eval(k as f64 * dt)).collect();
-    let y_range = {
-        let y = ExtendedModel::new(&sys, &[], dt, 1).unwrap().with_hold(InputHold::Zoh).simulate(&w, dt, &[0.0, 0.0]).y;
-        y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min)
-    };
-    for frac in [0.013, 0.37, 0.61] {
-        let delay = (3.0 + frac) * dt;
-        let eff = Effect::InputDelay { delay };
-        let gen = plant_sim::simulate(&pl, 0.0, Some(&eff), &sig, &[0.0, 0.0], dt, ns, true);
-        let exact = ExtendedModel::new(&sys, &[eff.clone()], dt, 1)
-            .unwrap()
-            .with_hold(InputHold::Zoh)
-            .simulate(&w, dt, &[0.0, 0.0])
-            .y;
-        let d = max_abs_diff(&gen, &exact) / y_range;
-        // RK2 on a grid of h/20 with the switching instant on the grid: O((omega h/20)^2).
-        assert!(d < 2e-5, "delay {frac} h into the sample: generator off the exact response by {d:.2e} of the range");
-        // Negative control: the same delay off by a quarter of the generator's fine step
-        // (before, the switching instant was rounded to that grid: up to half a step off) is
-        // visibly another response.
-        let off = Effect::InputDelay { delay: delay + 0.25 * dt / 20.0 };
-        let yr =
-            ExtendedModel::new(&sys, &[off], dt, 1).unwrap().with_hold(InputHold::Zoh).simulate(&w, dt, &[0.0, 0.0]).y;
-        let dr = max_abs_diff(&yr, &exact) / y_range;
-        eprintln!("delay {frac}: generator {d:.2e}, shifted {dr:.2e}");
-        assert!(dr > 10.0 * d, "a delay off by h/80 went unnoticed: {dr:.2e} against {d:.2e}");
+    for hold in [InputHold::Zoh, InputHold::Foh] {
+        let exact_at = |eff: &Effect| {
+            ExtendedModel::new(&sys, std::slice::from_ref(eff), dt, 1)
+                .unwrap()
+                .with_hold(hold)
+                .simulate(&w, dt, &[0.0, 0.0])
+                .y
+        };
+        let y_range = {
+            let y = ExtendedModel::new(&sys, &[], dt, 1).unwrap().with_hold(hold).simulate(&w, dt, &[0.0, 0.0]).y;
+            y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        for frac in [0.013, 0.37, 0.61] {
+            let delay = (3.0 + frac) * dt;
+            let eff = Effect::InputDelay { delay };
+            let gen =
+                plant_sim::simulate(&pl, 0.0, Some(&eff), &sig, &[0.0, 0.0], dt, ns, plant_sim::Drive::Held(hold));
+            let exact = exact_at(&eff);
+            let d = max_abs_diff(&gen, &exact) / y_range;
+            // RK2 on a grid of h/20 with the switching instant on the grid: O((omega h/20)^2).
+            assert!(
+                d < 2e-5,
+                "{hold:?}, delay {frac} h into the sample: generator off the exact response by {d:.2e} of the range"
+            );
+            // Negative control: the same delay off by a quarter of the generator's fine step
+            // (before, the switching instant was rounded to that grid: up to half a step off) is
+            // visibly another response.
+            let dr = max_abs_diff(&exact_at(&Effect::InputDelay { delay: delay + 0.25 * dt / 20.0 }), &exact) / y_range;
+            eprintln!("{hold:?}, delay {frac}: generator {d:.2e}, shifted {dr:.2e}");
+            assert!(dr > 10.0 * d, "{hold:?}: a delay off by h/80 went unnoticed: {dr:.2e} against {d:.2e}");
+        }
     }
 }
 
@@ -103,6 +109,21 @@ fn a_delay_under_an_unknown_hold_is_covered_by_its_interval() {
         // The interval covers the other reading too.
         assert!((other - e).abs() <= 2.0 * sd, "other reading {other:.4e} outside {e:.4e} +- 2 x {sd:.2e}");
     }
+}
+
+#[test]
+fn a_delay_under_half_a_sample_is_found_under_the_other_hold() {
+    // Seed 9302 case 3 of the mixed profile: a linearly interpolated (first-order-held)
+    // command sampled at 1.85 ms, delayed by 0.66 ms (a third of a sample). The nominal prefers
+    // the zero-order hold by 632 in BIC (it acts as a delay of h/2 = 0.93 ms), under which the
+    // delay would be negative. Before, the second look at the hold refitted only the three
+    // leading singles under the other hold, the delay was not among them, and the recording
+    // was read as direction-dependent friction + cogging.
+    let r = bench::run_case_with("input_delay", 9302, 3, Profile::Mixed, &DiagnoseSettings::default());
+    assert_eq!(r.predicted, "input_delay", "{r:?}");
+    assert_eq!(r.hold_used, "foh", "{r:?}");
+    let (e, t, sd) = (r.est_param.unwrap(), r.true_param.unwrap(), r.est_std.unwrap());
+    assert!((e - t).abs() <= 2.0 * sd, "delay {e:.4e} +- {sd:.2e} against the truth {t:.4e}");
 }
 
 #[test]

@@ -18,7 +18,11 @@
 //!   [1, 10] ms, 30-100 samples per natural period (so `omega0 = 2 pi / (N dt)`), half the
 //!   plants lightly damped (damping ratio in [0.03, 0.1]), the recorded command held constant
 //!   over each sample (zero-order hold) as the plant sees it, and the measurement noise white
-//!   or AR(1)-coloured (`rho` in [0.5, 0.9], half the cases each).
+//!   or AR(1)-coloured (`rho` in [0.5, 0.9], half the cases each);
+//! - `mixed` (every convention of issue 27's acceptance at once): as `digital`, with the sample
+//!   period log-uniform in [0.5, 20] ms and the plant driven, a third of the cases each, by the
+//!   continuous signal, its zero-order-held or its linearly interpolated (first-order-held)
+//!   samples ([`plant_sim::Drive`]).
 //!
 //! Both: input a multisine, low-pass filtered noise or a sequence of sine segments, at least
 //! 10 slowest time constants and 25 natural periods (at most 80). The effect's magnitude is
@@ -35,6 +39,7 @@ use crate::recording::Recording;
 use model::effects::{names, Effect, PlayLocation};
 use model::{Input, SimDefaults, System};
 use nalgebra::{DMatrix, DVector};
+use plant_sim::{Drive, InputHold};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::{PI, TAU};
@@ -93,6 +98,7 @@ struct FrictionShape {
 pub enum Profile {
     Classic,
     Digital,
+    Mixed,
 }
 
 impl Profile {
@@ -100,13 +106,15 @@ impl Profile {
         match self {
             Profile::Classic => "classic",
             Profile::Digital => "digital",
+            Profile::Mixed => "mixed",
         }
     }
-    /// From its name (`classic` or `digital`).
+    /// From its name (`classic`, `digital` or `mixed`).
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "classic" => Some(Profile::Classic),
             "digital" => Some(Profile::Digital),
+            "mixed" => Some(Profile::Mixed),
             _ => None,
         }
     }
@@ -125,7 +133,7 @@ pub fn converged_truth() -> bool {
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Conditions {
     pub profile: Profile,
-    /// `continuous` (the plant sees the continuous signal) or `zoh` (held samples).
+    /// What the plant sees of the command: `continuous`, `zoh` or `foh` ([`plant_sim::Drive`]).
     pub hold: &'static str,
     /// Sample period (s).
     pub dt: f64,
@@ -351,17 +359,40 @@ impl FrictionShape {
     }
 }
 
-/// The digital profile's own draws (a second stream: the classic stream is untouched): the
-/// sample period, the natural frequency and damping that replace the plant's, and the AR(1)
-/// coefficient of the noise.
-fn digital_draws(mix: u64) -> (Option<f64>, Option<(f64, f64)>, f64) {
+/// The sampling of a case: its period (`None`: 60 samples per natural period), the natural
+/// frequency and damping that replace the plant's, what the plant sees of the command, and the
+/// AR(1) coefficient of the noise (0 = white).
+struct Sampling {
+    dt: Option<f64>,
+    over: Option<(f64, f64)>,
+    drive: Drive,
+    noise_rho: f64,
+}
+
+/// The sampling of `profile`. The digital and mixed profiles draw from a second stream (the
+/// classic stream is untouched; the mixed profile's drive from a third, so that its other draws
+/// are the digital profile's with the wider range of sample periods).
+fn sampling(profile: Profile, mix: u64) -> Sampling {
+    let (lo, hi) = match profile {
+        Profile::Classic => return Sampling { dt: None, over: None, drive: Drive::Continuous, noise_rho: 0.0 },
+        Profile::Digital => (1e-3f64, 1e-2f64),
+        Profile::Mixed => (5e-4f64, 2e-2f64),
+    };
     let mut rd = ChaCha8Rng::seed_from_u64(mix ^ 0xD161_7A1D_0000_0001);
-    let dt = (rd.random_range(1e-3f64.ln()..1e-2f64.ln())).exp();
+    let dt = (rd.random_range(lo.ln()..hi.ln())).exp();
     let spp: f64 = rd.random_range(30.0..100.0);
     let light = rd.random::<bool>();
     let zeta = if light { rd.random_range(0.03..0.1) } else { rd.random_range(0.1..0.7) };
-    let rho = if rd.random::<bool>() { rd.random_range(0.5..0.9) } else { 0.0 };
-    (Some(dt), Some((TAU / (spp * dt), zeta)), rho)
+    let noise_rho = if rd.random::<bool>() { rd.random_range(0.5..0.9) } else { 0.0 };
+    let drive = match profile {
+        Profile::Mixed => match ChaCha8Rng::seed_from_u64(mix ^ 0xD41F_E000_0000_0003).random_range(0..3) {
+            0 => Drive::Continuous,
+            1 => Drive::Held(InputHold::Zoh),
+            _ => Drive::Held(InputHold::Foh),
+        },
+        _ => Drive::Held(InputHold::Zoh),
+    };
+    Sampling { dt: Some(dt), over: Some((TAU / (spp * dt), zeta)), drive, noise_rho }
 }
 
 /// `ns` samples of measurement noise of standard deviation `std`: white, or AR(1) with
@@ -470,8 +501,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     let has = |c: &str| classes.contains(&c);
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
     let mut fshape = FrictionShape::draw(mix);
-    let digital = profile == Profile::Digital;
-    let (dig_dt, over, noise_rho) = if digital { digital_draws(mix) } else { (None, None, 0.0) };
+    let Sampling { dt: dig_dt, over, drive, noise_rho } = sampling(profile, mix);
     let n = rng.random_range(2..=4);
     let plant = random_plant(&mut rng, n, over);
     let tau_slow = {
@@ -481,7 +511,6 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     };
     let period = TAU / plant.omega0;
     let dt = dig_dt.unwrap_or(period / 60.0);
-    let zoh = digital;
     let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period);
     let ns = (duration / dt) as usize + 1;
     let (signal, sig_name) = random_signal(&mut rng, plant.omega0, duration);
@@ -500,7 +529,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
     let target: f64 = rng.random_range(86.0..94.0);
     let hw_nom = if nominal_has_play { plant.half_width } else { 0.0 };
-    let clean_nom = plant_sim::simulate(&plant, hw_nom, None, &signal, &x0, dt, ns, zoh);
+    let clean_nom = plant_sim::simulate(&plant, hw_nom, None, &signal, &x0, dt, ns, drive);
     let ystd = {
         let m = clean_nom.iter().sum::<f64>() / ns as f64;
         (clean_nom.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ns as f64).sqrt()
@@ -514,7 +543,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let noise = measurement_noise(&mut rng, ns, noise_std, noise_rho);
     let measure_all = |effs: &[&Effect]| -> Vec<f64> {
-        plant_sim::simulate_effects(&plant, hw_nom, effs, &signal, &x0, dt, ns, zoh)
+        plant_sim::simulate_effects(&plant, hw_nom, effs, &signal, &x0, dt, ns, drive)
             .iter()
             .zip(&noise)
             .map(|(a, b)| a + b)
@@ -545,7 +574,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
         // The magnitudes above were set on the 20-per-sample grid; the recording's truth is
         // converged to a tenth of a sigma of any fitted parameter (white-noise count of samples).
         let tol = 0.1 * noise_std / (ns as f64).sqrt();
-        let (clean, _) = plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, zoh, tol);
+        let (clean, _) = plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive, tol);
         clean.iter().zip(&noise).map(|(a, b)| a + b).collect()
     } else {
         measure_all(&effs)
@@ -578,14 +607,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
         y.iter().map(|v| vec![*v]).collect(),
         None,
     );
-    let conditions = Conditions {
-        profile,
-        hold: if zoh { "zoh" } else { "continuous" },
-        dt,
-        noise_rho,
-        omega0: plant.omega0,
-        zeta: plant.zeta,
-    };
+    let conditions = Conditions { profile, hold: drive.name(), dt, noise_rho, omega0: plant.omega0, zeta: plant.zeta };
     let description = format!(
         "n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, {}, nominal fit {nominal_fit:.1} %",
         plant.omega0,

@@ -6,8 +6,29 @@
 //! from rest or through a reversal, the Stribeck level at the old speed while sliding, levels
 //! per direction; cogging as a force in the derivative, evaluated at the RK2 stages),
 //! backlash inertia by semi-implicit Euler, input effects on the continuous signal or on its
-//! zero-order-held samples.
+//! held samples ([`Drive`]).
 use super::{Plant, Signal};
+pub use dynamics::extended::InputHold;
+
+/// What the plant sees of the command between the recording's samples `w(k dt)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Drive {
+    /// The continuous signal itself (the recording samples it).
+    Continuous,
+    /// The samples through a hold: `Zoh` held until the next sample (a digital controller's
+    /// command), `Foh` linearly interpolated between samples.
+    Held(InputHold),
+}
+
+impl Drive {
+    /// `continuous`, `zoh` or `foh` (the benchmark's conditions).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Drive::Continuous => "continuous",
+            Drive::Held(h) => h.name(),
+        }
+    }
+}
 use model::effects::{Effect, PlayLocation};
 
 /// Fine steps per sample of [`simulate_effects`] (enough for RK2 on the linear part).
@@ -16,9 +37,8 @@ const FINE: usize = 20;
 const FINE_MAX: usize = 2560;
 
 /// Simulates the plant (play half-width `hw`, 0 = none) with at most one effect and returns
-/// `y` at the `ns` sample times `k dt`. With `zoh`, the plant sees the input sampled at `k dt`
-/// and held constant until the next sample (a digital controller's command), delayed as a
-/// whole by an `input_delay`; otherwise it sees the continuous signal.
+/// `y` at the `ns` sample times `k dt`. The plant sees the input through `drive` (held samples
+/// are delayed as a whole by an `input_delay`).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     pl: &Plant,
@@ -28,9 +48,9 @@ pub fn simulate(
     x0: &[f64],
     dt: f64,
     ns: usize,
-    zoh: bool,
+    drive: Drive,
 ) -> Vec<f64> {
-    simulate_effects(pl, hw, eff.as_slice(), sig, x0, dt, ns, zoh)
+    simulate_effects(pl, hw, eff.as_slice(), sig, x0, dt, ns, drive)
 }
 
 /// [`simulate`] with every effect of `effs` at once (two concealed effects, issue 27 item 4):
@@ -45,9 +65,9 @@ pub fn simulate_effects(
     x0: &[f64],
     dt: f64,
     ns: usize,
-    zoh: bool,
+    drive: Drive,
 ) -> Vec<f64> {
-    simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, FINE)
+    simulate_fine(pl, hw, effs, sig, x0, dt, ns, drive, FINE)
 }
 
 /// [`simulate_effects`] with its truth converged: the play, the friction laws and backlash
@@ -66,10 +86,10 @@ pub fn simulate_converged(
     x0: &[f64],
     dt: f64,
     ns: usize,
-    zoh: bool,
+    drive: Drive,
     tol: f64,
 ) -> (Vec<f64>, usize) {
-    let at = |fine: usize| simulate_fine(pl, hw, effs, sig, x0, dt, ns, zoh, fine);
+    let at = |fine: usize| simulate_fine(pl, hw, effs, sig, x0, dt, ns, drive, fine);
     let mut fine = FINE;
     let mut y = at(fine);
     if !first_order(hw, effs) {
@@ -117,7 +137,7 @@ fn simulate_fine(
     x0: &[f64],
     dt: f64,
     ns: usize,
-    zoh: bool,
+    drive: Drive,
     fine: usize,
 ) -> Vec<f64> {
     let n = pl.A.nrows();
@@ -155,9 +175,21 @@ fn simulate_fine(
     let input = |t: f64| {
         let s = t - delay;
         // Held: the sample at or before `s` (a hair of tolerance so that the fine grid's
-        // sample instants, which are exact multiples up to rounding, pick their own sample).
-        let s = if zoh { dt * (s / dt + 1e-9).floor() } else { s };
-        sig.eval(s).clamp(-sat, sat)
+        // sample instants, which are exact multiples up to rounding, pick their own sample);
+        // linear: between that sample and the next.
+        let held = |s: f64| {
+            let k = (s / dt + 1e-9).floor();
+            (k * dt, (s / dt - k).clamp(0.0, 1.0))
+        };
+        let w = match drive {
+            Drive::Continuous => sig.eval(s),
+            Drive::Held(InputHold::Zoh) => sig.eval(held(s).0),
+            Drive::Held(InputHold::Foh) => {
+                let (tk, f) = held(s);
+                (1.0 - f) * sig.eval(tk) + f * sig.eval(tk + dt)
+            }
+        };
+        w.clamp(-sat, sat)
     };
     let cy = |x: &[f64]| (0..n).map(|j| pl.C[(0, j)] * x[j]).sum::<f64>();
     let deriv = |x: &[f64], w: f64, z: f64, out: &mut [f64]| {
@@ -184,7 +216,9 @@ fn simulate_fine(
         // constant input on every piece: the delay is integrated exactly, not rounded to h).
         let t_k = k as f64 * dt;
         let mut pieces: Vec<(f64, f64)> = (0..fine).map(|jf| (t_k + jf as f64 * h, h)).collect();
-        let split = zoh && delay > 0.0;
+        // (A delayed linear hold has a kink there: split too, so each piece sees a line.)
+        let split = drive != Drive::Continuous && delay > 0.0;
+        let zoh = drive == Drive::Held(InputHold::Zoh);
         if split {
             let off = (delay / dt).fract() * dt;
             let j = ((off / h).floor() as usize).min(fine - 1);
@@ -196,7 +230,7 @@ fn simulate_fine(
         }
         for (t, h) in pieces {
             // Held and delayed: the input is constant on each piece (its midpoint's value).
-            let u1 = if split { input(t + 0.5 * h) } else { input(t) };
+            let u1 = if split && zoh { input(t + 0.5 * h) } else { input(t) };
             deriv(&x, u1, z, &mut k1);
             for i in 0..n {
                 xm[i] = x[i] + 0.5 * h * k1[i];
@@ -289,14 +323,16 @@ mod tests {
         let (dt, ns) = (0.05, 1500);
         let x0 = [0.1, 0.0];
         // the generator's tolerance at 30 dB SNR
-        let tol = 0.1 * rms_spread(&simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false)) * 10f64.powf(-1.5)
+        let tol = 0.1
+            * rms_spread(&simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, Drive::Continuous))
+            * 10f64.powf(-1.5)
             / (ns as f64).sqrt();
-        let (y, fine) = simulate_converged(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, tol);
+        let (y, fine) = simulate_converged(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, Drive::Continuous, tol);
         assert!(fine > FINE && fine < FINE_MAX, "doubled to {fine}");
-        let halved = simulate_fine(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false, 2 * fine);
+        let halved = simulate_fine(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, Drive::Continuous, 2 * fine);
         let change = rms_difference(&y, &halved);
         assert!(change <= tol, "halving moves y by {change:e} > {tol:e}");
-        let coarse = simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, false);
+        let coarse = simulate_effects(&pl, 0.2, &[&fric], &sig, &x0, dt, ns, Drive::Continuous);
         let off = rms_difference(&coarse, &y);
         assert!(off > 3.0 * tol, "20 per sample is already converged? {off:e} against {tol:e}");
     }
@@ -305,7 +341,7 @@ mod tests {
     #[test]
     fn a_smooth_truth_is_not_refined() {
         let (pl, sig, _) = case();
-        let (_, fine) = simulate_converged(&pl, 0.0, &[], &sig, &[0.1, 0.0], 0.02, 500, false, 1e-12);
+        let (_, fine) = simulate_converged(&pl, 0.0, &[], &sig, &[0.1, 0.0], 0.02, 500, Drive::Continuous, 1e-12);
         assert_eq!(fine, FINE);
     }
 }

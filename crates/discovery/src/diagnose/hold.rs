@@ -92,7 +92,8 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
 /// Auto hold: do the best effects confirm the nominal's choice `hold`? The nominal's
 /// preference can be an artefact of the missing effect. The best few singles (clearing the
 /// BIC `margin`) are asked (a flexible wrong effect, e.g. a cogging force, can rank first under
-/// the wrong hold and fit no better under the other). Asked once per diagnosis (until
+/// the wrong hold and fit no better under the other), and the input delay wherever it ranks
+/// (started h/2 later or earlier). Asked once per diagnosis (until
 /// `report.effect_delta_bic` is set), only where the nominal residual is not adequate.
 ///
 /// Returns the other hold and the note that explains the switch where one of them fits better
@@ -115,12 +116,21 @@ pub(super) fn overturned_by_effects(
     // Another hold must beat the best single of this one (not only the effect's own fit).
     let best_bic = singles.first().map_or(f64::INFINITY, |b| b.bic);
     let bic_nom = candidate::nominal_scores(ctx, nom).0;
-    let leading = singles.iter().filter(|c| bic_nom - c.bic >= margin).take(3);
-    for (i, c) in leading.enumerate() {
-        let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
+    let mut leading: Vec<&Ranked> = singles.iter().filter(|c| bic_nom - c.bic >= margin).take(3).collect();
+    // The input delay too, wherever it ranks: hold and delay trade off, so under this hold a
+    // delay that the other hold reads as tau may need a negative one (a first-order-held
+    // input delayed by less than h/2 read under a zero-order hold) and rank nowhere.
+    if let Some(d) = singles.iter().find(|c| !delay_offsets(c).is_empty()) {
+        if !leading.iter().any(|c| std::ptr::eq(*c, d)) {
+            leading.push(d);
+        }
+    }
+    let other = other_hold(hold);
+    for (i, c) in leading.into_iter().enumerate() {
         let ctx_o = data.context(other, ctx.substeps, data.x_scale.clone());
         let fo = fit::FitSettings { max_iter: 10, ..s.fit.clone() };
-        let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&c.params), &fo);
+        let start = delay_shifted_start(c, hold, data.dt);
+        let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&start), &fo);
         let d = select::bic(c.sse_estimation, n_res, 0) - select::bic(r_o.sse, n_res, 0) - (c.bic - best_bic);
         if i == 0 {
             report.effect_delta_bic = Some(d);
@@ -170,6 +180,27 @@ pub(super) fn note(report: &HoldReport, hold: InputHold, tie_bic: f64) -> Option
     }
 }
 
+/// The hold that is not `hold`.
+fn other_hold(hold: InputHold) -> InputHold {
+    if hold == InputHold::Zoh {
+        InputHold::Foh
+    } else {
+        InputHold::Zoh
+    }
+}
+
+/// The parameters of `c` (fitted under `hold`) as a start under the other hold: its delays
+/// moved by the h/2 that a zero-order hold adds to a first-order one (`+h/2` from zoh to foh),
+/// not below 0.
+fn delay_shifted_start(c: &Ranked, hold: InputHold, dt: f64) -> Vec<f64> {
+    let shift = if hold == InputHold::Zoh { 0.5 * dt } else { -0.5 * dt };
+    let mut start = c.params.clone();
+    for i in delay_offsets(c) {
+        start[i] = (start[i] + shift).max(0.0);
+    }
+    start
+}
+
 /// Offsets of the delay parameters of `c` (a delay of the input as a whole or of one input).
 fn delay_offsets(c: &Ranked) -> Vec<usize> {
     let mut off = 0;
@@ -206,13 +237,9 @@ pub(super) fn delay_under_both_holds(
     if at.is_empty() {
         return None;
     }
-    let other = if hold == InputHold::Zoh { InputHold::Foh } else { InputHold::Zoh };
-    let shift = if hold == InputHold::Zoh { 0.5 * data.dt } else { -0.5 * data.dt };
+    let other = other_hold(hold);
     let ctx_o = data.context(other, ctx.substeps, ctx.x_scale.clone());
-    let mut start = c.params.clone();
-    for &i in &at {
-        start[i] = (start[i] + shift).max(0.0);
-    }
+    let start = delay_shifted_start(c, hold, data.dt);
     let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&start), &s.fit);
     let d = select::bic(r_o.sse, data.n_res, 0) - select::bic(c.sse_estimation, data.n_res, 0);
     report.delay_delta_bic = Some(d);

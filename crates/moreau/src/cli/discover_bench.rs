@@ -1,7 +1,9 @@
 //! `moreau discover-bench --cases N --seed S`: the concealed-effect benchmark of `discovery`
 //! (N cases of each of the 9 classes: none and the 8 effects, or of the `--classes` given),
 //! printing the confusion matrix, the false-alarm rate on `none` and the parameter errors. `--profile digital` generates
-//! zero-order-held inputs, 1-10 ms sampling, white or AR(1) noise and lightly damped plants.
+//! zero-order-held inputs, 1-10 ms sampling, white or AR(1) noise and lightly damped plants;
+//! `--profile mixed` every convention at once (continuous, zero- or first-order-held inputs,
+//! 0.5-20 ms sampling).
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -15,9 +17,10 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Generator profile: `classic` (continuous inputs, white noise, 60 samples per natural
-    /// period) or `digital` (zero-order-held inputs, sample periods 1-10 ms, white or
-    /// AR(1)-coloured noise, half the plants lightly damped).
-    #[arg(long, default_value = "classic", value_parser = ["classic", "digital"])]
+    /// period), `digital` (zero-order-held inputs, sample periods 1-10 ms, white or
+    /// AR(1)-coloured noise, half the plants lightly damped) or `mixed` (as digital, with
+    /// continuous, zero- or first-order-held inputs and sample periods 0.5-20 ms).
+    #[arg(long, default_value = "classic", value_parser = ["classic", "digital", "mixed"])]
     pub profile: String,
     /// Classes: `classic` (none and the 8 original effects), `friction` (none,
     /// coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging), `all`, or a
@@ -48,7 +51,8 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         1e6,
         "per class",
     )?;
-    let profile = discovery::bench_gen::Profile::parse(&a.profile).unwrap_or(discovery::bench_gen::Profile::Classic);
+    let profile = discovery::bench_gen::Profile::parse(&a.profile)
+        .with_context(|| format!("--profile {:?}: expected classic, digital or mixed", a.profile))?;
     let classes = discovery::bench::class_set(&a.classes).with_context(|| {
         format!(
             "--classes {:?}: expected classic, friction, all or a comma-separated list of {}",
