@@ -71,7 +71,8 @@ pub fn main_param(e: &Effect) -> f64 {
 }
 
 /// Name of the hypothesis parameter that is the main parameter (for its reported
-/// uncertainty); `None` where the main parameter is derived from several.
+/// uncertainty); `None` where the main parameter is derived from several (the report's
+/// `effects[].derived`).
 fn main_param_name(e: &Effect) -> Option<&'static str> {
     physics::main_parameter(e).1
 }
@@ -197,17 +198,23 @@ pub fn run_case_with(
                         }
                         _ => String::new(),
                     };
-                    let sd = |pick: fn(&crate::diagnose::FittedEffect) -> &Vec<(String, f64)>| {
-                        main_param_name(t).and_then(|name| {
-                            rep.effects
+                    // The main parameter's sigma: that of its hypothesis parameter, or of the
+                    // report's derived main parameter (Stribeck static level, cogging amplitude).
+                    let sd =
+                        |pick: fn(&crate::diagnose::FittedEffect) -> &Vec<(String, f64)>,
+                         pick_derived: fn(&crate::diagnose::DerivedParameter) -> f64| {
+                            let f = rep
+                                .effects
                                 .iter()
-                                .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))
-                                .and_then(|f| pick(f).iter().find(|u| u.0 == name).map(|u| u.1))
-                        })
-                    };
-                    out.est_std = sd(|f| &f.uncertainty);
-                    out.est_std_statistical = sd(|f| &f.uncertainty_statistical);
-                    out.est_std_jackknife = sd(|f| &f.uncertainty_jackknife);
+                                .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))?;
+                            match main_param_name(t) {
+                                Some(name) => pick(f).iter().find(|u| u.0 == name).map(|u| u.1),
+                                None => f.derived.as_ref().map(pick_derived),
+                            }
+                        };
+                    out.est_std = sd(|f| &f.uncertainty, |d| d.uncertainty);
+                    out.est_std_statistical = sd(|f| &f.uncertainty_statistical, |d| d.uncertainty_statistical);
+                    out.est_std_jackknife = sd(|f| &f.uncertainty_jackknife, |d| d.uncertainty_jackknife);
                 }
             }
         }

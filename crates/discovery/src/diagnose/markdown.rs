@@ -197,6 +197,25 @@ impl Report {
                     if sp.is_finite() { format!(", stepping {sp:.2e}") } else { String::new() }
                 );
             }
+            if let Some(d) = &e.derived {
+                s += &format!(
+                    "  - {} = {:.6} +- {:.2e} (derived; 1 sigma; statistical {:.2e}, fold jackknife {}{})\n",
+                    d.name,
+                    d.value,
+                    d.uncertainty,
+                    d.uncertainty_statistical,
+                    if d.uncertainty_jackknife.is_finite() {
+                        format!("{:.2e}", d.uncertainty_jackknife)
+                    } else {
+                        "n/a".into()
+                    },
+                    if d.uncertainty_stepping.is_finite() {
+                        format!(", stepping {:.2e}", d.uncertainty_stepping)
+                    } else {
+                        String::new()
+                    }
+                );
+            }
             if let Some((h, ps)) = &e.other_hold {
                 for (n, v) in ps {
                     s += &format!("  - under the {h} hold instead: {n} = {v:.6}\n");

@@ -45,8 +45,8 @@ mod verdict;
 pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
 pub use joint::{diagnose_recordings, JointReport};
 pub use report::{
-    FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Remaining, Report, Series,
-    FITTED_INPUT_FILE,
+    DerivedParameter, FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Remaining, Report,
+    Series, FITTED_INPUT_FILE,
 };
 pub use settings::{DiagnoseSettings, HoldChoice, InitialState, Metric, SERVO_FIT_PERCENT};
 

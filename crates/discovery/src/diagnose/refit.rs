@@ -3,12 +3,13 @@
 //! ([`fitted`]: its simulation and residual, the grey-box values, `fitted.toml`'s system with
 //! the input file that replays the fit, and the effects as reported).
 use super::pass::FinerFit;
-use super::report::{FittedEffect, NominalValue, FITTED_INPUT_FILE};
+use super::report::{DerivedParameter, FittedEffect, NominalValue, FITTED_INPUT_FILE};
 use super::setup::Setup;
 use crate::fit::jackknife::{self, Jackknife};
 use crate::fit::FitResult;
 use crate::hypothesis::Kind;
 use crate::metrics::{self, Fit};
+use crate::physics;
 use crate::residual::ResidualTests;
 use crate::select::{FitContext, Ranked};
 use dynamics::extended::{InputHold, SimOutput};
@@ -26,6 +27,9 @@ pub(super) struct Uncertainty {
     pub stepping: Option<(Vec<f64>, Vec<f64>)>,
     /// What the reported sigma includes (report's `uncertainty_method`).
     pub method: String,
+    /// Per selected effect, its main parameter where it is derived from several fitted ones
+    /// ([`derived_main`]).
+    pub derived: Vec<Option<DerivedParameter>>,
 }
 
 /// Reported uncertainty: the statistical sigma of the fit (the larger of Gauss-Newton and
@@ -43,6 +47,7 @@ pub(super) fn uncertainty(
     let mut std_stat: (Vec<f64>, Vec<f64>) = (vec![], vec![]);
     let mut jack: Option<Jackknife> = None;
     let mut stepping: Option<(Vec<f64>, Vec<f64>)> = None;
+    let mut derived = Vec::new();
     if let Some(c) = chosen {
         std_stat = (c.std.clone(), c.nominal_std.clone());
         if s.jackknife_iter > 0 && (!c.params.is_empty() || c.refit) {
@@ -82,6 +87,7 @@ pub(super) fn uncertainty(
             }
             stepping = Some((st, sn));
         }
+        derived = derived_main(c, jack.as_ref(), finer);
     }
     let jack_resolved = jack.as_ref().is_some_and(|j| j.estimates.len() >= 2);
     let stepping_text = match (&stepping, finer) {
@@ -100,7 +106,51 @@ pub(super) fn uncertainty(
             (None, _) => "The jackknife was not computed here (no effect parameters, or disabled): s_stat alone. ".into(),
         }
     );
-    Uncertainty { std_stat, jack, stepping, method }
+    Uncertainty { std_stat, jack, stepping, method, derived }
+}
+
+/// Per effect of `c`, its main parameter where it is derived from several fitted parameters
+/// (a Stribeck law's static level, a cogging force's amplitude: [`physics::derived_main`]),
+/// with a sigma of the same three parts as the fitted parameters': statistical (the
+/// linearised `sqrt(max(g' C_gn g, g' C_sw g))` with the fit's covariances), the jackknife
+/// of the derived value over the fold estimates, and the stepping part of the derived value
+/// at the finer stepping.
+fn derived_main(c: &Ranked, jack: Option<&Jackknife>, finer: Option<&FinerFit>) -> Vec<Option<DerivedParameter>> {
+    let finer = finer.filter(|f| f.label == c.label && f.theta.len() == c.params.len());
+    let mut off = 0;
+    c.parts
+        .iter()
+        .map(|h| {
+            let k = h.k();
+            let at = |t: &[f64]| physics::derived_main(h.kind, t).map(|d| d.1);
+            let out = physics::derived_main(h.kind, &c.params[off..off + k]).map(|(name, value, g)| {
+                let statistical = c.effect_covariance.as_ref().map_or(f64::NAN, |cov| cov.std_of(off, &g));
+                let jackknife = jack.map_or(f64::NAN, |j| {
+                    let rows: Vec<Vec<f64>> =
+                        j.estimates.iter().filter_map(|r| r.get(off..off + k).and_then(at).map(|v| vec![v])).collect();
+                    jackknife::jackknife_part(
+                        jackknife::jackknife_std(&rows).first().copied().unwrap_or(f64::NAN),
+                        rows.len(),
+                    )
+                });
+                let stepping = finer.map_or(f64::NAN, |f| {
+                    at(&f.theta[off..off + k])
+                        .map_or(f64::NAN, |vf| stepping_part(&[value], &[vf], f.substeps, f.substeps_fine)[0])
+                });
+                let uncertainty = jackknife::combine(jackknife::combine(statistical, jackknife), stepping);
+                DerivedParameter {
+                    name: name.to_string(),
+                    value,
+                    uncertainty,
+                    uncertainty_statistical: statistical,
+                    uncertainty_jackknife: jackknife,
+                    uncertainty_stepping: stepping,
+                }
+            });
+            off += k;
+            out
+        })
+        .collect()
 }
 
 /// The stepping part of the sigma of parameters `theta` fitted at `k` sub-steps per sample,
@@ -310,7 +360,8 @@ fn fitted_effects(c: &Ranked, unc: &Uncertainty, hold: InputHold, dt: f64) -> Ve
     let mut off = 0;
     c.parts
         .iter()
-        .map(|h| {
+        .enumerate()
+        .map(|(j, h)| {
             let k = h.k();
             let fe = FittedEffect {
                 kind: h.kind.name().into(),
@@ -352,6 +403,7 @@ fn fitted_effects(c: &Ranked, unc: &Uncertainty, hold: InputHold, dt: f64) -> Ve
                     };
                     (name.to_string(), vec![("delay".to_string(), v)])
                 }),
+                derived: unc.derived.get(j).cloned().flatten(),
             };
             off += k;
             fe

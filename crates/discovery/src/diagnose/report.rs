@@ -112,6 +112,23 @@ pub struct FittedEffect {
     /// decide the hold (see the report's `hold`), the recording cannot tell the two apart and
     /// the user's knowledge of the hold must.
     pub other_hold: Option<(String, Vec<(String, f64)>)>,
+    /// The effect's main parameter where it is derived from several of `params` (a Stribeck
+    /// law's `static_level`, a cogging force's `amplitude`), with its sigma; `None` (JSON
+    /// `null`) where the main parameter is one of `params`.
+    pub derived: Option<DerivedParameter>,
+}
+
+/// A main parameter derived from several fitted ones, with its 1-sigma and the same parts as
+/// theirs: statistical (linearised, with the fit's covariance), fold jackknife and stepping
+/// (`NaN`, JSON `null`, where not computed).
+#[derive(Debug, Clone, Serialize)]
+pub struct DerivedParameter {
+    pub name: String,
+    pub value: f64,
+    pub uncertainty: f64,
+    pub uncertainty_statistical: f64,
+    pub uncertainty_jackknife: f64,
+    pub uncertainty_stepping: f64,
 }
 
 /// One refitted nominal parameter in the report.

@@ -58,6 +58,35 @@ pub enum FitStatus {
     AtBound,
 }
 
+/// The effect parameters' statistical covariance, both estimates (see
+/// [`FitResult::effect_covariance`]).
+#[derive(Debug, Clone)]
+pub struct EffectCovariance {
+    pub gauss_newton: DMatrix<f64>,
+    pub sandwich: DMatrix<f64>,
+}
+
+impl EffectCovariance {
+    /// The statistical 1-sigma of a function of the parameters `[off, off + g.len())` with
+    /// gradient `g` there: `sqrt(max(g' C_gn g, g' C_sw g))` (linearised, as the parameters'
+    /// own sigmas); `NaN` where `g` or the block is not finite or out of range.
+    pub fn std_of(&self, off: usize, g: &[f64]) -> f64 {
+        let k = g.len();
+        if off + k > self.gauss_newton.nrows() || g.iter().any(|v| !v.is_finite()) {
+            return f64::NAN;
+        }
+        let form = |c: &DMatrix<f64>| {
+            (0..k).map(|i| (0..k).map(|j| g[i] * c[(off + i, off + j)] * g[j]).sum::<f64>()).sum::<f64>()
+        };
+        let v = form(&self.gauss_newton).max(form(&self.sandwich));
+        if v.is_finite() {
+            v.max(0.0).sqrt()
+        } else {
+            f64::NAN
+        }
+    }
+}
+
 impl FitStatus {
     /// Whether the fit can count as evidence against its effect (it converged inside its
     /// box with a non-zero gradient).
@@ -80,6 +109,12 @@ pub struct FitResult {
     /// Their statistical correlation matrix (Gauss-Newton; `NaN` where not identifiable; empty
     /// without a refit or where the normal matrix is singular).
     pub nominal_correlation: Vec<Vec<f64>>,
+    /// The effect parameters' covariance matrices, Gauss-Newton and batch-means sandwich
+    /// (physical units; `None` where not computed or the normal matrix is singular): `std` is
+    /// the larger of their diagonals, and a function `g` of the parameters has the 1-sigma
+    /// `sqrt(max(g' C_gn g, g' C_sw g))` ([`EffectCovariance::std_of`]).
+    #[serde(skip)]
+    pub effect_covariance: Option<EffectCovariance>,
     pub x0: Vec<f64>,
     /// Weighted sum of squared residuals on the estimation segment.
     pub sse: f64,
@@ -411,6 +446,7 @@ fn fit_with(
         nominal: nom0.clone(),
         nominal_std: vec![f64::NAN; kn],
         nominal_correlation: vec![],
+        effect_covariance: None,
         x0: x0_init.to_vec(),
         sse: f64::INFINITY,
         n_res: 0,
@@ -443,6 +479,7 @@ fn fit_with(
         nominal,
         nominal_std: vec![f64::NAN; kn],
         nominal_correlation: vec![],
+        effect_covariance: None,
         x0,
         sse: cost,
         n_res: r.len(),
@@ -464,6 +501,7 @@ fn nothing_to_fit(vars: &Vars, x0_init: &[f64], evals: &mut usize) -> FitResult 
         nominal: vec![],
         nominal_std: vec![],
         nominal_correlation: vec![],
+        effect_covariance: None,
         x0: x0_init.to_vec(),
         sse: cost,
         n_res,
@@ -582,11 +620,15 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
     let unit: Vec<f64> = slope.iter().map(|s| s.abs()).chain(vars.ns.iter().copied()).collect();
     let inverse = JtJ.clone().try_inverse();
     let nominal_correlation = inverse.as_ref().map_or(vec![], |inv| correlation_block(inv, k, kn));
+    let mut effect_covariance = None;
     let std_all: Vec<f64> = match inverse {
         Some(inv) => {
             // The larger of the white-noise and the coloured-residual (batch-means sandwich)
             // variances: the report never claims more precision than either supports.
             let sandwich = &inv * long_run_score_covariance(&J, &r, pb.p) * &inv;
+            let physical = |m: &DMatrix<f64>| DMatrix::from_fn(k, k, |i, j| m[(i, j)] * unit[i] * unit[j]);
+            effect_covariance =
+                Some(EffectCovariance { gauss_newton: physical(&(&inv * s2)), sandwich: physical(&sandwich) });
             (0..k + kn).map(|i| (s2 * inv[(i, i)]).max(sandwich[(i, i)]).max(0.0).sqrt() * unit[i]).collect()
         }
         None => vec![f64::NAN; k + kn],
@@ -613,6 +655,7 @@ fn conclude(vars: &Vars, done: (Vec<f64>, Vec<f64>, f64, bool), s: &FitSettings,
         nominal,
         nominal_std,
         nominal_correlation,
+        effect_covariance,
         x0,
         sse: cost,
         n_res: nres,

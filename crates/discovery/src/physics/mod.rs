@@ -174,6 +174,29 @@ pub fn main_parameter(effect: &Effect) -> (f64, Option<&'static str>) {
     FAMILIES.iter().find_map(|f| f.main_parameter(effect)).expect("every effect belongs to a family of FAMILIES")
 }
 
+/// The main parameter of `kind` at hypothesis parameters `theta` where it is derived from
+/// several of them (a Stribeck law's static level, a cogging force's amplitude): its name, its
+/// value and its gradient in `theta` (central differences); `None` where the main parameter is
+/// one of the hypothesis parameters (its sigma is that parameter's).
+pub fn derived_main(kind: Kind, theta: &[f64]) -> Option<(&'static str, f64, Vec<f64>)> {
+    let at = |t: &[f64]| main_parameter(&kind.effect(t)).0;
+    let effect = kind.effect(theta);
+    if main_parameter(&effect).1.is_some() {
+        return None;
+    }
+    let name = every_parameter(&effect)?.first()?.0;
+    let gradient = (0..theta.len())
+        .map(|i| {
+            let h = 1e-6 * theta[i].abs().max(1e-9);
+            let (mut up, mut down) = (theta.to_vec(), theta.to_vec());
+            up[i] += h;
+            down[i] -= h;
+            (at(&up) - at(&down)) / (2.0 * h)
+        })
+        .collect();
+    Some((name, at(theta), gradient))
+}
+
 /// Every identifiable parameter of a model-file effect (see [`Family::every_parameter`]).
 pub fn every_parameter(effect: &Effect) -> Option<Vec<(&'static str, f64)>> {
     FAMILIES.iter().find_map(|f| f.every_parameter(effect))
@@ -210,6 +233,29 @@ mod tests {
             assert_eq!(k.effect(&theta).kind(), k.name(), "{k:?}");
             let e = k.effect(&theta);
             assert_eq!(FAMILIES.iter().filter(|f| f.main_parameter(&e).is_some()).count(), 1, "{k:?}");
+            // a derived main parameter has the value of the main parameter
+            if let Some((_, v, _)) = derived_main(k, &theta) {
+                assert_eq!(v, main_parameter(&e).0, "{k:?}");
+            }
         }
+    }
+
+    #[test]
+    fn derived_main_parameters_have_their_gradients() {
+        // Stribeck: static level = level + static excess.
+        let (name, v, g) = derived_main(Kind::StribeckFriction { state: 1 }, &[2.0, 1.5, 0.3]).unwrap();
+        assert_eq!((name, v), ("static_level", 3.5));
+        for (gi, want) in g.iter().zip([1.0, 1.0, 0.0]) {
+            assert!((gi - want).abs() < 1e-6, "{g:?}");
+        }
+        // Cogging: amplitude = hypot(a_sin, a_cos).
+        let (name, v, g) = derived_main(Kind::Cogging { state: 1, position_state: 0 }, &[3.0, -4.0, 0.2]).unwrap();
+        assert_eq!((name, v), ("amplitude", 5.0));
+        for (gi, want) in g.iter().zip([0.6, -0.8, 0.0]) {
+            assert!((gi - want).abs() < 1e-6, "{g:?}");
+        }
+        // negative control: a main parameter that is a hypothesis parameter is not derived
+        assert!(derived_main(Kind::CoulombFriction { state: 1 }, &[2.0]).is_none());
+        assert!(derived_main(Kind::AsymmetricCoulomb { state: 1 }, &[2.0, 1.0]).is_none());
     }
 }

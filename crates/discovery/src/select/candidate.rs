@@ -43,6 +43,9 @@ pub struct Ranked {
     /// Their statistical correlation (see `FitResult::nominal_correlation`).
     #[serde(skip)]
     pub nominal_correlation: Vec<Vec<f64>>,
+    /// The effect parameters' statistical covariance (see `FitResult::effect_covariance`).
+    #[serde(skip)]
+    pub effect_covariance: Option<fit::EffectCovariance>,
     #[serde(skip)]
     pub x0: Vec<f64>,
     #[serde(skip)]
@@ -122,6 +125,7 @@ pub(crate) fn fit_hypothesis(
         nominal: r.nominal.clone(),
         nominal_std: r.nominal_std.clone(),
         nominal_correlation: r.nominal_correlation.clone(),
+        effect_covariance: r.effect_covariance.clone(),
         sse_estimation: r.sse,
         bic: b,
         delta_bic: bic_nom - b,

@@ -136,6 +136,7 @@ impl Selector<'_, '_> {
             nominal: vec![],
             nominal_std: vec![],
             nominal_correlation: vec![],
+            effect_covariance: None,
             sse_estimation: nom.sse,
             bic: self.bic_nom,
             delta_bic: 0.0,
