@@ -55,7 +55,7 @@ fn main() {
     for e in &rep.effects {
         println!("  {} {:?} +- {:?}", e.label, e.params, e.uncertainty);
     }
-    for r in rep.ranking.iter().take(12) {
+    for r in rep.ranking.iter().take(40) {
         println!(
             "  {:40} {:?} std {:?} dBIC {:.1} vr {:.3} {:?} {} cv {:?}",
             r.label,
@@ -103,7 +103,18 @@ fn main() {
                     Effect::BacklashInertia { mass: mass * f, damping: *damping }
                 }
                 Effect::GapWidth { relative_change } => Effect::GapWidth { relative_change: relative_change * f },
-                _ => panic!(),
+                // the static excess over the sliding level scaled (f = 0: Coulomb friction)
+                Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
+                    Effect::StribeckFriction {
+                        state: *state,
+                        level: *level,
+                        static_level: level + (static_level - level) * (f - 0.5) * 2.0,
+                        stribeck_velocity: *stribeck_velocity,
+                        viscous: *viscous,
+                    }
+                }
+                Effect::CoulombFriction { state, level } => Effect::CoulombFriction { state: *state, level: level * f },
+                _ => panic!("no profile for {truth:?}"),
             };
             let pb = Problem {
                 sys,

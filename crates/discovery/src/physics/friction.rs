@@ -141,6 +141,36 @@ impl Family for Friction {
         }
     }
 
+    /// From a Coulomb level `L`: a Stribeck law with its sliding level at 0.6 and 0.9 `L`, a
+    /// static excess of 0.8, 1.5 and 2.5 times that and Stribeck velocities of 1-30 % of the
+    /// velocity scale (the Coulomb reading lies between the sliding and the static level); a
+    /// direction-dependent law with levels `L` split 1:1, 1.3:0.7 and 1.6:0.4 either way.
+    fn starts_from_simpler(&self, h: &Hypothesis, simpler: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let l = *simpler.first()?;
+        let unit = |t: [f64; 3], k: usize| (0..k).map(|i| h.unit_of(i, t[i])).collect::<Vec<f64>>();
+        match h.kind {
+            Kind::StribeckFriction { .. } => {
+                let v_scale = 0.5 * h.upper[2];
+                let mut starts = Vec::new();
+                for a in [0.6, 0.9] {
+                    for r in [0.8, 1.5, 2.5] {
+                        for v in [0.01, 0.03, 0.1, 0.3] {
+                            starts.push(unit([a * l, r * a * l, v * v_scale], 3));
+                        }
+                    }
+                }
+                Some(starts)
+            }
+            Kind::AsymmetricCoulomb { .. } => Some(
+                [(1.0, 1.0), (1.3, 0.7), (0.7, 1.3), (1.6, 0.4), (0.4, 1.6)]
+                    .iter()
+                    .map(|&(a, b)| unit([a * l, b * l, 0.0], 2))
+                    .collect(),
+            ),
+            _ => None,
+        }
+    }
+
     fn main_parameter(&self, effect: &Effect) -> Option<(f64, Option<&'static str>)> {
         match effect {
             Effect::CoulombFriction { level, .. } => Some((*level, Some(LEVEL))),

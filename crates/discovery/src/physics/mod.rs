@@ -148,6 +148,12 @@ pub trait Family: Sync {
     fn simpler_form(&self, _kind: Kind) -> Option<Kind> {
         None
     }
+    /// Starts (unit coordinates of `h`) around the simpler form's estimate `simpler` (physical
+    /// units), for a generalisation whose own starts ended no better than what it nests;
+    /// `None` where `h` generalises nothing.
+    fn starts_from_simpler(&self, _h: &Hypothesis, _simpler: &[f64]) -> Option<Vec<Vec<f64>>> {
+        None
+    }
     /// The main parameter of a model-file `effect` (the one that sets its size, which a
     /// benchmark sets and scores) and the hypothesis parameter that estimates it (`None` where
     /// the main parameter is derived from several).
@@ -172,6 +178,12 @@ pub fn hypotheses_at(sites: &[Site], cx: &Context) -> Vec<Hypothesis> {
 /// (see [`Family::main_parameter`]).
 pub fn main_parameter(effect: &Effect) -> (f64, Option<&'static str>) {
     FAMILIES.iter().find_map(|f| f.main_parameter(effect)).expect("every effect belongs to a family of FAMILIES")
+}
+
+/// Starts for the generalisation `h` around its simpler form's estimate (see
+/// [`Family::starts_from_simpler`]).
+pub fn starts_from_simpler(h: &Hypothesis, simpler: &[f64]) -> Option<Vec<Vec<f64>>> {
+    h.kind.family().starts_from_simpler(h, simpler)
 }
 
 /// The main parameter of `kind` at hypothesis parameters `theta` where it is derived from

@@ -170,6 +170,7 @@ pub(crate) fn fit_singles(
     let one = |h: &Hypothesis| fit_hypothesis(ctx, plan, vec![h.clone()], None, warm(h), &nom.x0, bic_nom, val_sse_nom);
     let mut singles: Vec<Ranked> =
         if plan.parallel { cands.par_iter().map(one).collect() } else { cands.iter().map(one).collect() };
+    refit_from_simpler_forms(ctx, plan, &cands, &mut singles, nom, bic_nom, val_sse_nom);
     // Grey-box refit: the freed nominal parameters alone, ranked with the effects ("the
     // plant's parameters were off" is a hypothesis of its own, not missing physics).
     if let Some(free) = ctx.free {
@@ -186,6 +187,48 @@ pub(crate) fn fit_singles(
     }
     singles.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     singles
+}
+
+/// A generalisation (`singles[i]` of `cands[i]`) whose fit stuck (a zero gradient or a bound)
+/// is fitted again from starts around its simpler form's estimate
+/// ([`crate::physics::starts_from_simpler`]); the better of the two fits stands. Its own
+/// starts can all lead to the nested corner: a Stribeck law whose static excess runs to zero,
+/// where its Stribeck velocity has no influence, is stuck there and reads as Coulomb friction
+/// (an inconclusive fit, which is never evidence against the effect).
+#[allow(clippy::too_many_arguments)]
+fn refit_from_simpler_forms(
+    ctx: &FitContext,
+    plan: &Plan,
+    cands: &[Hypothesis],
+    singles: &mut [Ranked],
+    nom: &FitResult,
+    bic_nom: f64,
+    val_sse_nom: f64,
+) {
+    let redo: Vec<(usize, Hypothesis)> = cands
+        .iter()
+        .enumerate()
+        .filter_map(|(i, h)| {
+            let simple = h.kind.simpler_form()?;
+            let j = cands.iter().position(|c| c.kind == simple)?;
+            let (g, s) = (&singles[i], &singles[j]);
+            if g.status.conclusive() || !s.status.conclusive() {
+                return None;
+            }
+            let starts = crate::physics::starts_from_simpler(h, &s.params)?;
+            Some((i, Hypothesis { starts, ..h.clone() }))
+        })
+        .collect();
+    let again = |(i, h): &(usize, Hypothesis)| {
+        (*i, fit_hypothesis(ctx, plan, vec![h.clone()], None, None, &nom.x0, bic_nom, val_sse_nom))
+    };
+    let refits: Vec<(usize, Ranked)> =
+        if plan.parallel { redo.par_iter().map(again).collect() } else { redo.iter().map(again).collect() };
+    for (i, r) in refits {
+        if r.sse_estimation < singles[i].sse_estimation {
+            singles[i] = r;
+        }
+    }
 }
 
 /// BIC of the nominal fit and its validation SSE.
