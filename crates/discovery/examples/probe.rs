@@ -1,6 +1,6 @@
 //! Development aid: one benchmark case, its ranking, and a profile of the estimation cost
 //! along the true effect's main parameter (initial state refitted at each point).
-//! Usage: `cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`.
+//! Usage: `[HOLD=zoh|foh] [SUB=N] cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`.
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
@@ -26,6 +26,12 @@ fn main() {
             x0: case.nominal.x0.iter().copied().collect(),
             z0: Some(case.nominal.z0.iter().copied().collect()),
         }),
+        // HOLD=zoh|foh: the hold given instead of chosen from the data
+        input_hold: match std::env::var("HOLD").as_deref() {
+            Ok("zoh") => discovery::HoldChoice::Fixed(dynamics::extended::InputHold::Zoh),
+            Ok("foh") => discovery::HoldChoice::Fixed(dynamics::extended::InputHold::Foh),
+            _ => discovery::HoldChoice::Auto,
+        },
         ..Default::default()
     };
     let rep = discovery::diagnose(&case.nominal, &case.recording, &s).unwrap();

@@ -7,6 +7,7 @@ use super::hold;
 use super::pass::Pass;
 use super::refit::Fitted;
 use super::report::HoldReport;
+use super::settings::HoldChoice;
 use super::setup::Setup;
 use super::Outcome;
 use crate::discretisation::SubstepCheck;
@@ -85,6 +86,13 @@ pub(super) fn closing(
     notes.extend(hypothesis::friction_notes(&fitted.effects_chosen, ties));
     if chosen.is_some_and(|c| c.parts.iter().any(|h| h.kind == Kind::InputDelay)) {
         notes.push(input_delay_note(data, pass.hold, &pass.hold_report, fitted));
+    } else if pass.hold == InputHold::Zoh && pass.hold_report.requested == HoldChoice::Auto {
+        // A zero-order hold chosen from the data may stand for a delay under the other hold:
+        // a delay near h/2 of a continuous or interpolated command cannot be told from it.
+        notes.push(format!(
+            "The zero-order hold was chosen from the data, and it acts like a first-order hold delayed by h/2 = {:.3e} s: a continuous or linearly interpolated command delayed by about that much reads the same, and no delay is added here. If the plant sees such a command, run with --input-hold foh to read the delay.",
+            0.5 * data.dt
+        ));
     }
 }
 
