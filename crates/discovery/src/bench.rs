@@ -438,7 +438,9 @@ pub struct PairResult {
     /// How many of the two concealed classes the selected model names.
     pub named: usize,
     /// The most of them that the selected model or one of the readings the report names as
-    /// fitting as well (`equivalents`) names: the truth is among the readings the recording
+    /// fitting as well (`equivalents`) names, each reading also read through the identity the
+    /// report's friction note states (direction-dependent Coulomb friction is Coulomb friction
+    /// plus a constant force on the same state): the truth is among the readings the recording
     /// cannot tell apart.
     pub named_or_equivalent: usize,
     /// The report's equivalent readings (labels).
@@ -499,7 +501,18 @@ pub fn run_pair_case(
                 |kinds: &[String]| case.truths.iter().filter(|t| kinds.iter().any(|k| k == t.kind())).count();
             let selected: Vec<String> = rep.effects.iter().map(|e| e.kind.clone()).collect();
             out.named = named_in(&selected);
-            out.named_or_equivalent = rep.equivalents.iter().map(|e| named_in(&e.kinds)).fold(out.named, usize::max);
+            let identity = |kinds: &[String]| -> Vec<String> {
+                let mut k = kinds.to_vec();
+                if kinds.iter().any(|k| k == names::ASYMMETRIC_COULOMB) {
+                    k.extend([names::COULOMB_FRICTION.to_string(), names::CONSTANT_FORCE.to_string()]);
+                }
+                k
+            };
+            out.named_or_equivalent = rep
+                .equivalents
+                .iter()
+                .map(|e| named_in(&identity(&e.kinds)))
+                .fold(named_in(&identity(&selected)), usize::max);
             out.equivalents = rep.equivalents.iter().map(|e| e.label.clone()).collect();
             let chosen_label = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
             out.delta_bic_selected = if rep.effects.is_empty() {
