@@ -17,6 +17,15 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
+/// Default settings with the case's true initial state (as `bench::run_case_with` passes it).
+fn with_known_state(case: &bench_gen::Case) -> DiagnoseSettings {
+    let known = InitialState {
+        x0: case.nominal.x0.iter().copied().collect(),
+        z0: Some(case.nominal.z0.iter().copied().collect()),
+    };
+    DiagnoseSettings { initial_state: Some(known), ..DiagnoseSettings::default() }
+}
+
 /// A damped oscillator without play, as the generator and as a model file.
 fn oscillator() -> (Plant, model::System) {
     let pl = Plant {
@@ -248,11 +257,7 @@ fn a_stuck_generalisation_is_restarted_from_its_simpler_form() {
     // converges. (The recording does not show the breakaway: at 16 sub-steps the true law and
     // Coulomb friction differ by 0.1 % in SSE, so Coulomb friction stays the reading.)
     let case = bench_gen::generate_profile("stribeck_friction", 9303, 3, Profile::Mixed);
-    let known = InitialState {
-        x0: case.nominal.x0.iter().copied().collect(),
-        z0: Some(case.nominal.z0.iter().copied().collect()),
-    };
-    let s = DiagnoseSettings { initial_state: Some(known), ..DiagnoseSettings::default() };
+    let s = with_known_state(&case);
     let rep = diagnose(&case.nominal, &case.recording, &s).unwrap();
     let stribeck = rep.ranking.iter().find(|r| r.label == "stribeck_friction(x2)").expect("fitted");
     assert!(stribeck.status.conclusive(), "{:?} at {:?}", stribeck.status, stribeck.params);
@@ -268,11 +273,7 @@ fn a_delay_the_zero_order_hold_absorbs_is_named_in_a_note_and_read_with_the_hold
     // recording reads "no missing physics" and cannot say otherwise. The report says so and
     // how to read the delay; with the hold given, the delay is read within 2 sigma.
     let case = bench_gen::generate_profile("input_delay", 9313, 14, Profile::Mixed);
-    let known = InitialState {
-        x0: case.nominal.x0.iter().copied().collect(),
-        z0: Some(case.nominal.z0.iter().copied().collect()),
-    };
-    let s = DiagnoseSettings { initial_state: Some(known), ..DiagnoseSettings::default() };
+    let s = with_known_state(&case);
     let note = "acts like a first-order hold delayed by h/2";
     let auto = diagnose(&case.nominal, &case.recording, &s).unwrap();
     assert_eq!(auto.hold.chosen, "zoh", "{:?}", auto.hold);

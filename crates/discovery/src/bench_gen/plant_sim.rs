@@ -127,6 +127,83 @@ fn first_order(hw: f64, effs: &[&Effect]) -> bool {
         })
 }
 
+/// The truth's effects as [`simulate_fine`] steps them: the play's half-width (with a loop
+/// backlash and a gap change), the input delay and saturation limit, the constant force,
+/// Coulomb friction, backlash inertia's time constant, the sensor offset, the friction library
+/// (sliding up, sliding down, static excess, Stribeck velocity) and the cogging force
+/// (amplitude, wavenumber, phase, position state).
+struct Truth {
+    hw: f64,
+    delay: f64,
+    sat: f64,
+    force: f64,
+    fric: f64,
+    tau: f64,
+    offset: f64,
+    lib: Option<(f64, f64, f64, f64)>,
+    cog: Option<(f64, f64, f64, usize)>,
+}
+
+impl Truth {
+    fn of(hw: f64, effs: &[&Effect]) -> Self {
+        let mut t = Truth {
+            hw,
+            delay: 0.0,
+            sat: f64::INFINITY,
+            force: 0.0,
+            fric: 0.0,
+            tau: 0.0,
+            offset: 0.0,
+            lib: None,
+            cog: None,
+        };
+        let mut gap = 1.0;
+        for eff in effs {
+            match eff {
+                Effect::Backlash { width, location: PlayLocation::Loop } => t.hw += 0.5 * width,
+                Effect::GapWidth { relative_change } => gap *= 1.0 + relative_change,
+                Effect::InputDelay { delay: d } => t.delay = *d,
+                Effect::InputSaturation { limit } => t.sat = *limit,
+                Effect::ConstantForce { force: f, .. } => t.force = *f,
+                Effect::CoulombFriction { level, .. } => t.fric = *level,
+                Effect::BacklashInertia { mass, damping } => t.tau = mass / damping,
+                Effect::SensorOffset { offset: o } => t.offset = o[0],
+                Effect::StribeckFriction { level, static_level, stribeck_velocity, .. } => {
+                    t.lib = Some((*level, *level, static_level - level, *stribeck_velocity))
+                }
+                Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
+                    t.lib = Some((*level_positive, *level_negative, 0.0, 1.0))
+                }
+                Effect::Cogging { amplitude, period, phase, position_state, .. } => {
+                    t.cog = Some((*amplitude, std::f64::consts::TAU / period, *phase, *position_state))
+                }
+                _ => {}
+            }
+        }
+        t.hw *= gap;
+        t
+    }
+}
+
+/// What the plant sees of the command at time `s` (already delayed): the signal, its sample
+/// at or before `s` (held; a hair of tolerance so that the fine grid's sample instants, exact
+/// multiples up to rounding, pick their own sample), or the line between that sample and the
+/// next (linear).
+fn drive_at(sig: &Signal, drive: Drive, dt: f64, s: f64) -> f64 {
+    let held = |s: f64| {
+        let k = (s / dt + 1e-9).floor();
+        (k * dt, (s / dt - k).clamp(0.0, 1.0))
+    };
+    match drive {
+        Drive::Continuous => sig.eval(s),
+        Drive::Held(InputHold::Zoh) => sig.eval(held(s).0),
+        Drive::Held(InputHold::Foh) => {
+            let (tk, f) = held(s);
+            (1.0 - f) * sig.eval(tk) + f * sig.eval(tk + dt)
+        }
+    }
+}
+
 /// The simulation at `fine` steps per sample.
 #[allow(clippy::too_many_arguments)]
 fn simulate_fine(
@@ -142,55 +219,8 @@ fn simulate_fine(
 ) -> Vec<f64> {
     let n = pl.A.nrows();
     let h = dt / fine as f64;
-    let mut hw = hw;
-    let (mut delay, mut sat, mut force, mut fric, mut tau, mut offset) = (0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0);
-    let mut gap = 1.0;
-    // The friction library: (sliding up, sliding down, static excess, Stribeck velocity) and
-    // the cogging force (amplitude, wavenumber, phase) with position state 0.
-    let mut lib: Option<(f64, f64, f64, f64)> = None;
-    let mut cog: Option<(f64, f64, f64, usize)> = None;
-    for eff in effs {
-        match eff {
-            Effect::Backlash { width, location: PlayLocation::Loop } => hw += 0.5 * width,
-            Effect::GapWidth { relative_change } => gap *= 1.0 + relative_change,
-            Effect::InputDelay { delay: d } => delay = *d,
-            Effect::InputSaturation { limit } => sat = *limit,
-            Effect::ConstantForce { force: f, .. } => force = *f,
-            Effect::CoulombFriction { level, .. } => fric = *level,
-            Effect::BacklashInertia { mass, damping } => tau = mass / damping,
-            Effect::SensorOffset { offset: o } => offset = o[0],
-            Effect::StribeckFriction { level, static_level, stribeck_velocity, .. } => {
-                lib = Some((*level, *level, static_level - level, *stribeck_velocity))
-            }
-            Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
-                lib = Some((*level_positive, *level_negative, 0.0, 1.0))
-            }
-            Effect::Cogging { amplitude, period, phase, position_state, .. } => {
-                cog = Some((*amplitude, std::f64::consts::TAU / period, *phase, *position_state))
-            }
-            _ => {}
-        }
-    }
-    hw *= gap;
-    let input = |t: f64| {
-        let s = t - delay;
-        // Held: the sample at or before `s` (a hair of tolerance so that the fine grid's
-        // sample instants, which are exact multiples up to rounding, pick their own sample);
-        // linear: between that sample and the next.
-        let held = |s: f64| {
-            let k = (s / dt + 1e-9).floor();
-            (k * dt, (s / dt - k).clamp(0.0, 1.0))
-        };
-        let w = match drive {
-            Drive::Continuous => sig.eval(s),
-            Drive::Held(InputHold::Zoh) => sig.eval(held(s).0),
-            Drive::Held(InputHold::Foh) => {
-                let (tk, f) = held(s);
-                (1.0 - f) * sig.eval(tk) + f * sig.eval(tk + dt)
-            }
-        };
-        w.clamp(-sat, sat)
-    };
+    let Truth { hw, delay, sat, force, fric, tau, offset, lib, cog } = Truth::of(hw, effs);
+    let input = |t: f64| drive_at(sig, drive, dt, t - delay).clamp(-sat, sat);
     let cy = |x: &[f64]| (0..n).map(|j| pl.C[(0, j)] * x[j]).sum::<f64>();
     let deriv = |x: &[f64], w: f64, z: f64, out: &mut [f64]| {
         for i in 0..n {
