@@ -295,3 +295,16 @@ fn a_delay_the_zero_order_hold_absorbs_is_named_in_a_note_and_read_with_the_hold
     // Negative control: with the hold given, the note on the chosen hold is not written.
     assert!(!given.notes.iter().any(|n| n.contains("was chosen from the data")), "{:#?}", given.notes);
 }
+
+#[test]
+fn a_held_recording_with_nothing_missing_keeps_its_hold() {
+    // Mixed-profile seed 9404 case 77: a zero-order-held command at 10.4 ms, nothing missing.
+    // The hold's second look asks the input delay under the first-order hold wherever it ranks
+    // (a_delay_under_half_a_sample_is_found_under_the_other_hold); "first-order hold + h/2"
+    // beat the best effect under the zero-order hold, the nominal itself, by 6.6 in BIC, and
+    // the hold was switched and a delay named. It must also clear the selection margin
+    // against the nominal.
+    let r = bench::run_case_with("none", 9404, 77, Profile::Mixed, &DiagnoseSettings::default());
+    assert_eq!(r.predicted, "none", "{r:?}");
+    assert_eq!(r.hold_used, "zoh", "{r:?}");
+}

@@ -135,6 +135,14 @@ pub(super) fn overturned_by_effects(
         if i == 0 {
             report.effect_delta_bic = Some(d);
         }
+        // Under the other hold it must also clear the selection margin against this hold's
+        // nominal (automatic for the leading effects, which clear it here; the delay asked
+        // wherever it ranks must earn it: on a zero-order-held recording with nothing missing,
+        // "first-order hold + h/2" can beat the best effect, the nominal itself, by a few BIC).
+        let bic_o = c.bic - select::bic(c.sse_estimation, n_res, 0) + select::bic(r_o.sse, n_res, 0);
+        if bic_nom - bic_o < margin {
+            continue;
+        }
         // The tie margin for every effect, an input delay included: with a delay, hold and
         // delay are confounded (a zero-order hold acts like a first-order hold delayed by
         // h/2) and the two fits differ by a fraction of a BIC unit; switching on that would
