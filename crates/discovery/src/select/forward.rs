@@ -152,6 +152,28 @@ impl Selector<'_, '_> {
         }
     }
 
+    /// Whether candidate `c` with cross-validation `cv` and BIC `gain` over the model it
+    /// extends is supported: passed on held-out folds, or not testable there and its gain
+    /// clearing the margin for the colour of its own residual
+    /// ([`super::untestable_gain_clears`]).
+    fn supported(&self, c: &Ranked, cv: &super::CvResult, gain: f64) -> bool {
+        match cv.status {
+            "failed" => false,
+            "not_testable" => super::untestable_gain_clears(gain, self.margin, self.residual_rho(c)),
+            _ => true,
+        }
+    }
+
+    /// Lag-one autocorrelation of `c`'s residual on the estimation segment (the largest over
+    /// the outputs; 0 where it cannot be simulated).
+    fn residual_rho(&self, c: &Ranked) -> f64 {
+        let ctx = self.ctx;
+        let Some(sim) = c.problem(ctx).simulate_with(&c.params, &c.nominal, &c.x0, None) else { return 0.0 };
+        let n = ctx.k_est * ctx.p;
+        let e: Vec<f64> = ctx.y[..n].iter().zip(&sim.y[..n]).map(|(a, b)| a - b).collect();
+        crate::residual::prewhiten_ar1(&e, ctx.k_est, ctx.p).1.into_iter().fold(0.0, f64::max)
+    }
+
     /// Singles: cross-validates the best few (`max_cv`) that clear the BIC margin against the
     /// nominal model, until one passes.
     fn accept_best_single(
@@ -169,7 +191,7 @@ impl Selector<'_, '_> {
             }
             tried += 1;
             let cv = cross_validate(ctx, plan, r, nominal_ranked, base_sse);
-            r.beats_nominal = cv.status != "failed";
+            r.beats_nominal = self.supported(r, &cv, self.bic_nom - r.bic);
             if !r.beats_nominal {
                 cv_rejected.push((r.label.clone(), cv.ratio, format!("at most {:.2}", 1.0 - plan.select.min_val_gain)));
             }
@@ -668,7 +690,7 @@ impl Selector<'_, '_> {
             }
             tried += 1;
             let cv = cross_validate(self.ctx, self.plan, c, cur, &cur_sse);
-            c.beats_nominal = cv.status != "failed";
+            c.beats_nominal = self.supported(c, &cv, cur.bic - c.bic);
             c.cv = Some(cv);
             if c.beats_nominal {
                 return Some(c.clone());

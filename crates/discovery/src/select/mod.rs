@@ -62,6 +62,17 @@ pub struct Plan<'a> {
     pub whiteness: Option<(usize, usize)>,
 }
 
+/// Whether a candidate that held-out folds cannot test (`not_testable`) is supported by its
+/// BIC gain alone: the gain, counted as if every residual were independent, deflated by
+/// `(1 - rho) / (1 + rho)` (the share of independent samples in AR(1)-coloured residuals with
+/// lag-one autocorrelation `rho`, clamped to [0, 0.99]), must clear `margin`. Under coloured
+/// noise a flexible effect acting on one stretch (a saturation limit reached once) gains tens
+/// of BIC on noise; a real one gains far more.
+pub fn untestable_gain_clears(gain: f64, margin: f64, rho: f64) -> bool {
+    let rho = if rho.is_finite() { rho.clamp(0.0, 0.99) } else { 0.0 };
+    gain * (1.0 - rho) / (1.0 + rho) >= margin
+}
+
 /// `N log(SSE/N) + k log N`.
 pub fn bic(sse: f64, n: usize, k: usize) -> f64 {
     let nf = n.max(1) as f64;
@@ -84,6 +95,20 @@ pub struct Decision {
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn an_untestable_gain_is_deflated_for_the_residual_colour() {
+        // White residuals: the gain counts as it is.
+        assert!(untestable_gain_clears(12.0, 10.0, 0.0));
+        // AR(1) 0.85: a gain of 26 is worth 2 independent samples' 2.1 (the false alarm of mixed
+        // seed 9504 case 7, a saturation limit fitted to coloured noise), a real effect's 500
+        // still clears.
+        assert!(!untestable_gain_clears(26.4, 10.0, 0.85));
+        assert!(untestable_gain_clears(500.0, 10.0, 0.85));
+        // rho is clamped: a NaN or negative rho counts as white, 1 as 0.99.
+        assert!(untestable_gain_clears(12.0, 10.0, f64::NAN) && untestable_gain_clears(12.0, 10.0, -0.5));
+        assert!(!untestable_gain_clears(1000.0, 10.0, 1.0));
+    }
+
     #[test]
     fn margin_and_validation_both_required() {
         let s = SelectSettings::default();
