@@ -178,3 +178,18 @@ fn a_residual_off_zero_is_not_passed_as_coloured_noise() {
         assert!(r.verdict.contains("its mean is off zero"), "{}", r.verdict);
     }
 }
+
+#[test]
+fn an_effect_only_the_held_out_segment_shows_leaves_the_model_incomplete() {
+    // Mixed-profile seed 9602 case 3: an input saturation that only the validation segment's
+    // commands reach. On the estimation segment it gains 0.4 in BIC (nothing selected), on the
+    // held-out segment it cuts the error to 0.086 of the nominal's; the residual, white once an
+    // AR(1) colour is removed, exempted the model, which was reported complete.
+    let case = bench_gen::generate_profile("input_saturation", 9602, 3, Profile::Mixed);
+    let r = run(&case);
+    assert!(r.model_incomplete, "{}", r.verdict);
+    assert!(r.verdict.contains("input_saturation cuts the held-out error"), "{}", r.verdict);
+    // Negative control: a recording with nothing missing (same profile and seed) is complete.
+    let none = run(&bench_gen::generate_profile("none", 9602, 3, Profile::Mixed));
+    assert!(!none.model_incomplete && none.effects.is_empty(), "{}", none.verdict);
+}

@@ -167,6 +167,9 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 ///   `tests/two_effects.rs`) left 0.99 with an extension 26 better, not called incomplete. The
 ///   line at 1 is thin (a noise level from 1000-2000 samples is uncertain by about 2 %).
 ///
+/// Neither exempts a model that a fitted candidate beats on the held-out segment by half
+/// ([`verdict::held_out_extension`]): the effect acts where the estimation data do not reach.
+///
 /// With the localisation of that residual.
 fn remaining(
     data: &Setup,
@@ -195,7 +198,10 @@ fn remaining(
     let above_noise = rms_over_noise.iter().any(|&r| r > 1.0);
     let rho = ar1.first().copied().unwrap_or(0.0);
     let mean_off_zero = t.mean.abs() > t.mean_bound * ((1.0 + rho) / (1.0 - rho)).sqrt();
-    if (t_w.white && !mean_off_zero) || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)) {
+    let held_out = verdict::held_out_extension(&outcome.ranking, outcome.chosen.as_ref());
+    let exempt =
+        (t_w.white && !mean_off_zero) || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise));
+    if exempt && held_out.is_none() {
         return None;
     }
     let contact = fitted.fit_sim.contact.iter().any(|&c| c).then_some(&fitted.fit_sim.contact[..]);
@@ -210,6 +216,7 @@ fn remaining(
         uncorrelated_ar1: t_w.uncorrelated,
         mean_off_zero,
         unconfirmed_extension: unconfirmed,
+        held_out_extension: held_out,
         windows: loc.windows,
         regimes: loc.regimes.into_iter().filter(|g| g.enriched).collect(),
     })

@@ -188,6 +188,11 @@ pub struct Remaining {
     /// BIC over it (the gain) but did not pass the held-out folds: the estimation data say more
     /// is there.
     pub unconfirmed_extension: Option<(String, f64)>,
+    /// A fitted candidate (label) that cuts the final model's held-out (validation) error to
+    /// the given share, at most half, without paying on the estimation segment: the effect acts
+    /// where the estimation data do not reach (a saturation limit only the validation
+    /// segment's commands exceed).
+    pub held_out_extension: Option<(String, f64)>,
     /// Windows where the final residual's energy concentrates (largest share first).
     pub windows: Vec<Window>,
     /// Regimes in which the final residual's energy is enriched against the null.
