@@ -303,8 +303,11 @@ fn a_held_recording_with_nothing_missing_keeps_its_hold() {
     // (a_delay_under_half_a_sample_is_found_under_the_other_hold); "first-order hold + h/2"
     // beat the best effect under the zero-order hold, the nominal itself, by 6.6 in BIC, and
     // the hold was switched and a delay named. It must also clear the selection margin
-    // against the nominal.
-    let r = bench::run_case_with("none", 9404, 77, Profile::Mixed, &DiagnoseSettings::default());
-    assert_eq!(r.predicted, "none", "{r:?}");
-    assert_eq!(r.hold_used, "zoh", "{r:?}");
+    // against the nominal. Case 98 (AR(1) 0.57 noise): it beat it by 11.8, 3.2 once counted
+    // for the colour of its residual; switched, Coulomb friction stood in for the hold.
+    for i in [77, 98] {
+        let r = bench::run_case_with("none", 9404, i, Profile::Mixed, &DiagnoseSettings::default());
+        assert_eq!(r.predicted, "none", "{r:?}");
+        assert_eq!(r.hold_used, "zoh", "{r:?}");
+    }
 }

@@ -160,6 +160,20 @@ pub fn prewhiten_ar1(e: &[f64], n: usize, p: usize) -> (Vec<f64>, Vec<f64>) {
     (out, rhos)
 }
 
+/// The largest lag-one autocorrelation over the outputs of a time-major residual `e` (`n`
+/// samples of `p` outputs), clamped to [0, 0.99] as in [`prewhiten_ar1`].
+pub fn ar1_rho(e: &[f64], n: usize, p: usize) -> f64 {
+    prewhiten_ar1(e, n, p).1.into_iter().fold(0.0, f64::max)
+}
+
+/// `(1 - rho)/(1 + rho)`: the share of independent samples in AR(1)-coloured residuals with
+/// lag-one autocorrelation `rho` (clamped to [0, 0.99]; a NaN counts as white). BIC differences
+/// counted as if every residual were independent are overstated by its inverse.
+pub fn independent_share(rho: f64) -> f64 {
+    let rho = if rho.is_finite() { rho.clamp(0.0, 0.99) } else { 0.0 };
+    (1.0 - rho) / (1.0 + rho)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

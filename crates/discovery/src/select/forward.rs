@@ -171,7 +171,7 @@ impl Selector<'_, '_> {
         let Some(sim) = c.problem(ctx).simulate_with(&c.params, &c.nominal, &c.x0, None) else { return 0.0 };
         let n = ctx.k_est * ctx.p;
         let e: Vec<f64> = ctx.y[..n].iter().zip(&sim.y[..n]).map(|(a, b)| a - b).collect();
-        crate::residual::prewhiten_ar1(&e, ctx.k_est, ctx.p).1.into_iter().fold(0.0, f64::max)
+        crate::residual::ar1_rho(&e, ctx.k_est, ctx.p)
     }
 
     /// Singles: cross-validates the best few (`max_cv`) that clear the BIC margin against the

@@ -69,8 +69,7 @@ pub struct Plan<'a> {
 /// noise a flexible effect acting on one stretch (a saturation limit reached once) gains tens
 /// of BIC on noise; a real one gains far more.
 pub fn untestable_gain_clears(gain: f64, margin: f64, rho: f64) -> bool {
-    let rho = if rho.is_finite() { rho.clamp(0.0, 0.99) } else { 0.0 };
-    gain * (1.0 - rho) / (1.0 + rho) >= margin
+    gain * crate::residual::independent_share(rho) >= margin
 }
 
 /// `N log(SSE/N) + k log N`.
