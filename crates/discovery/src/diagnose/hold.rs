@@ -149,7 +149,7 @@ pub(super) fn overturned_by_effects(
         // independent samples per sample (AR(1) 0.57 noise on a zero-order-held recording
         // with nothing missing: first-order hold + h/2 beat it by 11.8, 3.2 once deflated).
         if i >= n_leading {
-            let deflate = colour_deflation(data, &c.problem(&ctx_o), &r_o);
+            let deflate = colour_deflation(&c.problem(&ctx_o), &r_o);
             if d * deflate <= s.select.tie_bic || (bic_nom - bic_o) * deflate < margin {
                 continue;
             }
@@ -202,11 +202,8 @@ pub(super) fn note(report: &HoldReport, hold: InputHold, tie_bic: f64) -> Option
 /// `(1 - rho)/(1 + rho)` for the lag-one autocorrelation `rho` of the fit `r`'s residual on
 /// the estimation segment (the largest over the outputs; 1 where it cannot be simulated): the
 /// share of independent samples that BIC differences should be counted with.
-fn colour_deflation(data: &Setup, pb: &fit::Problem, r: &FitResult) -> f64 {
-    let Some(sim) = pb.simulate_with(&r.theta, &r.nominal, &r.x0, None) else { return 1.0 };
-    let n = data.k_est * data.p;
-    let e: Vec<f64> = pb.y[..n].iter().zip(&sim.y[..n]).map(|(a, b)| a - b).collect();
-    crate::residual::independent_share(crate::residual::ar1_rho(&e, data.k_est, data.p))
+fn colour_deflation(pb: &fit::Problem, r: &FitResult) -> f64 {
+    crate::residual::independent_share(pb.estimation_residual_rho(&r.theta, &r.nominal, &r.x0).unwrap_or(0.0))
 }
 
 /// The hold that is not `hold`.

@@ -131,6 +131,16 @@ impl<'a> Problem<'a> {
         self.simulate_with(theta, &nom, x0, len)
     }
     /// As [`Problem::simulate`] with freed nominal parameters at `nom`.
+    /// The lag-one autocorrelation of the residual `y - yhat` at `(theta, nom, x0)` on the
+    /// estimation segment (the largest over the outputs, [`crate::residual::ar1_rho`]); `None`
+    /// where it cannot be simulated.
+    pub fn estimation_residual_rho(&self, theta: &[f64], nom: &[f64], x0: &[f64]) -> Option<f64> {
+        let sim = self.simulate_with(theta, nom, x0, None)?;
+        let n = self.k_est * self.p;
+        let e: Vec<f64> = self.y[..n].iter().zip(&sim.y[..n]).map(|(a, b)| a - b).collect();
+        Some(crate::residual::ar1_rho(&e, self.k_est, self.p))
+    }
+
     pub fn simulate_with(&self, theta: &[f64], nom: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
         let effects = self.effects(theta);
         let refitted: Option<System> = match self.refit.as_ref() {

@@ -167,11 +167,7 @@ impl Selector<'_, '_> {
     /// Lag-one autocorrelation of `c`'s residual on the estimation segment (the largest over
     /// the outputs; 0 where it cannot be simulated).
     fn residual_rho(&self, c: &Ranked) -> f64 {
-        let ctx = self.ctx;
-        let Some(sim) = c.problem(ctx).simulate_with(&c.params, &c.nominal, &c.x0, None) else { return 0.0 };
-        let n = ctx.k_est * ctx.p;
-        let e: Vec<f64> = ctx.y[..n].iter().zip(&sim.y[..n]).map(|(a, b)| a - b).collect();
-        crate::residual::ar1_rho(&e, ctx.k_est, ctx.p)
+        c.problem(self.ctx).estimation_residual_rho(&c.params, &c.nominal, &c.x0).unwrap_or(0.0)
     }
 
     /// Singles: cross-validates the best few (`max_cv`) that clear the BIC margin against the
