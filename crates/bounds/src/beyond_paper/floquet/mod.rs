@@ -239,7 +239,7 @@ fn prove(sys: &System, st: &PhaseStructure, settings: &FloquetSettings) -> Resul
     partial.section_state = K[..=g.n].iter().map(|v| [v.lo, v.hi]).collect();
     switching::check_phases(&g, &st.kinds, &ev)
         .map_err(|f| (FloquetError::Phase { phase: f.phase, what: f.what }, Some(partial.clone())))?;
-    let M = monodromy::monodromy(&ev.flows, &st.kinds, &g.C);
+    let M = monodromy::MonodromyEnclosure::new(&g, &st.kinds, &ev.durations, &ev.flows);
     let (rho, _) = monodromy::spectral_radius(&M).map_err(|f| {
         let what = match f {
             monodromy::SpectrumFailure::EigenvectorsIllConditioned => "eigenvectors ill-conditioned",

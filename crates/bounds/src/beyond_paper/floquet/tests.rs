@@ -164,3 +164,39 @@ fn unsupported_models_are_refused_with_a_reason() {
     assert!(!r.verified, "{r:?}");
     assert!(FloquetSettings { max_periods: 0, ..Default::default() }.validate().is_err());
 }
+
+/// The mean-value enclosure of the monodromy over a wide box of durations (Krawczyk radius
+/// 1e-6) contains the monodromy at the box's corners and centre and is narrower than the
+/// product of the wide flows; negative control: without its slope terms (the centre's
+/// enclosure alone) it misses the corners.
+#[test]
+fn the_mean_value_monodromy_contains_the_box_and_is_narrower() {
+    let sys = worked();
+    let (g, st, uhat) = solved(&sys);
+    let sh = Shooting::new(&g, st.kinds.clone(), st.section_sc());
+    let r: Vec<f64> = uhat.iter().map(|v| 1e-6 * (1.0 + v.abs())).collect();
+    let Some(KrawczykVerdict::Unique(K)) = sh.krawczyk(&uhat, &r) else { panic!("not verified") };
+    let wide: Vec<Ival> = K.iter().zip(&uhat).map(|(k, u)| k.hull(&Ival::mid_rad(*u, 1e-6))).collect();
+    let ev = sh.evaluate(&wide, false).unwrap();
+    let enc = monodromy::MonodromyEnclosure::new(&g, &st.kinds, &ev.durations, &ev.flows);
+    let M = enc.matrix();
+    assert!(M.max_width() < 0.5 * enc.direct.max_width(), "{} vs {}", M.max_width(), enc.direct.max_width());
+    let centre_only = monodromy::MonodromyEnclosure::entrywise(enc.centre.clone()).matrix();
+    let mut missed = 0;
+    let k = st.kinds.len();
+    for corner in 0..(1usize << (k - 1)).min(16) {
+        // a point of the box of the free durations; the last closes the period
+        let mut h: Vec<f64> =
+            (0..k - 1).map(|j| if corner >> j & 1 == 1 { ev.durations[j].hi } else { ev.durations[j].lo }).collect();
+        h.push(sh.T.mid() - h.iter().sum::<f64>());
+        if !ev.durations[k - 1].contains(h[k - 1]) {
+            continue;
+        }
+        let flows: Vec<_> = st.kinds.iter().zip(&h).map(|(kind, hj)| g.flow(*kind, Ival::point(*hj))).collect();
+        let exact = monodromy::monodromy(&flows, &st.kinds, &g.C).mid();
+        let inside = |E: &imat::IMat| (0..E.rows).all(|i| (0..E.cols).all(|j| E.at(i, j).contains(exact[(i, j)])));
+        assert!(inside(&M), "corner {corner} outside the mean-value enclosure");
+        missed += usize::from(!inside(&centre_only));
+    }
+    assert!(missed > 0, "the centre alone already holds every corner: the test says nothing");
+}
