@@ -2,7 +2,8 @@
 //! exponents on random p = 1 systems:
 //! `cargo run --release -p theorems --example floquet_benchmark -- [systems] [seed]`.
 //!
-//! Systems from `theorems::strategies::systems` (n = 2..4, p = 1, Theta an interval, sine
+//! Systems from `theorems::strategies::systems` (n = 2..4, p = 1, Theta an interval (with
+//! `FLOQUET_BENCHMARK_SETS=all` also a ball or an ellipsoid in R^1), sine
 //! inputs with amplitude 10^[0, 1.5], mu in [-2, -0.3]). A system counts when its measured
 //! exponent's 95 % interval lies below 0 (a periodic regime attracts). For each: the enclosure
 //! (verified or not, its relative width, its time), the measured exponent (3 pairs, 30 periods
@@ -30,9 +31,18 @@ fn config() -> SystemStrategyConfig {
         max_n: 4,
         max_p: 1,
         mu: (-2.0, -0.3),
-        theta: SetStrategyConfig { kinds: vec![SetKind::Interval], max_dim: 1, max_cond: 4.0, scale_exp: 0.75 },
+        theta: SetStrategyConfig { kinds: set_kinds(), max_dim: 1, max_cond: 4.0, scale_exp: 0.75 },
         input: InputStrategyConfig { amp_exp: (0.0, 1.5), ..Default::default() },
         ..Default::default()
+    }
+}
+
+/// Theta: intervals; with `FLOQUET_BENCHMARK_SETS=all` also balls and ellipsoids in R^1 (the
+/// p = 1 sets of the theta benchmark).
+fn set_kinds() -> Vec<SetKind> {
+    match std::env::var("FLOQUET_BENCHMARK_SETS").as_deref() {
+        Ok("all") => vec![SetKind::Interval, SetKind::Ball, SetKind::Ellipsoid],
+        _ => vec![SetKind::Interval],
     }
 }
 

@@ -39,8 +39,10 @@ pub struct Generators {
     pub n: usize,
     /// `n + 4`.
     pub dim: usize,
-    pub lo: f64,
-    pub hi: f64,
+    /// The faces of `Theta = [lo, hi]`, enclosed (points for an interval; a ball or an
+    /// ellipsoid in R^1 gives `c -+ r` rounded outward).
+    pub lo: Ival,
+    pub hi: Ival,
     pub omega: f64,
     /// `C` as a row (`p = 1`).
     pub C: Vec<f64>,
@@ -68,8 +70,8 @@ impl Generators {
         a: &[f64],
         C: &DMatrix<f64>,
         E: &DMatrix<f64>,
-        lo: f64,
-        hi: f64,
+        lo: Ival,
+        hi: Ival,
         omega: f64,
     ) -> Self {
         let n = A.nrows();
@@ -93,13 +95,13 @@ impl Generators {
             resting.set(i, iz, P(E[(i, 0)]));
         }
         let F = IMat::from_f64(A).add(&Ei.mul(&Ci));
-        let engaged = |b: f64| {
+        let engaged = |b: Ival| {
             let mut g = g0.clone();
             for i in 0..n {
                 for j in 0..n {
                     g.set(i, j, F.at(i, j));
                 }
-                g.set(i, i1, Ei.at(i, 0).scale(b));
+                g.set(i, i1, Ei.at(i, 0).mul(b));
             }
             // z' = C x'
             let top = g.block(0, 0, n, dim);
@@ -154,8 +156,8 @@ impl Generators {
         expm_interval(G, err, h)
     }
 
-    /// The value of `q` on a face.
-    pub fn face_value(&self, f: Face) -> f64 {
+    /// The value of `q` on a face (enclosed: exact for an interval `Theta`).
+    pub fn face_value(&self, f: Face) -> Ival {
         match f {
             Face::Lo => self.lo,
             Face::Hi => self.hi,
@@ -367,7 +369,16 @@ mod tests {
         let A = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -2.0, -0.6]);
         let col = |v: &[f64]| DMatrix::from_column_slice(v.len(), 1, v);
         let C = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
-        let g = Generators::new(&A, &col(&[0.0, 1.0]), &[1.0], &C, &col(&[0.0, 1.0]), -0.1, 0.1, 1.0);
+        let g = Generators::new(
+            &A,
+            &col(&[0.0, 1.0]),
+            &[1.0],
+            &C,
+            &col(&[0.0, 1.0]),
+            Ival::point(-0.1),
+            Ival::point(0.1),
+            1.0,
+        );
         let qr = g.q_row();
         for kind in [PhaseKind::Engaged(Face::Hi), PhaseKind::Engaged(Face::Lo)] {
             let (G, err) = g.of(kind);

@@ -1,4 +1,5 @@
-//! A verified enclosure of the periodic regime (p = 1, `Theta = [lo, hi]`, sine input) and of
+//! A verified enclosure of the periodic regime (p = 1, `Theta = [lo, hi]` (or a ball or an
+//! ellipsoid in R^1, faces enclosed), sine input) and of
 //! its Floquet exponent `ln rho(M) / T` (the local convergence exponent of trajectories near
 //! the regime), with no simulation in the claim (proofs-notes/floquet-enclosure.md).
 //!
@@ -66,7 +67,7 @@ impl FloquetSettings {
 /// Why no enclosure could be attempted or proven.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FloquetError {
-    #[error("the Floquet enclosure needs p = 1 and Theta an interval, got p = {p}, Theta = {theta}")]
+    #[error("the Floquet enclosure needs p = 1 and Theta an interval (or a ball or ellipsoid in R^1), got p = {p}, Theta = {theta}")]
     Unsupported { p: usize, theta: String },
     #[error("the Floquet enclosure needs a sine input, got {kind}")]
     UnsupportedInput { kind: &'static str },
@@ -135,19 +136,40 @@ impl FloquetEnclosure {
     }
 }
 
-/// The model's data the enclosure needs: `(lo, hi, a, omega, phase)`.
-fn supported(sys: &System) -> Result<(f64, f64, Vec<f64>, f64, f64), FloquetError> {
+/// The model's data the enclosure needs: `(lo, hi, a, omega, phase)`, the faces of `Theta`
+/// enclosed.
+fn supported(sys: &System) -> Result<(Ival, Ival, Vec<f64>, f64, f64), FloquetError> {
     if !sys.effects.list.is_empty() {
         return Err(FloquetError::Effects);
     }
-    let (lo, hi) = match (&sys.theta, sys.p()) {
-        (Shape::Interval(iv), 1) if iv.hi > iv.lo => (iv.lo, iv.hi),
-        (t, p) => return Err(FloquetError::Unsupported { p, theta: geometry::ConvexSet::describe(t) }),
-    };
+    let (lo, hi) = faces(&sys.theta)
+        .ok_or_else(|| FloquetError::Unsupported { p: sys.p(), theta: geometry::ConvexSet::describe(&sys.theta) })?;
     match &sys.input {
         Input::Sine { amplitudes, omega, phase } if *omega > 0.0 => Ok((lo, hi, amplitudes.clone(), *omega, *phase)),
         other => Err(FloquetError::UnsupportedInput { kind: other.kind() }),
     }
+}
+
+/// `Theta = [lo, hi]` in R^1 with its faces enclosed: an interval exactly, a ball or an
+/// ellipsoid as `c -+ r` (`r` the radius, or the square root of the 1 x 1 shape matrix) in
+/// interval arithmetic. `None` for other sets, `p != 1` or faces not provably apart.
+fn faces(theta: &Shape) -> Option<(Ival, Ival)> {
+    if geometry::ConvexSet::dim(theta) != 1 {
+        return None;
+    }
+    let (lo, hi) = match theta {
+        Shape::Interval(iv) => (Ival::point(iv.lo), Ival::point(iv.hi)),
+        Shape::Ball(b) => {
+            let (c, r) = (Ival::point(b.centre[0]), Ival::point(b.radius));
+            (c.sub(r), c.add(r))
+        }
+        Shape::Ellipsoid(e) => {
+            let (c, r) = (Ival::point(e.centre()[0]), Ival::point(e.matrix()[0]).sqrt());
+            (c.sub(r), c.add(r))
+        }
+        _ => return None,
+    };
+    (lo.is_valid() && hi.is_valid() && lo.hi < hi.lo).then_some((lo, hi))
 }
 
 fn generators(sys: &System) -> Result<(Generators, f64, f64), FloquetError> {
@@ -155,7 +177,8 @@ fn generators(sys: &System) -> Result<(Generators, f64, f64), FloquetError> {
     Ok((Generators::new(&sys.A, &sys.B, &a, &sys.C, &sys.E, lo, hi, omega), omega, phase))
 }
 
-/// Whether the enclosure applies to `sys` (p = 1, `Theta` an interval, sine input, no
+/// Whether the enclosure applies to `sys` (p = 1, `Theta` a set in R^1 with enclosed faces (an
+/// interval, a ball or an ellipsoid), sine input, no
 /// `[[effects]]`); elsewhere [`floquet_enclosure`] returns the reason.
 pub fn applies(sys: &System) -> bool {
     supported(sys).is_ok()
@@ -174,7 +197,7 @@ pub fn floquet_enclosure(sys: &System, settings: &FloquetSettings) -> FloquetEnc
 pub fn structure(sys: &System, settings: &FloquetSettings) -> Result<PhaseStructure, FloquetError> {
     settings.validate()?;
     let (lo, hi, _, omega, phase) = supported(sys)?;
-    phases::simulate_structure(sys, lo, hi, omega, phase, settings.max_periods)
+    phases::simulate_structure(sys, lo.mid(), hi.mid(), omega, phase, settings.max_periods)
 }
 
 /// Stages 2 to 4 for a given (hypothetical) phase structure.

@@ -89,10 +89,10 @@ impl<'a> Shooting<'a> {
         self.gens.n + 1 + self.switches()
     }
     /// The event row and constant of switch `j` (`1..=k`).
-    fn event(&self, j: usize) -> Option<(Vec<Ival>, f64)> {
+    fn event(&self, j: usize) -> Option<(Vec<Ival>, Ival)> {
         let (a, b) = (self.kinds[j - 1], self.kinds[j]);
         match (switch_kind(a, b)?, a, b) {
-            (SwitchKind::Release, PhaseKind::Engaged(_), _) => Some((self.gens.ydot_row(a), 0.0)),
+            (SwitchKind::Release, PhaseKind::Engaged(_), _) => Some((self.gens.ydot_row(a), Ival::point(0.0))),
             (SwitchKind::Contact, _, PhaseKind::Engaged(f)) => Some((self.gens.q_row(), self.gens.face_value(f))),
             _ => None,
         }
@@ -142,7 +142,7 @@ impl<'a> Shooting<'a> {
             states.push(Xn);
             if j < k {
                 let (row, c) = self.event(j + 1)?;
-                f.push(dot(&row, &states[j + 1]).sub(Ival::point(c)));
+                f.push(dot(&row, &states[j + 1]).sub(c));
                 if jacobian {
                     for col in 0..N {
                         let v = (0..dim).fold(Ival::point(0.0), |s, r| s.add(row[r].mul(D.at(r, col))));

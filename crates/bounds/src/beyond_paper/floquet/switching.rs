@@ -147,7 +147,7 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
             PhaseKind::Resting => {
                 let inside = |P: &Piece| {
                     let q = P.range(&qr);
-                    q.lo > lo && q.hi < hi
+                    q.lo > lo.hi && q.hi < hi.lo
                 };
                 if j > 0 {
                     let PhaseKind::Engaged(from) = kinds[j - 1] else {
@@ -156,7 +156,8 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
                     let s = if from == Face::Hi { 1.0 } else { -1.0 };
                     let c = |P: &Piece| {
                         let q = P.range(&qr);
-                        P.range(&r2).scale(s).is_positive() && if from == Face::Hi { q.lo > lo } else { q.hi < hi }
+                        P.range(&r2).scale(s).is_positive()
+                            && if from == Face::Hi { q.lo > lo.hi } else { q.hi < hi.lo }
                     };
                     t_a = end_piece(g, kind, Xs, eps, 1.0, &c).ok_or(PhaseFailure {
                         phase: j,
@@ -170,7 +171,7 @@ pub fn check_phases(g: &Generators, kinds: &[PhaseKind], ev: &Evaluation) -> Res
                     let s = if to == Face::Lo { 1.0 } else { -1.0 };
                     let c = |P: &Piece| {
                         let q = P.range(&qr);
-                        P.range(&r1).scale(s).is_positive() && if to == Face::Lo { q.hi < hi } else { q.lo > lo }
+                        P.range(&r1).scale(s).is_positive() && if to == Face::Lo { q.hi < hi.lo } else { q.lo > lo.hi }
                     };
                     let e = end_piece(g, kind, Xe, eps, -1.0, &c)
                         .ok_or(PhaseFailure { phase: j, what: "contact not transversal (y' sign)" })?;

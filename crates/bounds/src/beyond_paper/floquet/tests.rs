@@ -147,8 +147,8 @@ fn phase_conditions_fail_when_q_leaves_a_narrower_theta() {
     let ev = sh.evaluate(&uhat.iter().map(|v| Ival::point(*v)).collect::<Vec<_>>(), false).unwrap();
     assert!(switching::check_phases(&g, &st.kinds, &ev).is_ok());
     let mut narrow = g.clone();
-    narrow.lo *= 0.5;
-    narrow.hi *= 0.5;
+    narrow.lo = narrow.lo.scale(0.5);
+    narrow.hi = narrow.hi.scale(0.5);
     assert!(switching::check_phases(&narrow, &st.kinds, &ev).is_err());
 }
 
@@ -199,4 +199,35 @@ fn the_mean_value_monodromy_contains_the_box_and_is_narrower() {
         missed += usize::from(!inside(&centre_only));
     }
     assert!(missed > 0, "the centre alone already holds every corner: the test says nothing");
+}
+
+/// A ball and an ellipsoid in R^1 are intervals: the worked example with `Theta` the ball of
+/// radius 0.1 or the ellipsoid of shape matrix `[[0.01]]` (faces `-+ sqrt(0.01)` enclosed, not
+/// exact) is verified with the interval's exponent inside both enclosures; negative control:
+/// the ellipsoid of a wider set (`[[0.0121]]`, half-width 0.11) gives a verified enclosure
+/// that excludes the interval's exponent, and a p = 1 polytope is refused with the reason.
+#[test]
+fn a_ball_or_an_ellipsoid_in_r1_is_enclosed_as_its_interval() {
+    use geometry::{Ball, Ellipsoid};
+    let base = floquet_enclosure(&worked(), &FloquetSettings::default());
+    let with = |theta: Shape| {
+        let mut sys = worked();
+        sys.theta = theta;
+        floquet_enclosure(&sys, &FloquetSettings::default())
+    };
+    let ball = with(Shape::Ball(Ball::new(vec![0.0], 0.1).unwrap()));
+    let ell = with(Shape::Ellipsoid(Ellipsoid::new(vec![0.0], &DMatrix::from_element(1, 1, 0.01)).unwrap()));
+    for r in [&ball, &ell] {
+        assert!(r.verified, "{r:?}");
+        let [lo, hi] = r.floquet_exponent;
+        assert!(lo <= base.estimate && base.estimate <= hi, "[{lo}, {hi}] vs {}", base.estimate);
+        assert!(r.relative_width() <= 1e-6, "{}", r.relative_width());
+    }
+    let wider = with(Shape::Ellipsoid(Ellipsoid::new(vec![0.0], &DMatrix::from_element(1, 1, 0.0121)).unwrap()));
+    assert!(wider.verified, "{wider:?}");
+    assert!(!(wider.floquet_exponent[0] <= base.estimate && base.estimate <= wider.floquet_exponent[1]), "{wider:?}");
+    let mut sys = worked();
+    sys.theta = Shape::Polytope(geometry::Polytope::new(vec![vec![1.0], vec![-1.0]], vec![0.1, 0.1]).unwrap());
+    let r = floquet_enclosure(&sys, &FloquetSettings::default());
+    assert!(!r.verified && r.reason.as_deref().unwrap().contains("interval"), "{r:?}");
 }
