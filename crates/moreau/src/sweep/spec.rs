@@ -109,153 +109,13 @@ impl SweepSpec {
             Some(_) => return Err(wrong(path, "name", "a string")),
             None => path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sweep".into()),
         };
-        let axes_v = match root.get("axis") {
-            Some(Value::Array(a)) => a.clone(),
-            Some(_) => return Err(wrong(path, "axis", "an array of tables ([[axis]])")),
-            None => return Err(SweepError::NoAxes),
-        };
-        if axes_v.is_empty() {
-            return Err(SweepError::NoAxes);
-        }
-        let mut axes: Vec<Axis> = Vec::new();
-        // points of the axes so far: checked before each axis is expanded, so that no list
-        // longer than the limit is ever built
-        let mut total: u128 = 1;
-        for (k, a) in axes_v.iter().enumerate() {
-            let key = |s: &str| format!("axis[{k}].{s}");
-            let Value::Table(t) = a else { return Err(wrong(path, &format!("axis[{k}]"), "a table")) };
-            check_keys(path, t, &format!("axis[{k}]."), "parameter, values, range, label")?;
-            let pname = match t.get("parameter") {
-                Some(Value::String(s)) => s.clone(),
-                Some(_) => return Err(wrong(path, &key("parameter"), "a string")),
-                None => return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("parameter") }),
-            };
-            let parameter = Parameter::parse(&pname)?;
-            parameter.check_applicable(&base)?;
-            if axes.iter().any(|x| x.parameter == parameter) {
-                return Err(SweepError::DuplicateAxis { name: parameter.name() });
-            }
-            let values = match (t.get("values"), t.get("range")) {
-                (Some(_), Some(_)) => return Err(wrong(path, &key("values"), "either `values` or `range`, not both")),
-                (Some(Value::Array(v)), None) => Values::List(
-                    v.iter()
-                        .map(|x| num(x).ok_or_else(|| wrong(path, &key("values"), "an array of numbers")))
-                        .collect::<Result<_, _>>()?,
-                ),
-                (Some(_), None) => return Err(wrong(path, &key("values"), "an array of numbers")),
-                (None, Some(Value::Table(r))) => {
-                    check_keys(path, r, &key("range."), "from, to, count, step, spacing")?;
-                    let g = |s: &str| -> Result<Option<f64>, SweepError> {
-                        match r.get(s) {
-                            None => Ok(None),
-                            Some(v) => {
-                                num(v).map(Some).ok_or_else(|| wrong(path, &key(&format!("range.{s}")), "a number"))
-                            }
-                        }
-                    };
-                    let need = |s: &str| -> Result<f64, SweepError> {
-                        g(s)?.ok_or_else(|| SweepError::MissingKey {
-                            path: path.to_path_buf(),
-                            key: key(&format!("range.{s}")),
-                        })
-                    };
-                    let (from, to) = (need("from")?, need("to")?);
-                    let log = match r.get("spacing") {
-                        None => false,
-                        Some(Value::String(s)) if s == "linear" => false,
-                        Some(Value::String(s)) if s == "log" => true,
-                        Some(_) => return Err(wrong(path, &key("range.spacing"), "\"linear\" or \"log\"")),
-                    };
-                    match (r.get("count"), g("step")?) {
-                        (Some(Value::Integer(c)), None) => {
-                            if *c < 0 {
-                                return Err(SweepError::EmptyRange {
-                                    name: parameter.name(),
-                                    from,
-                                    to,
-                                    detail: format!("count = {c}"),
-                                });
-                            }
-                            Values::Count { from, to, count: *c as usize, log }
-                        }
-                        (Some(_), None) => return Err(wrong(path, &key("range.count"), "a non-negative integer")),
-                        (None, Some(step)) if !log => Values::Step { from, to, step },
-                        (None, Some(_)) => {
-                            return Err(wrong(path, &key("range.step"), "no step with spacing = \"log\" (use count)"))
-                        }
-                        (Some(_), Some(_)) => {
-                            return Err(wrong(path, &key("range"), "either `count` or `step`, not both"))
-                        }
-                        (None, None) => {
-                            return Err(SweepError::MissingKey {
-                                path: path.to_path_buf(),
-                                key: key("range.count (or range.step)"),
-                            })
-                        }
-                    }
-                }
-                (None, Some(_)) => return Err(wrong(path, &key("range"), "a table { from, to, count | step }")),
-                (None, None) => {
-                    return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("values (or range)") })
-                }
-            };
-            total = total.saturating_mul(values.len_before_expanding());
-            // the soft limit too (unless --allow-large): every axis value is validated below,
-            // which costs ~2 us a value (fuzzing found a 1.3 M-value axis taking 2.9 s to refuse)
-            let limit = if crate::budget::allow_large() { MAX_POINTS } else { crate::budget::MAX_SWEEP_POINTS };
-            if total > limit as u128 {
-                return Err(SweepError::TooManyPoints { points: total, limit });
-            }
-            let values = values.expand(&parameter.name())?;
-            let label = match t.get("label") {
-                Some(Value::String(s)) => s.clone(),
-                Some(_) => return Err(wrong(path, &key("label"), "a string")),
-                None => parameter.latex(),
-            };
-            axes.push(Axis { parameter, values, label });
-        }
-        let total = axes.iter().fold(1u128, |acc, a| acc.saturating_mul(a.values.len() as u128));
-        if total > MAX_POINTS as u128 {
-            return Err(SweepError::TooManyPoints { points: total, limit: MAX_POINTS });
-        }
+        let axes = parse_axes(path, &root, &base)?;
         let evaluate = match root.get("evaluate") {
             Some(Value::Table(t)) => t.clone(),
             Some(_) => return Err(wrong(path, "evaluate", "a table")),
             None => Table::new(),
         };
-        let mut table = TableSettings::default();
-        match root.get("table") {
-            None => {}
-            Some(Value::Table(t)) => {
-                check_keys(path, t, "table.", "columns, digits, caption")?;
-                if let Some(c) = t.get("columns") {
-                    let Value::Array(c) = c else {
-                        return Err(wrong(path, "table.columns", "an array of column names"));
-                    };
-                    table.columns = Some(
-                        c.iter()
-                            .map(|v| {
-                                v.as_str()
-                                    .map(String::from)
-                                    .ok_or_else(|| wrong(path, "table.columns", "an array of column names"))
-                            })
-                            .collect::<Result<_, _>>()?,
-                    );
-                }
-                if let Some(d) = t.get("digits") {
-                    let d = d.as_integer().ok_or_else(|| wrong(path, "table.digits", "an integer"))?;
-                    if !(1..=17).contains(&d) {
-                        return Err(SweepError::BadDigits { digits: d, source_key: "[table] digits =" });
-                    }
-                    table.digits = d as usize;
-                }
-                if let Some(c) = t.get("caption") {
-                    table.caption =
-                        Some(c.as_str().ok_or_else(|| wrong(path, "table.caption", "a string"))?.to_string());
-                }
-            }
-            Some(_) => return Err(wrong(path, "table", "a table")),
-        }
+        let table = parse_table_settings(path, root.get("table"))?;
         let spec = Self {
             path: path.to_path_buf(),
             name,
@@ -348,4 +208,155 @@ impl Fnv {
             self.0 = self.0.wrapping_mul(0x100000001b3);
         }
     }
+}
+
+/// The `[[axis]]` tables, each expanded; the number of grid points is checked before each axis
+/// is expanded, so that no list longer than the limit is ever built.
+fn parse_axes(path: &Path, root: &Table, base: &model::System) -> Result<Vec<Axis>, SweepError> {
+    let axes_v = match root.get("axis") {
+        Some(Value::Array(a)) => a,
+        Some(_) => return Err(wrong(path, "axis", "an array of tables ([[axis]])")),
+        None => return Err(SweepError::NoAxes),
+    };
+    if axes_v.is_empty() {
+        return Err(SweepError::NoAxes);
+    }
+    let mut axes: Vec<Axis> = Vec::new();
+    let mut total: u128 = 1;
+    for (k, a) in axes_v.iter().enumerate() {
+        let key = |s: &str| format!("axis[{k}].{s}");
+        let Value::Table(t) = a else { return Err(wrong(path, &format!("axis[{k}]"), "a table")) };
+        check_keys(path, t, &format!("axis[{k}]."), "parameter, values, range, label")?;
+        let pname = match t.get("parameter") {
+            Some(Value::String(s)) => s.clone(),
+            Some(_) => return Err(wrong(path, &key("parameter"), "a string")),
+            None => return Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("parameter") }),
+        };
+        let parameter = Parameter::parse(&pname)?;
+        parameter.check_applicable(base)?;
+        if axes.iter().any(|x| x.parameter == parameter) {
+            return Err(SweepError::DuplicateAxis { name: parameter.name() });
+        }
+        let values = parse_values(path, &key, t, &parameter)?;
+        total = total.saturating_mul(values.len_before_expanding());
+        // the soft limit too (unless --allow-large): every axis value is validated below,
+        // which costs ~2 us a value (fuzzing found a 1.3 M-value axis taking 2.9 s to refuse)
+        let limit = if crate::budget::allow_large() { MAX_POINTS } else { crate::budget::MAX_SWEEP_POINTS };
+        if total > limit as u128 {
+            return Err(SweepError::TooManyPoints { points: total, limit });
+        }
+        let values = values.expand(&parameter.name())?;
+        let label = match t.get("label") {
+            Some(Value::String(s)) => s.clone(),
+            Some(_) => return Err(wrong(path, &key("label"), "a string")),
+            None => parameter.latex(),
+        };
+        axes.push(Axis { parameter, values, label });
+    }
+    let total = axes.iter().fold(1u128, |acc, a| acc.saturating_mul(a.values.len() as u128));
+    if total > MAX_POINTS as u128 {
+        return Err(SweepError::TooManyPoints { points: total, limit: MAX_POINTS });
+    }
+    Ok(axes)
+}
+
+/// An axis's `values = [...]` or `range = { ... }` (not expanded).
+fn parse_values(
+    path: &Path,
+    key: &dyn Fn(&str) -> String,
+    t: &Table,
+    parameter: &Parameter,
+) -> Result<Values, SweepError> {
+    match (t.get("values"), t.get("range")) {
+        (Some(_), Some(_)) => Err(wrong(path, &key("values"), "either `values` or `range`, not both")),
+        (Some(Value::Array(v)), None) => Ok(Values::List(
+            v.iter()
+                .map(|x| num(x).ok_or_else(|| wrong(path, &key("values"), "an array of numbers")))
+                .collect::<Result<_, _>>()?,
+        )),
+        (Some(_), None) => Err(wrong(path, &key("values"), "an array of numbers")),
+        (None, Some(Value::Table(r))) => parse_range(path, key, r, parameter),
+        (None, Some(_)) => Err(wrong(path, &key("range"), "a table { from, to, count | step }")),
+        (None, None) => Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("values (or range)") }),
+    }
+}
+
+/// An axis's `range = { from, to, count | step, spacing }`.
+fn parse_range(
+    path: &Path,
+    key: &dyn Fn(&str) -> String,
+    r: &Table,
+    parameter: &Parameter,
+) -> Result<Values, SweepError> {
+    check_keys(path, r, &key("range."), "from, to, count, step, spacing")?;
+    let g = |s: &str| -> Result<Option<f64>, SweepError> {
+        match r.get(s) {
+            None => Ok(None),
+            Some(v) => num(v).map(Some).ok_or_else(|| wrong(path, &key(&format!("range.{s}")), "a number")),
+        }
+    };
+    let need = |s: &str| -> Result<f64, SweepError> {
+        g(s)?.ok_or_else(|| SweepError::MissingKey { path: path.to_path_buf(), key: key(&format!("range.{s}")) })
+    };
+    let (from, to) = (need("from")?, need("to")?);
+    let log = match r.get("spacing") {
+        None => false,
+        Some(Value::String(s)) if s == "linear" => false,
+        Some(Value::String(s)) if s == "log" => true,
+        Some(_) => return Err(wrong(path, &key("range.spacing"), "\"linear\" or \"log\"")),
+    };
+    match (r.get("count"), g("step")?) {
+        (Some(Value::Integer(c)), None) => {
+            if *c < 0 {
+                return Err(SweepError::EmptyRange {
+                    name: parameter.name(),
+                    from,
+                    to,
+                    detail: format!("count = {c}"),
+                });
+            }
+            Ok(Values::Count { from, to, count: *c as usize, log })
+        }
+        (Some(_), None) => Err(wrong(path, &key("range.count"), "a non-negative integer")),
+        (None, Some(step)) if !log => Ok(Values::Step { from, to, step }),
+        (None, Some(_)) => Err(wrong(path, &key("range.step"), "no step with spacing = \"log\" (use count)")),
+        (Some(_), Some(_)) => Err(wrong(path, &key("range"), "either `count` or `step`, not both")),
+        (None, None) => {
+            Err(SweepError::MissingKey { path: path.to_path_buf(), key: key("range.count (or range.step)") })
+        }
+    }
+}
+
+/// The `[table]` settings (columns, digits, caption).
+fn parse_table_settings(path: &Path, v: Option<&Value>) -> Result<TableSettings, SweepError> {
+    let mut table = TableSettings::default();
+    let t = match v {
+        None => return Ok(table),
+        Some(Value::Table(t)) => t,
+        Some(_) => return Err(wrong(path, "table", "a table")),
+    };
+    check_keys(path, t, "table.", "columns, digits, caption")?;
+    if let Some(c) = t.get("columns") {
+        let Value::Array(c) = c else {
+            return Err(wrong(path, "table.columns", "an array of column names"));
+        };
+        table.columns = Some(
+            c.iter()
+                .map(|v| {
+                    v.as_str().map(String::from).ok_or_else(|| wrong(path, "table.columns", "an array of column names"))
+                })
+                .collect::<Result<_, _>>()?,
+        );
+    }
+    if let Some(d) = t.get("digits") {
+        let d = d.as_integer().ok_or_else(|| wrong(path, "table.digits", "an integer"))?;
+        if !(1..=17).contains(&d) {
+            return Err(SweepError::BadDigits { digits: d, source_key: "[table] digits =" });
+        }
+        table.digits = d as usize;
+    }
+    if let Some(c) = t.get("caption") {
+        table.caption = Some(c.as_str().ok_or_else(|| wrong(path, "table.caption", "a string"))?.to_string());
+    }
+    Ok(table)
 }
