@@ -740,14 +740,39 @@ where
         .map_err(|e| err(&e))?;
     let (xr, yr) = chart.plotting_area().get_pixel_range();
     let base = root.get_base_pixel();
-    let (pl, pr) = (xr.start - base.0, xr.end - base.0);
-    let (pt, pb) = (yr.start - base.1, yr.end - base.1);
-    // as many ticks as fit their labels
-    let nx = ((pr - pl) / (widest_tick(x0, x1, st.tick) + 2 * st.gap).max(1)).clamp(2, 12) as usize;
-    let ny = ((pb - pt) / (2 * line_h(st.tick)).max(1)).clamp(2, 12) as usize;
-    // at least two labelled ticks (a scale to read) where their labels fit one above the other:
+    let plot = PlotBox { l: xr.start - base.0, r: xr.end - base.0, t: yr.start - base.1, b: yr.end - base.1 };
+    draw_mesh(&mut chart, &st, plot, (x0, x1), (y0, y1)).map_err(|e| err(&e))?;
+    draw_axis_labels(root, &lay, plot, y_area).map_err(|e| err(&e))?;
+    draw_elements(root, &mut chart, f, &st, plot).map_err(|e| err(&e))?;
+    draw_legend(root, f, &lay, plot).map_err(|e| err(&e))
+}
+
+/// The plotting area's pixel box within its panel: left, right, top and bottom edges.
+#[derive(Debug, Clone, Copy)]
+struct PlotBox {
+    l: i32,
+    r: i32,
+    t: i32,
+    b: i32,
+}
+
+type Chart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// Grid, axes and tick labels: as many ticks as fit their labels, at least two labelled ones
+/// on the y axis where their labels fit one above the other.
+fn draw_mesh<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    st: &Style,
+    plot: PlotBox,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> DrawResult<DB> {
+    let nx = ((plot.r - plot.l) / (widest_tick(x0, x1, st.tick) + 2 * st.gap).max(1)).clamp(2, 12) as usize;
+    let ny = ((plot.b - plot.t) / (2 * line_h(st.tick)).max(1)).clamp(2, 12) as usize;
     // a short panel's two "nice" ticks over [-0.45, 0.35] are 0 alone
-    let fit = ((pb - pt) / line_h(st.tick).max(1)).clamp(2, 12) as usize;
+    let fit = ((plot.b - plot.t) / line_h(st.tick).max(1)).clamp(2, 12) as usize;
     let ny = (ny..=fit.max(ny))
         .find(|&n| plotters::coord::types::RangedCoordf64::from(y0..y1).key_points(n).len() >= 2)
         .unwrap_or(ny);
@@ -765,19 +790,38 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .axis_style(BLACK.stroke_width((st.line / 2).max(1)))
         .draw()
-        .map_err(|e| err(&e))?;
-    // axis labels: the x label centred under the tick labels, the y label left of them (each
-    // broken into lines when longer than the plot)
+}
+
+/// The axis labels: the x label centred under the tick labels, the y label left of them (each
+/// broken into lines when longer than the plot).
+fn draw_axis_labels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    lay: &PanelLayout,
+    plot: PlotBox,
+    y_area: i32,
+) -> DrawResult<DB> {
+    let st = lay.st;
     let lh = line_h(st.label);
-    let x_label_top = pb + 2 * st.tick_mark + line_h(st.tick) + st.gap / 2;
+    let x_label_top = plot.b + 2 * st.tick_mark + line_h(st.tick) + st.gap / 2;
     for (i, l) in lay.x_lines.iter().enumerate() {
         let xw = rich_width(l, st.label);
-        draw_rich(root, l, ((pl + pr - xw) / 2, x_label_top + lh * i as i32), st.label).map_err(|e| err(&e))?;
+        draw_rich(root, l, ((plot.l + plot.r - xw) / 2, x_label_top + lh * i as i32), st.label)?;
     }
     for (i, l) in lay.y_lines.iter().enumerate() {
-        let left = pl - y_area + st.gap / 2 + lh * i as i32;
-        draw_rich_vertical(root, l, left, (pt + pb) / 2, st.label).map_err(|e| err(&e))?;
+        let left = plot.l - y_area + st.gap / 2 + lh * i as i32;
+        draw_rich_vertical(root, l, left, (plot.t + plot.b) / 2, st.label)?;
     }
+    Ok(())
+}
+
+/// The figure's bands, polygons, lines and markers (with their texts).
+fn draw_elements<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &mut Chart<'_, DB>,
+    f: &Figure,
+    st: &Style,
+    plot: PlotBox,
+) -> DrawResult<DB> {
     let dash = ((4 * st.line) as f64 * 2.0).max(4.0);
     let mut placed: Vec<(i32, i32, i32, i32)> = vec![];
     for e in &f.elements {
@@ -785,67 +829,77 @@ where
             Element::Band { x, lo, hi, color, .. } => {
                 let mut pts: Vec<(f64, f64)> = x.iter().zip(hi).map(|(&a, &b)| (a, b)).collect();
                 pts.extend(x.iter().zip(lo).rev().map(|(&a, &b)| (a, b)));
-                chart
-                    .draw_series(std::iter::once(Polygon::new(finite(&pts), color.mix(0.22).filled())))
-                    .map_err(|e| err(&e))?;
+                chart.draw_series(std::iter::once(Polygon::new(finite(&pts), color.mix(0.22).filled())))?;
             }
             Element::Polygon { pts, color, .. } => {
-                chart
-                    .draw_series(std::iter::once(Polygon::new(finite(pts), color.mix(0.12).filled())))
-                    .map_err(|e| err(&e))?;
+                chart.draw_series(std::iter::once(Polygon::new(finite(pts), color.mix(0.12).filled())))?;
             }
             Element::Line { pts, color, dashed, .. } => {
                 let style = color.stroke_width(st.line);
                 if *dashed {
-                    chart
-                        .draw_series(DashedLineSeries::new(finite(pts), dash as u32, (0.75 * dash) as u32, style))
-                        .map_err(|e| err(&e))?;
+                    chart.draw_series(DashedLineSeries::new(finite(pts), dash as u32, (0.75 * dash) as u32, style))?;
                 } else {
-                    chart.draw_series(LineSeries::new(finite(pts), style)).map_err(|e| err(&e))?;
+                    chart.draw_series(LineSeries::new(finite(pts), style))?;
                 }
             }
             Element::Markers { pts, text, color, .. } => {
-                chart
-                    .draw_series(finite(pts).into_iter().map(|p| Circle::new(p, st.marker, color.filled())))
-                    .map_err(|e| err(&e))?;
-                // each text beside its marker, at the first place (above right, above left,
-                // below right, below left) inside the plot and clear of the texts placed before
+                chart.draw_series(finite(pts).into_iter().map(|p| Circle::new(p, st.marker, color.filled())))?;
+                let base = root.get_base_pixel();
                 for (p, t) in pts.iter().zip(text) {
                     if !(p.0.is_finite() && p.1.is_finite()) || t.is_empty() {
                         continue;
                     }
                     let c = chart.backend_coord(p);
-                    let (cx, cy) = (c.0 - base.0, c.1 - base.1);
-                    let (w, h, r) = (rich_width(t, st.legend), line_h(st.legend), st.marker as i32 + 2);
-                    let candidates =
-                        [(cx + r, cy - r - h), (cx - r - w, cy - r - h), (cx + r, cy + r), (cx - r - w, cy + r)];
-                    let inside = |&(x, y): &(i32, i32)| x >= pl && y >= pt && x + w <= pr && y + h <= pb;
-                    let free = |&(x, y): &(i32, i32)| {
-                        placed.iter().all(|&(a, b, c, d)| x + w <= a || c <= x || y + h <= b || d <= y)
-                    };
-                    let at = candidates
-                        .iter()
-                        .find(|c| inside(c) && free(c))
-                        .or_else(|| candidates.iter().find(|c| inside(c)))
-                        .copied()
-                        .unwrap_or((cx.clamp(pl, (pr - w).max(pl)), (cy - r - h).clamp(pt, (pb - h).max(pt))));
-                    placed.push((at.0, at.1, at.0 + w, at.1 + h));
-                    draw_rich(root, t, at, st.legend).map_err(|e| err(&e))?;
+                    let at = marker_text_place((c.0 - base.0, c.1 - base.1), t, st, plot, &placed);
+                    placed.push((at.0, at.1, at.0 + rich_width(t, st.legend), at.1 + line_h(st.legend)));
+                    draw_rich(root, t, at, st.legend)?;
                 }
             }
         }
     }
-    // the legend in rows below the x-axis label, off the data
+    Ok(())
+}
+
+/// Where a marker's text goes: the first place (above right, above left, below right, below
+/// left of the marker at `(cx, cy)`) inside the plot and clear of the texts `placed` before,
+/// else the first inside the plot, else clamped into it.
+fn marker_text_place(
+    (cx, cy): (i32, i32),
+    t: &str,
+    st: &Style,
+    plot: PlotBox,
+    placed: &[(i32, i32, i32, i32)],
+) -> (i32, i32) {
+    let (w, h, r) = (rich_width(t, st.legend), line_h(st.legend), st.marker as i32 + 2);
+    let candidates = [(cx + r, cy - r - h), (cx - r - w, cy - r - h), (cx + r, cy + r), (cx - r - w, cy + r)];
+    let inside = |&(x, y): &(i32, i32)| x >= plot.l && y >= plot.t && x + w <= plot.r && y + h <= plot.b;
+    let free = |&(x, y): &(i32, i32)| placed.iter().all(|&(a, b, c, d)| x + w <= a || c <= x || y + h <= b || d <= y);
+    candidates
+        .iter()
+        .find(|c| inside(c) && free(c))
+        .or_else(|| candidates.iter().find(|c| inside(c)))
+        .copied()
+        .unwrap_or((cx.clamp(plot.l, (plot.r - w).max(plot.l)), (cy - r - h).clamp(plot.t, (plot.b - h).max(plot.t))))
+}
+
+/// The legend in rows below the x-axis label, off the data; the last row ends with "+ k more"
+/// when entries were left out.
+fn draw_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    f: &Figure,
+    lay: &PanelLayout,
+    plot: PlotBox,
+) -> DrawResult<DB> {
+    let st = lay.st;
     let sw = 2 * st.legend as i32;
-    let mut ly = pb + lay.x_area + st.gap / 2;
+    let mut ly = plot.b + lay.x_area + st.gap / 2;
     let more = (lay.more > 0).then(|| more_text(lay.more));
     for (r, row) in lay.legend.iter().enumerate() {
-        // the last row ends with "+ k more" when entries were left out
         let more = more.as_ref().filter(|_| r + 1 == lay.legend.len());
         let widths: Vec<i32> =
             row.iter().map(|&i| lay.entry_w[i]).chain(more.map(|t| rich_width(t, st.legend))).collect();
         let row_w: i32 = widths.iter().sum::<i32>() + 2 * st.gap * (widths.len() as i32 - 1);
-        let mut lx = (pl + pr - row_w) / 2;
+        let mut lx = (plot.l + plot.r - row_w) / 2;
         lx = lx.min(root.dim_in_pixel().0 as i32 - st.gap / 2 - row_w).max(st.gap / 2);
         let cy = ly + line_h(st.legend) / 2;
         for &i in row {
@@ -857,21 +911,19 @@ where
                     root.draw(&Rectangle::new([(lx, cy - m), (lx + sw, cy + m)], c.mix(0.3).filled()))
                 }
                 Element::Line { dashed: true, .. } => {
-                    root.draw(&PathElement::new(vec![(lx, cy), (lx + sw * 2 / 5, cy)], c.stroke_width(st.line)))
-                        .map_err(|e| err(&e))?;
+                    root.draw(&PathElement::new(vec![(lx, cy), (lx + sw * 2 / 5, cy)], c.stroke_width(st.line)))?;
                     root.draw(&PathElement::new(vec![(lx + sw * 3 / 5, cy), (lx + sw, cy)], c.stroke_width(st.line)))
                 }
                 Element::Line { .. } => {
                     root.draw(&PathElement::new(vec![(lx, cy), (lx + sw, cy)], c.stroke_width(st.line)))
                 }
                 Element::Markers { .. } => root.draw(&Circle::new((lx + sw / 2, cy), st.marker, c.filled())),
-            }
-            .map_err(|e| err(&e))?;
-            draw_rich(root, label, (lx + sw + st.gap / 2, ly), st.legend).map_err(|e| err(&e))?;
+            }?;
+            draw_rich(root, label, (lx + sw + st.gap / 2, ly), st.legend)?;
             lx += lay.entry_w[i] + 2 * st.gap;
         }
         if let Some(t) = more {
-            draw_rich(root, t, (lx, ly), st.legend).map_err(|e| err(&e))?;
+            draw_rich(root, t, (lx, ly), st.legend)?;
         }
         ly += lay.legend_row;
     }
