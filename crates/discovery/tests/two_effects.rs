@@ -193,3 +193,15 @@ fn an_effect_only_the_held_out_segment_shows_leaves_the_model_incomplete() {
     let none = run(&bench_gen::generate_profile("none", 9602, 3, Profile::Mixed));
     assert!(!none.model_incomplete && none.effects.is_empty(), "{}", none.verdict);
 }
+
+#[test]
+fn a_white_residual_off_zero_keeps_the_selection_going() {
+    // An input delay and a sensor offset (seed 9707, digital, case 0, white noise): read as the
+    // delay alone (+2276 in BIC), its residual white (Q = 19.8 against 37.6) about a mean off
+    // zero, so nothing was said to be left and delay + offset (+5164) was never fitted. A
+    // residual white about a non-zero mean is something left: the selection goes on.
+    let case = bench_gen::generate_pair(["input_delay", "sensor_offset"], 9707, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+    assert!(!r.model_incomplete, "{}", r.verdict);
+}

@@ -179,12 +179,17 @@ fn remaining(
     fitted: &Fitted,
 ) -> Option<Remaining> {
     let t = &fitted.residual_fitted;
-    if nominal.nominal_adequate || outcome.missing_inputs.iter().any(|c| c.missing) || t.white {
+    if nominal.nominal_adequate || outcome.missing_inputs.iter().any(|c| c.missing) {
         return None;
     }
     let (ctx, n, p) = (&pass.ctx, data.n_samp, data.p);
     let e_fit: Vec<f64> = ctx.y.iter().zip(&fitted.fit_sim.y).map(|(a, b)| a - b).collect();
     let (e_w, ar1) = crate::residual::prewhiten_ar1(&e_fit, n, p);
+    // a residual white about a mean off zero is something left too (a missing offset)
+    let mean_off_zero = crate::residual::mean_off_zero(&e_fit, n, p, &ar1, data.lag_step);
+    if t.white && !mean_off_zero {
+        return None;
+    }
     let t_w = data.residual_tests(&e_w, &ctx.w);
     let rms_over_noise: Vec<f64> = (0..p)
         .map(|i| {
@@ -196,11 +201,9 @@ fn remaining(
     let unconfirmed = verdict::unconfirmed_extension(&outcome.ranking, outcome.chosen.as_ref(), margin);
     let within_noise = rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO);
     let above_noise = rms_over_noise.iter().any(|&r| r > 1.0);
-    let rho = ar1.first().copied().unwrap_or(0.0);
-    let mean_off_zero = t.mean.abs() > t.mean_bound * ((1.0 + rho) / (1.0 - rho)).sqrt();
     let held_out = verdict::held_out_extension(&outcome.ranking, outcome.chosen.as_ref());
     let exempt =
-        (t_w.white && !mean_off_zero) || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise));
+        !mean_off_zero && (t_w.white || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)));
     if exempt && held_out.is_none() {
         return None;
     }

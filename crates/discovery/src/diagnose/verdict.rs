@@ -221,7 +221,8 @@ pub(super) fn still_missing(r: &Remaining, chosen: Option<&Ranked>, max_effects:
         (None, _) => String::new(),
     };
     format!(
-        "something is still missing: {whose} residual is not white (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed{}{}) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
+        "something is still missing: {whose} residual is {} (Q = {:.1} against {:.1} at the 1 % level, {:.1} with an AR(1) noise colour removed{}{}) and its RMS is {} times the noise level{at}; the model is incomplete{why}",
+        if r.q_auto <= r.q_auto_threshold { "white but not centred" } else { "not white" },
         r.q_auto,
         r.q_auto_threshold,
         r.q_auto_ar1,

@@ -140,6 +140,20 @@ pub fn test_outputs(e: &[f64], w: &[f64], n: usize, m: usize, p: usize, lags: us
     t.expect("p >= 1")
 }
 
+/// Whether some output's mean of the time-major residual `e` (`n` samples of `p` outputs) is
+/// off zero beyond its 1 % bound (blocks of `lag_step` samples, as [`test`]) widened for the
+/// output's AR(1) noise colour `rho[i]`: a mean of AR(1) noise has `(1 + rho) / (1 - rho)` times
+/// the variance of a mean of white noise. A missing offset leaves a residual that is white
+/// about a non-zero mean.
+pub fn mean_off_zero(e: &[f64], n: usize, p: usize, rho: &[f64], lag_step: usize) -> bool {
+    (0..p).any(|i| {
+        let ei: Vec<f64> = (0..n).map(|k| e[k * p + i]).collect();
+        let t = test(&ei, &[], 1, lag_step);
+        let r = rho.get(i).copied().unwrap_or(0.0).clamp(0.0, 0.99);
+        t.mean.abs() > t.mean_bound * ((1.0 + r) / (1.0 - r)).sqrt()
+    })
+}
+
 /// A time-major residual `e` (`n` samples of `p` outputs) with an AR(1) filter removed from
 /// each output: `e_k - rho e_{k-1}`, `rho` the output's lag-one autocorrelation (clamped to
 /// [0, 0.99]); the filtered residual and the `rho` of each output. Coloured measurement noise
@@ -198,6 +212,31 @@ mod tests {
         let o: Vec<f64> = e.iter().map(|a| a + 0.05).collect();
         let t = test(&o, &[u], 20, 1);
         assert!(t.white && !t.zero_mean, "{t:?}");
+    }
+
+    /// Two outputs, time-major: white noise about zero passes; an offset on the second output
+    /// alone is found; AR(1) noise (0.9) about zero passes once its colour widens the bound and
+    /// fails without (negative control: the widening is what lets coloured noise through).
+    #[test]
+    fn mean_off_zero_finds_an_offset_on_any_output_and_allows_for_colour() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let n = 4000;
+        let e: Vec<f64> = (0..2 * n).map(|_| rng.random::<f64>() - 0.5).collect();
+        assert!(!mean_off_zero(&e, n, 2, &[0.0, 0.0], 1));
+        let off: Vec<f64> = e.iter().enumerate().map(|(j, v)| v + if j % 2 == 1 { 0.05 } else { 0.0 }).collect();
+        assert!(mean_off_zero(&off, n, 2, &[0.0, 0.0], 1));
+        let (mut found_plain, mut found_widened) = (0, 0);
+        for seed in 0..20 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + seed);
+            let mut f = vec![0.0; n];
+            for k in 1..n {
+                f[k] = 0.9 * f[k - 1] + rng.random::<f64>() - 0.5;
+            }
+            found_plain += usize::from(mean_off_zero(&f, n, 1, &[0.0], 1));
+            found_widened += usize::from(mean_off_zero(&f, n, 1, &[0.9], 1));
+        }
+        assert!(found_widened <= 1, "{found_widened} of 20 coloured records called off zero");
+        assert!(found_plain >= 5, "only {found_plain} of 20: the widening is not what passes them");
     }
 
     #[test]

@@ -328,14 +328,16 @@ impl Selector<'_, '_> {
     }
 
     /// Whether `cur`'s residual says something is left: not white, nor once an AR(1) noise
-    /// colour is removed (coloured measurement noise alone passes then).
+    /// colour is removed (coloured measurement noise alone passes then); or white about a mean
+    /// off zero beyond what that colour allows (a missing offset).
     fn something_left(&self, cur: &Ranked) -> bool {
         let ctx = self.ctx;
         let Some((lags, step)) = self.plan.whiteness else { return false };
         let Some(sim) = cur.problem(ctx).simulate(&cur.params, &cur.x0, None) else { return false };
         let e: Vec<f64> = ctx.y.iter().zip(&sim.y).map(|(a, b)| a - b).collect();
         let test = |e: &[f64]| crate::residual::test_outputs(e, &ctx.w, ctx.n, ctx.m, ctx.p, lags, step).white;
-        !test(&e) && !test(&crate::residual::prewhiten_ar1(&e, ctx.n, ctx.p).0)
+        let (filtered, rho) = crate::residual::prewhiten_ar1(&e, ctx.n, ctx.p);
+        (!test(&e) && !test(&filtered)) || crate::residual::mean_off_zero(&e, ctx.n, ctx.p, &rho, step)
     }
 
     /// Where the greedy steps leave something (issue 27 item 4): the greedy second effect is
