@@ -205,3 +205,19 @@ fn a_white_residual_off_zero_keeps_the_selection_going() {
     assert_eq!(named(&case, &r), 2, "{}", r.verdict);
     assert!(!r.model_incomplete, "{}", r.verdict);
 }
+
+#[test]
+fn an_effect_chosen_over_a_close_single_is_swapped_for_it() {
+    // Coulomb friction and a sensor offset (seed 9711, digital, case 0): alone, a constant force
+    // (+1356 in BIC) beat the offset (+1321), so the greedy steps built constant force +
+    // Coulomb friction (+3084, residual white and centred) and the true pair was never fitted.
+    // With Coulomb friction in, the offset in place of the force gains 212 more.
+    let case = bench_gen::generate_pair(["coulomb_friction", "sensor_offset"], 9711, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+    // Negative control: where the force is the truth beside the friction, it is not swapped
+    // for the offset.
+    let case = bench_gen::generate_pair(["coulomb_friction", "constant_force"], 9711, 0, Profile::Digital).unwrap();
+    let r = run(&case);
+    assert!(r.effects.iter().all(|e| e.kind != "sensor_offset"), "{}", r.verdict);
+}

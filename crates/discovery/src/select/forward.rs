@@ -95,6 +95,13 @@ pub(crate) fn select_all(
                     }
                 }
             }
+            // An effect chosen over a single that fitted about as well alone, swapped for it.
+            let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| base_sse.clone());
+            let (better, swapped) = sel.swap_close_singles(&singles, &extra, &cur, &cur_sse);
+            extra.extend(swapped);
+            if let Some(b) = better {
+                cur = b;
+            }
             // Readings as good as the selected one: its generalisations' simpler forms, alone
             // or with another best single, fitted too where not yet fitted.
             let decomposed = sel.decompositions(&singles, &extra, &cur);
@@ -677,6 +684,70 @@ impl Selector<'_, '_> {
             .collect()
     }
 
+    /// A composite `cur` whose effects were chosen one at a time by their own fits (issue 27
+    /// item 4): an effect and a single that fitted about as well alone (its gain within
+    /// [`SWAP_WINDOW`] of the effect's own single's: a sensor offset against a constant force,
+    /// 1321 against 1356) are told apart only once the other effects are in. Each such single
+    /// in place of the effect, fitted from the other effects' estimates and its own single's;
+    /// the best that clear the margin against `cur` cross-validated against it until one
+    /// passes (returned); every swap fitted is returned for the ranking (readings within the
+    /// tie margin are then named as equivalent).
+    fn swap_close_singles(
+        &self,
+        singles: &[Ranked],
+        fitted: &[Ranked],
+        cur: &Ranked,
+        base_sse: &[f64],
+    ) -> (Option<Ranked>, Vec<Ranked>) {
+        let (ctx, plan) = (self.ctx, self.plan);
+        if cur.refit || cur.parts.len() < 2 {
+            return (None, vec![]);
+        }
+        let single_of =
+            |k: hypothesis::Kind| singles.iter().find(|r| r.parts.len() == 1 && !r.refit && r.parts[0].kind == k);
+        let known = |labels: &[String]| {
+            fitted.iter().chain(std::iter::once(cur)).any(|t| !t.refit && same_label_set(&label_list(t), labels))
+        };
+        let mut todo: Vec<(Vec<Hypothesis>, Vec<f64>)> = Vec::new();
+        for (i, g) in cur.parts.iter().enumerate() {
+            let Some(own) = single_of(g.kind) else { continue };
+            for s in singles.iter().filter(|r| r.parts.len() == 1 && !r.refit && r.status.conclusive()) {
+                let h = &s.parts[0];
+                let close = (own.delta_bic - s.delta_bic).abs() <= SWAP_WINDOW * own.delta_bic.abs();
+                if !close || cur.parts.iter().any(|p| rivals(p.kind, h.kind)) {
+                    continue;
+                }
+                let mut parts = cur.parts.clone();
+                parts[i] = h.clone();
+                let labels: Vec<String> = parts.iter().map(|h| h.kind.label()).collect();
+                if known(&labels) {
+                    continue;
+                }
+                let warm = parts
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| if j == i { Some(s.params.clone()) } else { part_params(cur, p.kind) })
+                    .collect::<Option<Vec<Vec<f64>>>>();
+                if let Some(w) = warm {
+                    todo.push((parts, w.concat()));
+                }
+            }
+        }
+        let f = |(parts, warm): &(Vec<Hypothesis>, Vec<f64>)| {
+            fit_hypothesis(ctx, plan, parts.clone(), None, Some(warm.clone()), &cur.x0, self.bic_nom, self.val_sse_nom)
+        };
+        let mut swapped: Vec<Ranked> =
+            if plan.parallel { todo.par_iter().map(f).collect() } else { todo.iter().map(f).collect() };
+        swapped.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+        let better = self.accept_combination(&mut swapped, cur, base_sse);
+        if let Some(b) = &better {
+            if let Some(r) = swapped.iter_mut().find(|r| r.label == b.label) {
+                r.beats_nominal = true;
+            }
+        }
+        (better, swapped)
+    }
+
     /// Cross-validates the best few combinations that clear the margin against `cur`, until
     /// one passes (returned).
     fn accept_combination(&self, combos: &mut [Ranked], cur: &Ranked, base_sse: &[f64]) -> Option<Ranked> {
@@ -700,6 +771,10 @@ impl Selector<'_, '_> {
 
 /// How many of the best singles the pair search draws its pairs from.
 pub const PAIR_POOL: usize = 6;
+
+/// How close two singles' gains over the nominal must be (relative to the selected effect's
+/// own single) for [`Selector::swap_close_singles`] to try one in place of the other.
+pub const SWAP_WINDOW: f64 = 0.1;
 
 /// The pair search's starts: both singles' estimates times each of these.
 pub const PAIR_START_SCALES: [f64; 3] = [1.0, 0.6, 0.3];
