@@ -70,10 +70,16 @@ pub(crate) fn select_all(
         sel.prefer_simpler_form(&mut singles, &nominal_ranked, &base_sse, &mut cv_rejected);
         // `max_effects` bounds the effects of the selected model, the first one included (0:
         // the nominal model, refitted where it frees parameters, and nothing added)
-        if let Some(best) = singles.iter().find(|r| r.beats_nominal && r.parts.len() <= plan.max_effects) {
-            ties = sel.ties(&singles, best);
-            let (mut cur, tried) = sel.forward(&singles, best.clone(), &base_sse);
-            extra = tried;
+        let first = singles.iter().find(|r| r.beats_nominal && r.parts.len() <= plan.max_effects).cloned();
+        let first = first.or_else(|| {
+            let (pair, pairs) = sel.pair_from_nominal(&singles, &nominal_ranked);
+            extra = pairs;
+            pair
+        });
+        if let Some(best) = first {
+            ties = sel.ties(&singles, &best);
+            let (mut cur, tried) = sel.forward(&singles, best, &base_sse);
+            extra.extend(tried);
             // Something left after the greedy steps: pairs of the best singles, fitted jointly;
             // then, still something left and room for it, every single beside the model.
             if plan.max_effects >= 2 && sel.something_left(&cur) {
@@ -345,6 +351,19 @@ impl Selector<'_, '_> {
         let test = |e: &[f64]| crate::residual::test_outputs(e, &ctx.w, ctx.n, ctx.m, ctx.p, lags, step).white;
         let (filtered, rho) = crate::residual::prewhiten_ar1(&e, ctx.n, ctx.p);
         (!test(&e) && !test(&filtered)) || crate::residual::mean_off_zero(&e, ctx.n, ctx.p, &rho, step)
+    }
+
+    /// Where no single passes against the nominal model but its residual still says something
+    /// is left (not white, nor white once an AR(1) colour is removed, or off zero): two effects
+    /// that cancel where the record dwells (a constant force and a sensor offset, a backlash and
+    /// an input saturation) each fit badly alone and show only together. The pair search
+    /// against the nominal model, at least two effects allowed: the pair accepted (if any) and
+    /// every pair fitted.
+    fn pair_from_nominal(&self, singles: &[Ranked], nominal: &Ranked) -> (Option<Ranked>, Vec<Ranked>) {
+        if self.plan.max_effects < 2 || !self.something_left(nominal) {
+            return (None, vec![]);
+        }
+        self.pair_search(singles, &[], nominal)
     }
 
     /// Where the greedy steps leave something (issue 27 item 4): the greedy second effect is
