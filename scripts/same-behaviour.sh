@@ -3,13 +3,15 @@
 #
 #   bash scripts/same-behaviour.sh REV_BEFORE REV_AFTER
 #
-# builds the CLI of both revisions (release, in worktrees under a temporary folder, sharing this
-# checkout's target/ so the dependencies compile once) and runs on each: `moreau theta` (table
+# builds the CLI of both revisions (release, in worktrees under a temporary folder, in a target
+# folder of their own, target/same-behaviour/, so the dependencies compile once for both; not in
+# target/ itself: cargo hashes a workspace crate without its path, and a worktree build newer
+# than this checkout's sources would be taken as this checkout's build) and runs on each: `moreau theta` (table
 # and --json) on every examples/*.toml, `simulate` of the worked example, the amplitude sweep
 # (examples/sweeps/amplitude.toml) and `discover-bench --cases 1 --seed 2626`. It then lists each
 # output file as identical or differing; run times ("(0.5 s;", "seconds": ..., "diagnosis
 # time") and the output folder's name are blanked before comparing. Exit code 1 if any file
-# differs after that. Takes about 6 minutes of two cores beyond the builds.
+# differs after that. The runs take about 1 minute; the first build about 5 more (the dependencies).
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: $0 REV_BEFORE REV_AFTER" >&2; exit 2; }
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -25,8 +27,8 @@ blank_times() {
 for side in before after; do
     rev=$1; [ $side = after ] && rev=$2
     git -C "$repo" worktree add -q --detach "$work/$side" "$rev"
-    (cd "$work/$side" && CARGO_TARGET_DIR="$repo/target" cargo build -q --release --locked -p moreau)
-    cp "$repo/target/release/moreau" "$work/moreau-$side"
+    (cd "$work/$side" && CARGO_TARGET_DIR="$repo/target/same-behaviour" cargo build -q --release --locked -p moreau)
+    cp "$repo/target/same-behaviour/release/moreau" "$work/moreau-$side"
     out="$work/out-$side"; mkdir -p "$out"; bin="$work/moreau-$side"
     cd "$work/$side"
     for m in examples/*.toml; do
