@@ -207,3 +207,16 @@ def test_every_example_loads_and_converts(tmp_path):
         s = moreau.load(f)
         rebuilt = moreau.System(s.A, s.B, s.C, s.E, name=s.name)
         assert rebuilt.n == s.n and rebuilt.p == s.p
+
+
+def test_a_multisine_input_is_the_model_files_and_is_certified():
+    ms = moreau.Multisine([1.0], omega=1.0, harmonics=[1, 3, 5], weights=[1.0, 0.3, 0.1], phases=[0.0, 0.4, 1.0])
+    sys = worked(input=ms)
+    assert sys.period == pytest.approx(2 * np.pi)
+    t = np.array([0.3, 1.7])
+    expect = np.sin(t) + 0.3 * np.sin(3 * t + 0.4) + 0.1 * np.sin(5 * t + 1.0)
+    assert np.allclose(sys.w(t)[:, 0], expect)
+    r = moreau.theta(sys, measure=False)
+    assert r.theta_verified and r.theta < 0
+    with pytest.raises(moreau.MoreauError, match=r"input\.harmonics\[0\].*whole multiple"):
+        worked(input=moreau.Multisine([1.0], omega=1.0, harmonics=[0.5]))

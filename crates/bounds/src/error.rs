@@ -9,7 +9,7 @@ pub enum BoundsError {
     #[error("F = A + E C is not Hurwitz: mu = max Re eig(F) = {mu} >= 0 (eq. (stab)); theta does not exist")]
     NotHurwitz { mu: f64 },
     /// The input has no period: Theorem 2 and eq. (theta) need a T-periodic input.
-    #[error("the input `{kind}` has no period: theta (eq. (theta)) needs a T-periodic input (sine, square, or csv with `period`)")]
+    #[error("the input `{kind}` has no period: theta (eq. (theta)) needs a T-periodic input (sine, square, multisine, or csv with `period`)")]
     NoPeriod { kind: &'static str },
     /// A settings field is out of range.
     #[error("setting `{name}` = {value} is out of range: {reason}")]

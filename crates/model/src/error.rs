@@ -21,7 +21,7 @@ pub enum ModelError {
     Ragged { key: String, first: usize, row: usize, len: usize },
     #[error("key `theta.shape`: unknown shape {:?} (known: interval, ball, ellipsoid, ball_intersection, polytope, box, point)", clip(value))]
     UnknownShape { value: String },
-    #[error("key `input.kind`: unknown input {:?} (known: sine, square, csv, zero)", clip(value))]
+    #[error("key `input.kind`: unknown input {:?} (known: sine, square, multisine, csv, zero)", clip(value))]
     UnknownInput { value: String },
     #[error("key `{}`: {source}", clip(key))]
     Geometry { key: String, source: geometry::GeometryError },

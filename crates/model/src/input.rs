@@ -12,9 +12,61 @@ pub enum Input {
     Sine { amplitudes: Vec<f64>, omega: f64, phase: f64 },
     /// `w_i(t) = a_i sign(sin(omega t + phase))` (value `+a_i` at the jumps); period `2 pi / omega`.
     Square { amplitudes: Vec<f64>, omega: f64, phase: f64 },
+    /// A sum of harmonics of `omega`: `w_i(t) = a_i sum_j c_j sin(k_j (omega t + phase) + phi_j)`
+    /// (harmonic `j`: multiple `k_j`, weight `c_j`, phase `phi_j`); period `2 pi / omega`.
+    Multisine { amplitudes: Vec<f64>, omega: f64, phase: f64, harmonics: Vec<Harmonic> },
     /// Samples `(t_k, w_k)` from a CSV file, linearly interpolated, held constant outside the
     /// sampled range. Periodic only if a `period` is stated.
     Samples { path: String, t: Vec<f64>, w: Vec<Vec<f64>>, period: Option<f64> },
+}
+
+/// One term of a [`Input::Multisine`]: `weight sin(k (omega t + phase) + phase_k)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    /// The multiple of the fundamental `omega` (at least 1).
+    pub k: u32,
+    /// Weight `c` (relative amplitude; the input's `amplitudes` scale the sum).
+    pub weight: f64,
+    /// Phase `phi` of this harmonic (radians), added to `k` times the input's own phase.
+    pub phase: f64,
+}
+
+/// Most harmonics a multisine may have (each costs a complex solve in the closed form of
+/// `eta_T` and a sine per sample).
+pub const MAX_HARMONICS: usize = 256;
+
+/// Checks the harmonics of a multisine: at least one, `k` from 1 to 10^6 and distinct, finite
+/// weights (not all 0) and phases.
+pub fn check_harmonics(harmonics: &[Harmonic]) -> Result<(), ModelError> {
+    let bad = |key: &str, value: f64, reason: &'static str| {
+        Err(ModelError::OutOfRange { key: format!("input.{key}"), value, reason })
+    };
+    if harmonics.is_empty() || harmonics.len() > MAX_HARMONICS {
+        return bad("harmonics", harmonics.len() as f64, "a multisine needs 1 to 256 harmonics");
+    }
+    for (j, h) in harmonics.iter().enumerate() {
+        if h.k == 0 || h.k > 1_000_000 {
+            return bad("harmonics", h.k as f64, "each harmonic is a whole multiple of omega from 1 to 10^6");
+        }
+        if harmonics[..j].iter().any(|g| g.k == h.k) {
+            return bad("harmonics", h.k as f64, "each harmonic may appear once");
+        }
+        if !h.weight.is_finite() {
+            return bad("weights", h.weight, "weights must be finite");
+        }
+        if !h.phase.is_finite() {
+            return bad("phases", h.phase, "phases must be finite");
+        }
+    }
+    if harmonics.iter().all(|h| h.weight == 0.0) {
+        return bad("weights", 0.0, "at least one weight must be non-zero");
+    }
+    Ok(())
+}
+
+/// `sum_j c_j sin(k_j theta + phi_j)`, the waveform of a multisine at `theta = omega t + phase`.
+pub fn multisine_wave(harmonics: &[Harmonic], theta: f64) -> f64 {
+    harmonics.iter().map(|h| h.weight * (h.k as f64 * theta + h.phase).sin()).sum()
 }
 
 impl Input {
@@ -22,7 +74,9 @@ impl Input {
     pub fn m(&self) -> usize {
         match self {
             Input::Zero { m } => *m,
-            Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } => amplitudes.len(),
+            Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } | Input::Multisine { amplitudes, .. } => {
+                amplitudes.len()
+            }
             Input::Samples { w, .. } => w[0].len(),
         }
     }
@@ -31,7 +85,9 @@ impl Input {
     pub fn period(&self) -> Option<f64> {
         match self {
             Input::Zero { .. } => None,
-            Input::Sine { omega, .. } | Input::Square { omega, .. } => Some(TAU / omega),
+            Input::Sine { omega, .. } | Input::Square { omega, .. } | Input::Multisine { omega, .. } => {
+                Some(TAU / omega)
+            }
             Input::Samples { period, .. } => *period,
         }
     }
@@ -41,6 +97,7 @@ impl Input {
             Input::Zero { .. } => "zero",
             Input::Sine { .. } => "sine",
             Input::Square { .. } => "square",
+            Input::Multisine { .. } => "multisine",
             Input::Samples { .. } => "csv",
         }
     }
@@ -55,6 +112,10 @@ impl Input {
             }
             Input::Square { amplitudes, omega, phase } => {
                 let s = if (omega * t + phase).rem_euclid(TAU) < std::f64::consts::PI { 1.0 } else { -1.0 };
+                out.iter_mut().zip(amplitudes).for_each(|(o, a)| *o = a * s);
+            }
+            Input::Multisine { amplitudes, omega, phase, harmonics } => {
+                let s = multisine_wave(harmonics, omega * t + phase);
                 out.iter_mut().zip(amplitudes).for_each(|(o, a)| *o = a * s);
             }
             Input::Samples { t: ts, w, period, .. } => {
@@ -251,6 +312,34 @@ mod tests {
         let q = Input::Square { amplitudes: vec![1.0, -3.0], omega: 1.0, phase: 0.0 };
         assert_eq!(q.at(1.0), vec![1.0, -3.0]);
         assert_eq!(q.at(4.0), vec![-1.0, 3.0]);
+    }
+
+    #[test]
+    fn a_multisine_sums_its_harmonics_and_its_checks_name_the_bad_value() {
+        let h = |k, weight, phase| Harmonic { k, weight, phase };
+        let w = Input::Multisine {
+            amplitudes: vec![2.0],
+            omega: 1.0,
+            phase: 0.5,
+            harmonics: vec![h(1, 1.0, 0.0), h(3, 0.25, 1.0)],
+        };
+        assert_eq!(w.period(), Some(TAU));
+        assert_eq!(w.kind(), "multisine");
+        let t = 0.7;
+        let expect = 2.0 * ((t + 0.5f64).sin() + 0.25 * (3.0 * (t + 0.5) + 1.0f64).sin());
+        assert!((w.at(t)[0] - expect).abs() < 1e-15);
+        assert!((w.at(t + TAU)[0] - expect).abs() < 1e-12);
+        assert!(check_harmonics(&[h(1, 1.0, 0.0), h(2, 0.5, 0.0)]).is_ok());
+        for (bad, word) in [
+            (vec![], "1 to 256"),
+            (vec![h(0, 1.0, 0.0)], "whole multiple"),
+            (vec![h(2, 1.0, 0.0), h(2, 1.0, 0.0)], "once"),
+            (vec![h(1, f64::NAN, 0.0)], "finite"),
+            (vec![h(1, 0.0, 0.0)], "non-zero"),
+        ] {
+            let e = check_harmonics(&bad).unwrap_err().to_string();
+            assert!(e.contains(word), "{e}");
+        }
     }
 
     #[test]

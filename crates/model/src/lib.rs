@@ -3,7 +3,7 @@
 //! model-file format that describes it.
 //!
 //! - [`system`]: the validated [`System`] and its linearisation `F = A + E C` (eq. (F)).
-//! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, samples from a CSV).
+//! - [`input`]: the input signal `w(t)` ([`Input`]: sine, square wave, multisine, samples from a CSV).
 //! - [`fit`]: `[fit]`, the nominal parameters a grey-box refit may free ([`FitSpec`]) and the
 //!   refits recorded in a fitted model.
 //! - [`parameters`]: `[parameters]`, named physical constants and the numbers of the file

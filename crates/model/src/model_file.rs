@@ -11,7 +11,7 @@
 //! shape = "interval"          # interval | ball | ellipsoid | ball_intersection | polytope | box | point
 //! half_width = 0.1            # or lo/hi
 //! [input]
-//! kind = "sine"               # sine | square | csv | zero
+//! kind = "sine"               # sine | square | multisine | csv | zero
 //! amplitudes = [1.0]
 //! omega = 1.0
 //! [initial]
@@ -54,6 +54,7 @@
 //! reference = "w1"            # output i tracks this input (servo loops): tracking-error metrics
 //! ```
 pub use crate::fit::{parse_param_name, FitRecord, FitSpec, FreeParam, FreeTarget, PlantMatrix};
+use crate::input::Harmonic;
 use crate::parameters::{Parameters, Place};
 pub use crate::signals::Signals;
 use crate::system::{check_step, SimDefaults, System};
@@ -269,6 +270,12 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
                 Input::Square { amplitudes, omega, phase }
             }
         }
+        "multisine" => {
+            check_keys(t, pre, "kind, amplitudes, omega, phase, harmonics, weights, phases")?;
+            let amplitudes = vec_at(t, pre, "amplitudes")?;
+            let (omega, phase) = omega_phase(t)?;
+            Input::Multisine { amplitudes, omega, phase, harmonics: parse_harmonics(t)? }
+        }
         "csv" => {
             check_keys(t, pre, "kind, file, period")?;
             let file = str_at(t, pre, "file")?;
@@ -290,6 +297,38 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
         }
         other => return Err(ModelError::UnknownInput { value: other.to_string() }),
     })
+}
+
+/// `harmonics`, `weights` (default 1) and `phases` (default 0) of a multisine input.
+fn parse_harmonics(t: &Table) -> Result<Vec<Harmonic>, ModelError> {
+    let pre = "input";
+    let ks = vec_at(t, pre, "harmonics")?;
+    let per_harmonic = |name: &str, default: f64| -> Result<Vec<f64>, ModelError> {
+        let Some(v) = t.get(name) else { return Ok(vec![default; ks.len()]) };
+        let v = crate::toml_access::vector(v, &format!("input.{name}"))?;
+        if v.len() != ks.len() {
+            return Err(ModelError::Dimension {
+                key: format!("input.{name}"),
+                expected: format!("one per harmonic ({})", ks.len()),
+                got: format!("{}", v.len()),
+            });
+        }
+        Ok(v)
+    };
+    let (weights, phases) = (per_harmonic("weights", 1.0)?, per_harmonic("phases", 0.0)?);
+    let mut out = Vec::with_capacity(ks.len());
+    for (j, &k) in ks.iter().enumerate() {
+        if k.fract() != 0.0 || !(1.0..=1e6).contains(&k) {
+            return Err(ModelError::OutOfRange {
+                key: format!("input.harmonics[{j}]"),
+                value: k,
+                reason: "each harmonic is a whole multiple of omega from 1 to 10^6",
+            });
+        }
+        out.push(Harmonic { k: k as u32, weight: weights[j], phase: phases[j] });
+    }
+    crate::input::check_harmonics(&out)?;
+    Ok(out)
 }
 
 /// Longest model `name` in bytes: it goes into plot titles, tables and reports.
@@ -482,10 +521,20 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     inp.insert("kind".into(), Value::String(s.input.kind().into()));
     match &s.input {
         Input::Zero { .. } => {}
-        Input::Sine { amplitudes, omega, phase } | Input::Square { amplitudes, omega, phase } => {
+        Input::Sine { amplitudes, omega, phase }
+        | Input::Square { amplitudes, omega, phase }
+        | Input::Multisine { amplitudes, omega, phase, .. } => {
             inp.insert("amplitudes".into(), vec_value(amplitudes));
             inp.insert("omega".into(), Value::Float(*omega));
             inp.insert("phase".into(), Value::Float(*phase));
+            if let Input::Multisine { harmonics, .. } = &s.input {
+                let ks: Vec<f64> = harmonics.iter().map(|h| h.k as f64).collect();
+                let ws: Vec<f64> = harmonics.iter().map(|h| h.weight).collect();
+                let ps: Vec<f64> = harmonics.iter().map(|h| h.phase).collect();
+                inp.insert("harmonics".into(), Value::Array(ks.iter().map(|k| Value::Integer(*k as i64)).collect()));
+                inp.insert("weights".into(), vec_value(&ws));
+                inp.insert("phases".into(), vec_value(&ps));
+            }
         }
         Input::Samples { path, period, .. } => {
             inp.insert("file".into(), Value::String(path.clone()));

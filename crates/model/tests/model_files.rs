@@ -150,3 +150,32 @@ fn missing_file_and_bad_csv_inputs() {
     let e = write("hdr.csv", "time,w\n0,0\n1,1\n").unwrap_err().to_string();
     assert!(e.contains("header"), "{e}");
 }
+
+#[test]
+fn a_multisine_input_parses_round_trips_and_its_errors_name_key_and_value() {
+    let ms = "kind = \"multisine\"\nharmonics = [1, 3]\nweights = [1.0, 0.25]\nphases = [0.0, 1.5]";
+    let s = parse_str(&with("kind = \"sine\"", ms)).unwrap();
+    let model::Input::Multisine { harmonics, amplitudes, omega, .. } = &s.input else { panic!("{:?}", s.input) };
+    assert_eq!((harmonics.len(), harmonics[1].k, harmonics[1].weight, harmonics[1].phase), (2, 3, 0.25, 1.5));
+    assert_eq!((amplitudes.clone(), *omega), (vec![1.0], 1.0));
+    assert_eq!(parse_str(&to_toml_string(&s)).unwrap().input, s.input);
+    // weights and phases default to 1 and 0
+    let s = parse_str(&with("kind = \"sine\"", "kind = \"multisine\"\nharmonics = [2]")).unwrap();
+    let model::Input::Multisine { harmonics, .. } = &s.input else { panic!() };
+    assert_eq!((harmonics[0].weight, harmonics[0].phase), (1.0, 0.0));
+    for (bad, words) in [
+        ("harmonics = [1, 2.5]", &["input.harmonics[1]", "2.5", "whole multiple"][..]),
+        ("harmonics = [0]", &["input.harmonics[0]", "whole multiple"][..]),
+        ("harmonics = [2, 2]", &["input.harmonics", "once"][..]),
+        ("harmonics = [1, 2]\nweights = [1.0]", &["input.weights", "one per harmonic (2)"][..]),
+        ("harmonics = [1]\nphases = [\"x\"]", &["input.phases[0]"][..]),
+        ("harmonics = [1]\nweights = [0.0]", &["input.weights", "non-zero"][..]),
+        ("weights = [1.0]", &["input.harmonics"][..]),
+        ("harmonics = [1]\nharmonic = 2", &["input.harmonic"][..]),
+    ] {
+        let e = err(&with("kind = \"sine\"", &format!("kind = \"multisine\"\n{bad}")));
+        assert!(words.iter().all(|w| e.contains(w)), "{bad}: {e}");
+    }
+    let e = err(&with("kind = \"sine\"", "kind = \"multisin\""));
+    assert!(e.contains("multisine"), "{e}");
+}

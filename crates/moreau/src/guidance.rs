@@ -82,7 +82,9 @@ fn certifies(sys: &System) -> Option<(f64, &'static str)> {
 
 fn amplitudes(sys: &System) -> Option<&[f64]> {
     match &sys.input {
-        Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } => Some(amplitudes),
+        Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } | Input::Multisine { amplitudes, .. } => {
+            Some(amplitudes)
+        }
         _ => None,
     }
 }
@@ -146,7 +148,7 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
     };
     if amplitudes(sys).is_some() {
         push("input.amplitude", with_amplitude_factor(sys, up), with_amplitude_factor(sys, dn));
-        if let Input::Sine { omega, .. } | Input::Square { omega, .. } = &sys.input {
+        if let Input::Sine { omega, .. } | Input::Square { omega, .. } | Input::Multisine { omega, .. } = &sys.input {
             push(
                 "input.omega",
                 with(sys, Parameter::InputOmega, omega * up),
@@ -154,7 +156,7 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
             );
         }
     } else {
-        notes.push("the input is not a sine or square wave: amplitude and frequency are not varied".into());
+        notes.push("the input is not a sine, square wave or multisine: amplitude and frequency are not varied".into());
     }
     push("theta.scale", with(sys, Parameter::ThetaScale, up), with(sys, Parameter::ThetaScale, dn));
 

@@ -9,7 +9,9 @@
 //! (verified `< 0`), the median of bound / measured over the certified ones, and violations
 //! (a certified bound below the measured interval's upper end). Prints a Markdown table.
 //! `THETA_BENCHMARK_INPUT=square` gives every system a square wave of the same amplitudes,
-//! period and phase instead of its sine (issue 29 item 2: the same systems, another input).
+//! period and phase instead of its sine (issue 29 item 2: the same systems, another input);
+//! `THETA_BENCHMARK_INPUT=multisine` the multisine of [`multisine_harmonics`] (harmonics 1, 2
+//! and 3 of the sine's frequency, peak scaled to the sine's amplitude).
 //! `THETA_BENCHMARK_MIN_P=2` keeps only the drawn systems with `p >= 2` (issue 29 item 3: balls
 //! and ellipsoids in R^2 and R^3); the tables end with a breakdown by `p`.
 //! `THETA_BENCHMARK_NEAR=1` (issue 29 item 4) scales each drawn system to its smallest amplitude
@@ -53,6 +55,10 @@ struct Row {
     /// smallest |z'| per cell as floors (the exact normal speed; not a bound), minimised over the
     /// certified curve: how far any speed floor can take theta_engaged.
     floor_ceiling: Option<f64>,
+    /// With `THETA_BENCHMARK_INPUT` other than `sine`: the same system under its sine,
+    /// `theta_best / measured` where the sine's `theta_best` is certified and its measured
+    /// interval lies below 0 (the paired comparison).
+    sine_ratio: Option<f64>,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -69,17 +75,22 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// One drawn system assembled with its measured side: a row if it converges (measured 95 %
-/// interval below 0); with `square`, under the square wave of its sine's amplitudes, period
-/// and phase.
+/// interval below 0); under the input `kind` (`sine`, `square` or `multisine`) of its sine's
+/// amplitudes, period and phase.
 fn measure_system(
     c: &theorems::strategies::systems::SystemParams,
     settings: &ThetaSettings,
-    square: bool,
+    kind: &str,
 ) -> Option<Row> {
     let mut sys = c.build();
-    if square {
-        if let model::Input::Sine { amplitudes, omega, phase } = &sys.input {
-            sys.input = model::Input::Square { amplitudes: amplitudes.clone(), omega: *omega, phase: *phase };
+    if let model::Input::Sine { amplitudes, omega, phase } = &sys.input {
+        let (amplitudes, omega, phase) = (amplitudes.clone(), *omega, *phase);
+        match kind {
+            "square" => sys.input = model::Input::Square { amplitudes, omega, phase },
+            "multisine" => {
+                sys.input = model::Input::Multisine { amplitudes, omega, phase, harmonics: multisine_harmonics() }
+            }
+            _ => {}
         }
     }
     let rep = assemble(&sys, settings).ok()?;
@@ -104,7 +115,15 @@ fn measure_system(
         .flatten();
     let floor_ceiling =
         (sys.p() >= 2 && rep.theta_verified && rep.theta < 0.0).then(|| measured_floor_ceiling(&sys, &rep)).flatten();
-    Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling, floor_ceiling })
+    let sine_ratio = (kind != "sine").then(|| sine_ratio(c, settings)).flatten();
+    Some(Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling, floor_ceiling, sine_ratio })
+}
+
+/// `theta_best / measured` of the drawn system under its own sine, where certified and convergent.
+fn sine_ratio(c: &theorems::strategies::systems::SystemParams, settings: &ThetaSettings) -> Option<f64> {
+    let rep = assemble(&c.build(), settings).ok()?;
+    let m = rep.measured.as_ref()?;
+    (m.ci_high < 0.0 && rep.theta_best_verified && rep.theta_best < 0.0).then(|| rep.theta_best / m.rate)
 }
 
 /// theta_engaged's bound with the simulated smallest `|z'|` per cell (400 cells, catching-up
@@ -202,7 +221,11 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
-    let square = std::env::var("THETA_BENCHMARK_INPUT").is_ok_and(|v| v == "square");
+    let input_kind = std::env::var("THETA_BENCHMARK_INPUT").unwrap_or_else(|_| "sine".into());
+    if !["sine", "square", "multisine"].contains(&input_kind.as_str()) {
+        eprintln!("THETA_BENCHMARK_INPUT={input_kind}: expected sine, square or multisine");
+        std::process::exit(2);
+    }
     let min_p: usize = std::env::var("THETA_BENCHMARK_MIN_P").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
     if std::env::var("THETA_BENCHMARK_NEAR").is_ok_and(|v| v == "1") {
         return near_main(want, seed, min_p);
@@ -225,7 +248,7 @@ fn main() {
         let got: Vec<Row> = chunk
             .par_iter()
             .filter(|c| c.n >= 2 && c.p >= min_p)
-            .filter_map(|c| measure_system(c, &settings, square))
+            .filter_map(|c| measure_system(c, &settings, &input_kind))
             .collect();
         paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
         rows.extend(got);
@@ -333,6 +356,37 @@ fn main() {
         .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
         .count();
     println!("Violations over all {} convergent systems and all bounds: {all_viol}.", rows.len());
+    paired_with_sine(&rows, &input_kind);
+}
+
+/// The paired comparison with the sine (`THETA_BENCHMARK_INPUT` other than `sine`): over the
+/// systems whose `theta_best` is certified under both inputs, the median and quartiles of
+/// (`theta_best / measured` under the input) / (the same under the sine).
+fn paired_with_sine(rows: &[Row], input_kind: &str) {
+    if input_kind == "sine" {
+        return;
+    }
+    let q: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.rep.theta_best_verified && r.rep.theta_best < 0.0)
+        .filter_map(|r| r.sine_ratio.map(|s| (r.rep.theta_best / r.rate) / s))
+        .collect();
+    let mut sorted = q.clone();
+    sorted.sort_by(f64::total_cmp);
+    let at = |f: f64| sorted.get(((sorted.len() as f64 - 1.0) * f).round() as usize).copied().unwrap_or(f64::NAN);
+    let sine_only = rows
+        .iter()
+        .filter(|r| r.sine_ratio.is_some() && !(r.rep.theta_best_verified && r.rep.theta_best < 0.0))
+        .count();
+    println!(
+        "Paired with the sine of equal amplitude and period (same systems): {} certified under both (and {sine_only} under the sine only); (theta_best / measured under {input_kind}) / (under the sine): median {:.3}, quartiles {:.3} - {:.3}, within 20 % of 1 on {} of {}.",
+        q.len(),
+        median(q.clone()),
+        at(0.25),
+        at(0.75),
+        q.iter().filter(|x| (**x - 1.0).abs() <= 0.2).count(),
+        q.len()
+    );
 }
 
 fn kind(r: &Row) -> &'static str {
@@ -346,6 +400,22 @@ fn kind(r: &Row) -> &'static str {
 // ---------------------------------------------------------------------------------------------
 // Near the threshold (issue 29 item 4): `THETA_BENCHMARK_NEAR=1`.
 // ---------------------------------------------------------------------------------------------
+
+/// The waveform of `THETA_BENCHMARK_INPUT=multisine`: `sin a + 0.5 sin(2 a + 0.7) + 0.25
+/// sin(3 a + 1.9)`, its weights divided by its peak (on a grid of 2^16 points of a period), so
+/// the input's largest `|w_i|` is the sine's amplitude `a_i`.
+fn multisine_harmonics() -> Vec<model::input::Harmonic> {
+    let mut h: Vec<model::input::Harmonic> = [(1, 1.0, 0.0), (2, 0.5, 0.7), (3, 0.25, 1.9)]
+        .into_iter()
+        .map(|(k, weight, phase)| model::input::Harmonic { k, weight, phase })
+        .collect();
+    let grid = 1 << 16;
+    let peak = (0..grid)
+        .map(|i| model::input::multisine_wave(&h, std::f64::consts::TAU * i as f64 / grid as f64).abs())
+        .fold(0.0, f64::max);
+    h.iter_mut().for_each(|x| x.weight /= peak);
+    h
+}
 
 /// The system with every input amplitude multiplied by `s` (sine and square inputs).
 fn scaled(sys: &model::System, s: f64) -> model::System {
@@ -596,7 +666,16 @@ fn near_system(c: &theorems::strategies::systems::SystemParams, index: u64, seed
         return Err(NearSkip::NotConvergent);
     }
     let dec = decompose(&sys, &rep);
-    let row = Row { n: sys.n(), p: sys.p(), rate: m.rate, hi: m.ci_high, rep, ceiling: None, floor_ceiling: None };
+    let row = Row {
+        n: sys.n(),
+        p: sys.p(),
+        rate: m.rate,
+        hi: m.ci_high,
+        rep,
+        ceiling: None,
+        floor_ceiling: None,
+        sine_ratio: None,
+    };
     Ok(NearRow { row, s0, factor, dec })
 }
 

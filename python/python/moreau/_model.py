@@ -262,6 +262,33 @@ class Square(Input):
         super().__init__({"kind": "square", "amplitudes": _vector("input.amplitudes", amplitudes), "omega": _real("input.omega", omega), "phase": _real("input.phase", phase)})
 
 
+class Multisine(Input):
+    """``w_i(t) = a_i sum_j c_j sin(k_j (omega t + phase) + phi_j)``, period ``2 pi / omega``.
+
+    ``harmonics`` are the whole multiples ``k_j`` of ``omega`` (distinct, at least 1),
+    ``weights`` the ``c_j`` (default 1 each), ``phases`` the ``phi_j`` (default 0 each).
+    """
+
+    def __init__(
+        self,
+        amplitudes: ArrayLike,
+        omega: float,
+        harmonics: ArrayLike,
+        weights: Optional[ArrayLike] = None,
+        phases: Optional[ArrayLike] = None,
+        phase: float = 0.0,
+    ) -> None:
+        super().__init__({
+            "kind": "multisine",
+            "amplitudes": _vector("input.amplitudes", amplitudes),
+            "omega": _real("input.omega", omega),
+            "phase": _real("input.phase", phase),
+            "harmonics": _vector("input.harmonics", harmonics),
+            "weights": None if weights is None else _vector("input.weights", weights),
+            "phases": None if phases is None else _vector("input.phases", phases),
+        })
+
+
 class Zero(Input):
     """``w = 0`` (the default; no period)."""
 

@@ -14,6 +14,11 @@
 //! `||eta_T'||_inf` from above by the samples and the Lipschitz constant of `eta_T'` inside the
 //! pieces, its jumps at the input's edges taken in (verified up to the rounding margin).
 //!
+//! **Multisine inputs** (a sum of harmonics of the sine): the sum of the harmonics' phasor
+//! orbits ([`super::multisine`]); `osc` and `||eta_T'||_inf` from its samples as for the
+//! piecewise inputs, with the Lipschitz constant `sum_j |c_j| (k_j omega)^2 |C g_j|` (verified
+//! up to the rounding margin).
+//!
 //! **Other periodic inputs**: grid samples from `dynamics::periodic::linearised`; the sampled
 //! diameter is a lower bound of `osc` only if the samples are exact, and the sampled maximum of
 //! `|eta_T'|` is not an upper bound, so both are reported as estimates (`verified = false`).
@@ -84,6 +89,9 @@ impl EtaOrbit {
         match &sys.input {
             Input::Sine { amplitudes, omega, phase } => {
                 Ok(Self::sine(sys, amplitudes, *omega, *phase, T, settings.samples))
+            }
+            Input::Multisine { amplitudes, omega, phase, harmonics } => {
+                Ok(super::multisine::orbit(sys, amplitudes, *omega, *phase, harmonics, T, settings.samples))
             }
             _ => {
                 let lp =

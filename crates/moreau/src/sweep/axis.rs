@@ -174,7 +174,9 @@ impl Parameter {
                 }
             }
             Parameter::InputAmplitude { .. } | Parameter::InputOmega | Parameter::InputPhase => match &base.input {
-                Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } => {
+                Input::Sine { amplitudes, .. }
+                | Input::Square { amplitudes, .. }
+                | Input::Multisine { amplitudes, .. } => {
                     if let Parameter::InputAmplitude { component: Some(k) } = self {
                         if *k >= amplitudes.len() {
                             return Err(SweepError::IndexOutOfRange {
@@ -187,7 +189,7 @@ impl Parameter {
                         }
                     }
                 }
-                _ => return na("the base model's input is not a sine or square wave"),
+                _ => return na("the base model's input is not a sine, square wave or multisine"),
             },
             Parameter::ThetaScale => {}
             Parameter::ThetaR => {
@@ -220,7 +222,10 @@ impl Parameter {
             }
             Parameter::InputAmplitude { component } => {
                 self.check_applicable(sys)?;
-                if let Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } = &mut sys.input {
+                if let Input::Sine { amplitudes, .. }
+                | Input::Square { amplitudes, .. }
+                | Input::Multisine { amplitudes, .. } = &mut sys.input
+                {
                     match component {
                         None => amplitudes.iter_mut().for_each(|a| *a = value),
                         Some(k) => amplitudes[*k] = value,
@@ -232,7 +237,10 @@ impl Parameter {
                 if *self == Parameter::InputOmega && (value.is_nan() || value <= 0.0) {
                     return Err(SweepError::NotApplicable { name, reason: "omega must be positive" });
                 }
-                if let Input::Sine { omega, phase, .. } | Input::Square { omega, phase, .. } = &mut sys.input {
+                if let Input::Sine { omega, phase, .. }
+                | Input::Square { omega, phase, .. }
+                | Input::Multisine { omega, phase, .. } = &mut sys.input
+                {
                     if *self == Parameter::InputOmega {
                         *omega = value;
                     } else {
