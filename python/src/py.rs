@@ -108,17 +108,17 @@ fn rows(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
 #[pymethods]
 impl PySystem {
     /// From the tables of a model file as a dict (`plant`, `theta`, `input`, `initial`,
-    /// `simulation`, `effects`, `name`); `samples = (t, w, period, source)` replaces the input.
+    /// `simulation`, `effects`, `name`); `samples = (t, w, period, source, hold)` replaces the input.
     #[staticmethod]
     #[pyo3(signature = (table, samples=None))]
     fn from_table(py: Python<'_>, table: &Bound<'_, PyDict>, samples: Option<SamplesArg>) -> PyResult<Self> {
         let t = toml_table("", table, &mut NumberBudget(0))?;
         let stated = Stated::of_table(&t);
-        if let Some((t, w, _, source)) = &samples {
+        if let Some((t, w, _, source, _)) = &samples {
             let numbers = t.len() as u64 + w.iter().map(|r| r.len() as u64).sum::<u64>();
             moreau::budget::sample_numbers(numbers, &format!("t and w of {source}")).map_err(err)?;
         }
-        let samples = samples.map(|(t, w, period, source)| SamplesSpec { t, w, period, source });
+        let samples = samples.map(|(t, w, period, source, hold)| SamplesSpec { t, w, period, source, hold });
         let inner = py.detach(move || system_from_table(t, samples)).map_err(err)?;
         Ok(Self { inner, stated })
     }
@@ -242,7 +242,7 @@ impl PySystem {
 }
 
 /// Sampled input as it crosses from Python: `(t, w rows, period, source name)`.
-type SamplesArg = (Vec<f64>, Vec<Vec<f64>>, Option<f64>, String);
+type SamplesArg = (Vec<f64>, Vec<Vec<f64>>, Option<f64>, String, String);
 
 fn bytes<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyBytes> {
     let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();

@@ -12,6 +12,8 @@ pub struct SamplesSpec {
     pub w: Vec<Vec<f64>>,
     pub period: Option<f64>,
     pub source: String,
+    /// `"foh"` or `"zoh"` (the `hold` of a `csv` input).
+    pub hold: String,
 }
 
 fn samples_input(s: SamplesSpec) -> Result<Input, ModelError> {
@@ -61,7 +63,8 @@ fn samples_input(s: SamplesSpec) -> Result<Input, ModelError> {
     if let Some(per) = s.period {
         model::input::check_period(per, &s.t, &s.source)?;
     }
-    Ok(Input::Samples { path: s.source, t: s.t, w: s.w, period: s.period })
+    let hold = model::input::InputHold::parse(&s.hold, "input.hold")?;
+    Ok(Input::Samples { path: s.source, t: s.t, w: s.w, period: s.period, hold })
 }
 
 /// A system from the tables of a model file (`plant`, `theta`, `input`, `initial`,
@@ -127,7 +130,13 @@ mod tests {
 
     #[test]
     fn samples_are_checked_like_an_input_csv() {
-        let spec = |t: Vec<f64>, period| SamplesSpec { t, w: vec![vec![0.0]; 3], period, source: "<samples>".into() };
+        let spec = |t: Vec<f64>, period| SamplesSpec {
+            t,
+            w: vec![vec![0.0]; 3],
+            period,
+            source: "<samples>".into(),
+            hold: "foh".into(),
+        };
         let e = one_line(&system_from_table(worked_example(), Some(spec(vec![0.0, 1.0, 1.0], None))).unwrap_err());
         assert!(e.contains("time stamps must increase strictly: row 4 has t = 1 after t = 1"), "{e}");
         let e = one_line(&system_from_table(worked_example(), Some(spec(vec![0.0, 1.0, 2.0], Some(1.5)))).unwrap_err());

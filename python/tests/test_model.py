@@ -220,3 +220,14 @@ def test_a_multisine_input_is_the_model_files_and_is_certified():
     assert r.theta_verified and r.theta < 0
     with pytest.raises(moreau.MoreauError, match=r"input\.harmonics\[0\].*whole multiple"):
         worked(input=moreau.Multisine([1.0], omega=1.0, harmonics=[0.5]))
+
+
+def test_samples_take_the_csv_inputs_hold():
+    t = np.linspace(0.0, 2 * np.pi, 32, endpoint=False)
+    zoh = worked(input=moreau.Samples(t, np.sin(t), period=2 * np.pi, hold="zoh"))
+    foh = worked(input=moreau.Samples(t, np.sin(t), period=2 * np.pi))
+    mid = 0.5 * (t[3] + t[4])
+    assert zoh.w([mid])[0, 0] == pytest.approx(np.sin(t[3]))
+    assert foh.w([mid])[0, 0] == pytest.approx(0.5 * (np.sin(t[3]) + np.sin(t[4])))
+    with pytest.raises(moreau.MoreauError, match=r"input\.hold.*cubic"):
+        worked(input=moreau.Samples(t, np.sin(t), period=2 * np.pi, hold="cubic"))

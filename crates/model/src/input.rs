@@ -1,7 +1,46 @@
 //! The external input `w(t)` of eq. (xy).
 use crate::ModelError;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 use std::path::Path;
+
+/// How `w` behaves between its samples `w(t_k)`, `w(t_{k+1})`: the one hold type of the
+/// whole workspace (a CSV input's interpolation here; the step maps, the catching-up scheme and
+/// the extended model of `dynamics`, which re-exports it as `dynamics::linear::hold::InputHold`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum InputHold {
+    /// `w(t_k + s) = w(t_k) + (s/h)(w(t_{k+1}) - w(t_k))`: linear interpolation between
+    /// samples (first-order hold). Default.
+    #[default]
+    #[serde(rename = "Linear")]
+    Foh,
+    /// `w(t_k + s) = w(t_k)`: each sample held until the next (zero-order hold, a digital
+    /// controller's command).
+    #[serde(rename = "Held")]
+    Zoh,
+}
+
+impl InputHold {
+    /// The hold named `"foh"` or `"zoh"` (the key `key` of a model file, or Python's `hold`).
+    pub fn parse(word: &str, key: &str) -> Result<Self, ModelError> {
+        match word {
+            "foh" => Ok(InputHold::Foh),
+            "zoh" => Ok(InputHold::Zoh),
+            other => Err(ModelError::Dimension {
+                key: key.into(),
+                expected: "\"foh\" (linear interpolation) or \"zoh\" (each sample held until the next)".into(),
+                got: format!("{other:?}"),
+            }),
+        }
+    }
+    /// `"foh"` or `"zoh"` (reports).
+    pub fn name(&self) -> &'static str {
+        match self {
+            InputHold::Foh => "foh",
+            InputHold::Zoh => "zoh",
+        }
+    }
+}
 
 /// Input signal `w : R -> R^m`.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,9 +54,10 @@ pub enum Input {
     /// A sum of harmonics of `omega`: `w_i(t) = a_i sum_j c_j sin(k_j (omega t + phase) + phi_j)`
     /// (harmonic `j`: multiple `k_j`, weight `c_j`, phase `phi_j`); period `2 pi / omega`.
     Multisine { amplitudes: Vec<f64>, omega: f64, phase: f64, harmonics: Vec<Harmonic> },
-    /// Samples `(t_k, w_k)` from a CSV file, linearly interpolated, held constant outside the
-    /// sampled range. Periodic only if a `period` is stated.
-    Samples { path: String, t: Vec<f64>, w: Vec<Vec<f64>>, period: Option<f64> },
+    /// Samples `(t_k, w_k)` from a CSV file, linearly interpolated (`hold = Foh`) or each held
+    /// until the next (`Zoh`), held constant outside the sampled range. Periodic only if a
+    /// `period` is stated.
+    Samples { path: String, t: Vec<f64>, w: Vec<Vec<f64>>, period: Option<f64>, hold: InputHold },
 }
 
 /// One term of a [`Input::Multisine`]: `weight sin(k (omega t + phase) + phase_k)`.
@@ -118,7 +158,7 @@ impl Input {
                 let s = multisine_wave(harmonics, omega * t + phase);
                 out.iter_mut().zip(amplitudes).for_each(|(o, a)| *o = a * s);
             }
-            Input::Samples { t: ts, w, period, .. } => {
+            Input::Samples { t: ts, w, period, hold, .. } => {
                 let mut tt = t;
                 if let Some(per) = period {
                     tt = ts[0] + (t - ts[0]).rem_euclid(*per);
@@ -126,8 +166,9 @@ impl Input {
                 let k = ts.partition_point(|&s| s <= tt);
                 if k == 0 {
                     out.copy_from_slice(&w[0]);
-                } else if k >= ts.len() {
-                    out.copy_from_slice(&w[ts.len() - 1]);
+                } else if k >= ts.len() || *hold == InputHold::Zoh {
+                    // after the last sample, or a zero-order hold: the last sample at or before t
+                    out.copy_from_slice(&w[k - 1]);
                 } else {
                     let (t0, t1) = (ts[k - 1], ts[k]);
                     let a = (tt - t0) / (t1 - t0);
@@ -254,7 +295,7 @@ impl Input {
         if t.len() < 2 {
             return Err(ModelError::Csv { path: ps, reason: format!("needs at least 2 samples, found {}", t.len()) });
         }
-        Ok(Input::Samples { path: path.display().to_string(), t, w, period })
+        Ok(Input::Samples { path: path.display().to_string(), t, w, period, hold: InputHold::Foh })
     }
 }
 
@@ -349,10 +390,18 @@ mod tests {
             t: vec![0.0, 1.0, 3.0],
             w: vec![vec![0.0], vec![2.0], vec![0.0]],
             period: None,
+            hold: InputHold::Foh,
         };
         assert_eq!(s.at(0.5), vec![1.0]);
         assert_eq!(s.at(2.0), vec![1.0]);
         assert_eq!(s.at(-1.0), vec![0.0]);
         assert_eq!(s.at(9.0), vec![0.0]);
+        // zero-order hold: each sample until the next
+        let Input::Samples { t, w, .. } = s else { unreachable!() };
+        let z = Input::Samples { path: String::new(), t, w, period: None, hold: InputHold::Zoh };
+        assert_eq!(
+            (z.at(0.5), z.at(1.0), z.at(2.9), z.at(3.0), z.at(-1.0)),
+            (vec![0.0], vec![2.0], vec![2.0], vec![0.0], vec![0.0])
+        );
     }
 }

@@ -54,7 +54,7 @@
 //! reference = "w1"            # output i tracks this input (servo loops): tracking-error metrics
 //! ```
 pub use crate::fit::{parse_param_name, FitRecord, FitSpec, FreeParam, FreeTarget, PlantMatrix};
-use crate::input::Harmonic;
+use crate::input::{Harmonic, InputHold};
 use crate::parameters::{Parameters, Place};
 pub use crate::signals::Signals;
 use crate::system::{check_step, SimDefaults, System};
@@ -277,8 +277,12 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
             Input::Multisine { amplitudes, omega, phase, harmonics: parse_harmonics(t)? }
         }
         "csv" => {
-            check_keys(t, pre, "kind, file, period")?;
+            check_keys(t, pre, "kind, file, period, hold")?;
             let file = str_at(t, pre, "file")?;
+            let hold = match t.get("hold") {
+                None => InputHold::Foh,
+                Some(_) => InputHold::parse(str_at(t, pre, "hold")?, "input.hold")?,
+            };
             let period = opt_f64(t, pre, "period")?;
             if let Some(per) = period {
                 if per <= 0.0 {
@@ -289,7 +293,10 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
                     });
                 }
             }
-            let input = Input::from_csv(&dir.join(file), period)?;
+            let mut input = Input::from_csv(&dir.join(file), period)?;
+            if let Input::Samples { hold: h, .. } = &mut input {
+                *h = hold;
+            }
             if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
                 crate::input::check_period(per, t, &file)?;
             }
@@ -536,8 +543,11 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
                 inp.insert("phases".into(), vec_value(&ps));
             }
         }
-        Input::Samples { path, period, .. } => {
+        Input::Samples { path, period, hold, .. } => {
             inp.insert("file".into(), Value::String(path.clone()));
+            if *hold == InputHold::Zoh {
+                inp.insert("hold".into(), Value::String(hold.name().into()));
+            }
             if let Some(per) = period {
                 inp.insert("period".into(), Value::Float(*per));
             }

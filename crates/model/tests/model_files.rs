@@ -179,3 +179,29 @@ fn a_multisine_input_parses_round_trips_and_its_errors_name_key_and_value() {
     let e = err(&with("kind = \"sine\"", "kind = \"multisin\""));
     assert!(e.contains("multisine"), "{e}");
 }
+
+#[test]
+fn a_csv_input_takes_a_hold_and_a_wrong_one_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("w.csv"), "t,w\n0,0\n1,1\n2,0\n").unwrap();
+    let load = |extra: &str| {
+        let text = with(
+            "kind = \"sine\"\namplitudes = [1.0]\nomega = 1.0",
+            &format!("kind = \"csv\"\nfile = \"w.csv\"\nperiod = 3.0{extra}"),
+        );
+        std::fs::write(dir.path().join("m.toml"), text).unwrap();
+        model::load(&dir.path().join("m.toml"))
+    };
+    let hold = |s: &model::System| match &s.input {
+        model::Input::Samples { hold, .. } => *hold,
+        other => panic!("{other:?}"),
+    };
+    use model::input::InputHold;
+    let foh = load("").unwrap();
+    assert_eq!((hold(&foh), foh.input.at(0.5)), (InputHold::Foh, vec![0.5]));
+    let zoh = load("\nhold = \"zoh\"").unwrap();
+    assert_eq!((hold(&zoh), zoh.input.at(0.5), zoh.input.at(1.5)), (InputHold::Zoh, vec![0.0], vec![1.0]));
+    assert!(to_toml_string(&zoh).contains("hold = \"zoh\"") && !to_toml_string(&foh).contains("hold"));
+    let e = load("\nhold = \"cubic\"").unwrap_err().to_string();
+    assert!(e.contains("input.hold") && e.contains("\"cubic\"") && e.contains("zoh"), "{e}");
+}

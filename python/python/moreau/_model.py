@@ -309,12 +309,15 @@ def _real_sample_array(key: str, v: ArrayLike) -> np.ndarray:
 
 
 class Samples(Input):
-    """Samples ``(t_k, w_k)``, linearly interpolated and held outside; periodic if ``period`` is given.
+    """Samples ``(t_k, w_k)``, linearly interpolated (``hold="foh"``) or each held until the
+    next (``hold="zoh"``), held outside; periodic if ``period`` is given.
 
     ``w`` is an array of shape (len(t), m) (or (len(t),) for m = 1). Checked like an input CSV.
     """
 
-    def __init__(self, t: ArrayLike, w: ArrayLike, period: Optional[float] = None, name: str = "<samples>") -> None:
+    def __init__(
+        self, t: ArrayLike, w: ArrayLike, period: Optional[float] = None, name: str = "<samples>", hold: str = "foh"
+    ) -> None:
         super().__init__({"kind": "samples"})
         ta = _real_sample_array(f"{name}: t", t)
         wa = _real_sample_array(f"{name}: w", w)
@@ -327,9 +330,10 @@ class Samples(Input):
         self.w = wa
         self.period = None if period is None else _real("input.period", period)
         self.name = name
+        self.hold = str(hold)
 
-    def _spec(self) -> Tuple[List[float], List[List[float]], Optional[float], str]:
-        return ([float(x) for x in self.t], self.w.tolist(), self.period, self.name)
+    def _spec(self) -> Tuple[List[float], List[List[float]], Optional[float], str, str]:
+        return ([float(x) for x in self.t], self.w.tolist(), self.period, self.name, self.hold)
 
     def __repr__(self) -> str:
         return f"Samples(<{len(self.t)} samples, m = {self.w.shape[1]}>, period={self.period!r})"

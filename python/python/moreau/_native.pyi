@@ -16,7 +16,7 @@ class System:
     @staticmethod
     def from_table(
         table: Dict[str, Any],
-        samples: Optional[Tuple[List[float], List[List[float]], Optional[float], str]] = None,
+        samples: Optional[Tuple[List[float], List[List[float]], Optional[float], str, str]] = None,
     ) -> System: ...
     @staticmethod
     def load(path: _Path) -> System: ...

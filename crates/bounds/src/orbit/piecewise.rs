@@ -1,6 +1,6 @@
 //! `eta_T` in closed form for a periodic piecewise-affine input: a square wave (constant
-//! pieces) or a periodic CSV input (the linear interpolation of its samples, held after the
-//! last sample until the period wraps).
+//! pieces) or a periodic CSV input (the linear interpolation of its samples, or each sample
+//! held until the next under `hold = "zoh"`; the last sample held until the period wraps).
 //!
 //! On a piece `[t_j, t_j + L_j)` with `w = u_j + s r_j` the linearised system
 //! `xi' = F xi + B w` (eq. (xieta)) has the affine particular solution `alpha_j + s beta_j`,
@@ -20,6 +20,7 @@
 //! (verified up to that margin).
 use super::eta_orbit::EtaOrbit;
 use dynamics::linear::expm::{expm_enclosure, frobenius_up};
+use model::input::InputHold;
 use model::{Input, System};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::{PI, TAU};
@@ -66,7 +67,7 @@ pub(super) fn pieces(input: &Input) -> Option<(f64, Vec<Piece>)> {
             }
             Some((0.0, out))
         }
-        Input::Samples { t, w, period: Some(P), .. } => {
+        Input::Samples { t, w, period: Some(P), hold, .. } => {
             let start = t[0];
             let end = start + P;
             let m = w[0].len();
@@ -76,7 +77,7 @@ pub(super) fn pieces(input: &Input) -> Option<(f64, Vec<Piece>)> {
                 if b <= a {
                     continue;
                 }
-                let r = if k + 1 < t.len() && t[k + 1] <= end {
+                let r = if *hold == InputHold::Foh && k + 1 < t.len() && t[k + 1] <= end {
                     (dv(&w[k + 1]) - dv(&w[k])) / (t[k + 1] - t[k])
                 } else {
                     DVector::zeros(m)

@@ -343,7 +343,13 @@ fn replay_input(
             (t, wv)
         }
     };
-    fitted_sys.input = Input::Samples { path: FITTED_INPUT_FILE.into(), t: t_in, w: w_in, period: None };
+    fitted_sys.input = Input::Samples {
+        path: FITTED_INPUT_FILE.into(),
+        t: t_in,
+        w: w_in,
+        period: None,
+        hold: model::input::InputHold::Foh,
+    };
     let sim_dt = if hold == InputHold::Zoh { h_sub } else { dt_rows / sub_rows as f64 };
     fitted_sys.sim = SimDefaults { dt: sim_dt, periods: 1, t_end: Some((n_samp - 1) as f64 * dt) };
     if hold == InputHold::Zoh {
