@@ -11,7 +11,9 @@
 //! `THETA_BENCHMARK_INPUT=square` gives every system a square wave of the same amplitudes,
 //! period and phase instead of its sine (issue 29 item 2: the same systems, another input);
 //! `THETA_BENCHMARK_INPUT=multisine` the multisine of [`multisine_harmonics`] (harmonics 1, 2
-//! and 3 of the sine's frequency, peak scaled to the sine's amplitude).
+//! and 3 of the sine's frequency, peak scaled to the sine's amplitude); `csv` and `csv-zoh` the
+//! sine sampled at 64 points per period, linearly interpolated or zero-order held. Each of these
+//! ends with a paired comparison against the same systems under their sine.
 //! `THETA_BENCHMARK_MIN_P=2` keeps only the drawn systems with `p >= 2` (issue 29 item 3: balls
 //! and ellipsoids in R^2 and R^3); the tables end with a breakdown by `p`.
 //! `THETA_BENCHMARK_NEAR=1` (issue 29 item 4) scales each drawn system to its smallest amplitude
@@ -90,6 +92,7 @@ fn measure_system(
             "multisine" => {
                 sys.input = model::Input::Multisine { amplitudes, omega, phase, harmonics: multisine_harmonics() }
             }
+            "csv" | "csv-zoh" => sys.input = sampled_sine(&amplitudes, omega, phase, kind == "csv-zoh"),
             _ => {}
         }
     }
@@ -222,8 +225,8 @@ fn main() {
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2026);
     let input_kind = std::env::var("THETA_BENCHMARK_INPUT").unwrap_or_else(|_| "sine".into());
-    if !["sine", "square", "multisine"].contains(&input_kind.as_str()) {
-        eprintln!("THETA_BENCHMARK_INPUT={input_kind}: expected sine, square or multisine");
+    if !["sine", "square", "multisine", "csv", "csv-zoh"].contains(&input_kind.as_str()) {
+        eprintln!("THETA_BENCHMARK_INPUT={input_kind}: expected sine, square, multisine, csv or csv-zoh");
         std::process::exit(2);
     }
     let min_p: usize = std::env::var("THETA_BENCHMARK_MIN_P").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
@@ -418,6 +421,17 @@ fn multisine_harmonics() -> Vec<model::input::Harmonic> {
         h.iter_mut().for_each(|x| x.weight /= peak);
     }
     h
+}
+
+/// `THETA_BENCHMARK_INPUT=csv` / `csv-zoh`: the sine sampled at 64 points per period as a
+/// periodic sampled input, linearly interpolated or zero-order held.
+fn sampled_sine(a: &[f64], omega: f64, phase: f64, zoh: bool) -> model::Input {
+    const N: usize = 64;
+    let T = std::f64::consts::TAU / omega;
+    let t: Vec<f64> = (0..N).map(|k| k as f64 * T / N as f64).collect();
+    let w = t.iter().map(|tk| a.iter().map(|ai| ai * (omega * tk + phase).sin()).collect()).collect();
+    let hold = if zoh { model::input::InputHold::Zoh } else { model::input::InputHold::Foh };
+    model::Input::Samples { path: "<sampled sine>".into(), t, w, period: Some(T), hold }
 }
 
 /// The system with every input amplitude multiplied by `s` (sine and square inputs).
