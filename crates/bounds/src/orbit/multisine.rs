@@ -7,7 +7,7 @@
 //! `eta_T = sum_j c_j (P_j sin alpha_j + Q_j cos alpha_j)` and
 //! `eta_T' = sum_j c_j k_j omega (P_j cos alpha_j - Q_j sin alpha_j)`.
 //! Unlike a single sine the orbit is no ellipse, so `osc` and `||eta_T'||_inf` come from
-//! samples ([`EtaOrbit::certify_samples`]): `osc` from below by the samples' diameter, and
+//! samples (`EtaOrbit::certify_samples`): `osc` from below by the samples' diameter, and
 //! `||eta_T'||_inf` from above by the samples and the Lipschitz constant of `eta_T'`,
 //! `|eta_T''| <= L = sum_j |c_j| (k_j omega)^2 rho_j` with `rho_j = sqrt(|P_j|^2 + |Q_j|^2)`
 //! (each term `P sin + Q cos` has norm at most `rho_j`).
@@ -16,7 +16,7 @@
 //! F) eps`; the sines, products and the sum over `J` harmonics add `gamma_{J + 4}` relative to
 //! the sum of the terms' sizes. The error of a sample is therefore at most `m sum_j |c_j| rho_j`
 //! (of `eta_T'`: `m sum_j |c_j| k_j omega rho_j`), which is passed to
-//! [`EtaOrbit::certify_samples`] relative to the largest sample, so harmonics that cancel in
+//! `EtaOrbit::certify_samples` relative to the largest sample, so harmonics that cancel in
 //! the samples still count with their full size.
 use super::eta_orbit::EtaOrbit;
 use dynamics::periodic::linearised::sine_phasor;
