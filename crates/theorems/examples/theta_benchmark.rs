@@ -427,11 +427,11 @@ fn multisine_harmonics() -> Vec<model::input::Harmonic> {
 /// periodic sampled input, linearly interpolated or zero-order held.
 fn sampled_sine(a: &[f64], omega: f64, phase: f64, zoh: bool) -> model::Input {
     const N: usize = 64;
-    let T = std::f64::consts::TAU / omega;
-    let t: Vec<f64> = (0..N).map(|k| k as f64 * T / N as f64).collect();
+    let period = std::f64::consts::TAU / omega;
+    let t: Vec<f64> = (0..N).map(|k| k as f64 * period / N as f64).collect();
     let w = t.iter().map(|tk| a.iter().map(|ai| ai * (omega * tk + phase).sin()).collect()).collect();
     let hold = if zoh { model::input::InputHold::Zoh } else { model::input::InputHold::Foh };
-    model::Input::Samples { path: "<sampled sine>".into(), t, w, period: Some(T), hold }
+    model::Input::Samples { path: "<sampled sine>".into(), t, w, period: Some(period), hold }
 }
 
 /// The system with every input amplitude multiplied by `s` (sine and square inputs).
