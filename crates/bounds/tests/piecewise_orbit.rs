@@ -68,23 +68,7 @@ fn a_jump_of_eta_dot_is_taken_in_and_leaving_it_out_misses_the_supremum() {
 #[test]
 fn a_periodic_csv_input_is_verified_and_close_to_the_sine_it_samples() {
     let dir = tempfile::tempdir().unwrap();
-    let period = std::f64::consts::TAU;
-    let n = 256;
-    let mut csv = String::from("t,w\n");
-    for k in 0..n {
-        let t = k as f64 * period / n as f64;
-        csv += &format!("{t},{}\n", t.sin());
-    }
-    std::fs::write(dir.path().join("w.csv"), csv).unwrap();
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/worked-example.toml")).unwrap();
-    let start = text.find("[input]").unwrap();
-    let end = start + text[start..].find("\n[").unwrap_or(text.len() - start);
-    let text =
-        format!("{}[input]\nkind = \"csv\"\nfile = \"w.csv\"\nperiod = {period}\n{}", &text[..start], &text[end..]);
-    let path = dir.path().join("m.toml");
-    std::fs::write(&path, text).unwrap();
-    let sys = model::load(&path).unwrap();
+    let sys = worked_csv(dir.path(), 256, "foh");
     let o = EtaOrbit::new(&sys, &OrbitSettings::default()).unwrap();
     assert!(o.verified, "{}", o.method);
     let sine = EtaOrbit::new(&worked("kind = \"sine\""), &OrbitSettings::default()).unwrap();

@@ -132,6 +132,27 @@ impl Input {
         }
     }
 
+    /// The amplitudes, `omega` and `phase` of a sine, square wave or multisine (`None` for
+    /// other inputs): what sweeps and guidance vary.
+    pub fn wave(&self) -> Option<(&[f64], f64, f64)> {
+        match self {
+            Input::Sine { amplitudes, omega, phase }
+            | Input::Square { amplitudes, omega, phase }
+            | Input::Multisine { amplitudes, omega, phase, .. } => Some((amplitudes, *omega, *phase)),
+            Input::Zero { .. } | Input::Samples { .. } => None,
+        }
+    }
+
+    /// [`Input::wave`], to be changed in place.
+    pub fn wave_mut(&mut self) -> Option<(&mut Vec<f64>, &mut f64, &mut f64)> {
+        match self {
+            Input::Sine { amplitudes, omega, phase }
+            | Input::Square { amplitudes, omega, phase }
+            | Input::Multisine { amplitudes, omega, phase, .. } => Some((amplitudes, omega, phase)),
+            Input::Zero { .. } | Input::Samples { .. } => None,
+        }
+    }
+
     pub fn kind(&self) -> &'static str {
         match self {
             Input::Zero { .. } => "zero",
@@ -206,7 +227,7 @@ impl Input {
     /// Reads samples from a CSV file with header exactly `t,w` (or `t,w1`) or `t,w1,...,wm`.
     /// Rejects other headers, missing or non-numeric cells, NaN/inf, and time stamps that do
     /// not increase strictly. A stated `period` is checked by the caller ([`check_period`]).
-    pub fn from_csv(path: &Path, period: Option<f64>) -> Result<Self, ModelError> {
+    pub fn from_csv(path: &Path, period: Option<f64>, hold: InputHold) -> Result<Self, ModelError> {
         let ps = path.display().to_string();
         let text = crate::files::read_regular(path, crate::files::MAX_CSV_BYTES)?;
         let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
@@ -295,7 +316,7 @@ impl Input {
         if t.len() < 2 {
             return Err(ModelError::Csv { path: ps, reason: format!("needs at least 2 samples, found {}", t.len()) });
         }
-        Ok(Input::Samples { path: path.display().to_string(), t, w, period, hold: InputHold::Foh })
+        Ok(Input::Samples { path: path.display().to_string(), t, w, period, hold })
     }
 }
 

@@ -293,10 +293,7 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
                     });
                 }
             }
-            let mut input = Input::from_csv(&dir.join(file), period)?;
-            if let Input::Samples { hold: h, .. } = &mut input {
-                *h = hold;
-            }
+            let input = Input::from_csv(&dir.join(file), period, hold)?;
             if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
                 crate::input::check_period(per, t, &file)?;
             }
@@ -528,19 +525,19 @@ pub fn to_toml_string_stating(s: &System, stated: StatedInitial) -> String {
     inp.insert("kind".into(), Value::String(s.input.kind().into()));
     match &s.input {
         Input::Zero { .. } => {}
-        Input::Sine { amplitudes, omega, phase }
-        | Input::Square { amplitudes, omega, phase }
-        | Input::Multisine { amplitudes, omega, phase, .. } => {
+        Input::Sine { .. } | Input::Square { .. } | Input::Multisine { .. } => {
+            let (amplitudes, omega, phase) = s.input.wave().expect("a sine, square wave or multisine");
             inp.insert("amplitudes".into(), vec_value(amplitudes));
-            inp.insert("omega".into(), Value::Float(*omega));
-            inp.insert("phase".into(), Value::Float(*phase));
+            inp.insert("omega".into(), Value::Float(omega));
+            inp.insert("phase".into(), Value::Float(phase));
             if let Input::Multisine { harmonics, .. } = &s.input {
-                let ks: Vec<f64> = harmonics.iter().map(|h| h.k as f64).collect();
-                let ws: Vec<f64> = harmonics.iter().map(|h| h.weight).collect();
-                let ps: Vec<f64> = harmonics.iter().map(|h| h.phase).collect();
-                inp.insert("harmonics".into(), Value::Array(ks.iter().map(|k| Value::Integer(*k as i64)).collect()));
-                inp.insert("weights".into(), vec_value(&ws));
-                inp.insert("phases".into(), vec_value(&ps));
+                let each = |f: fn(&Harmonic) -> f64| harmonics.iter().map(f).collect::<Vec<f64>>();
+                inp.insert(
+                    "harmonics".into(),
+                    Value::Array(harmonics.iter().map(|h| Value::Integer(h.k.into())).collect()),
+                );
+                inp.insert("weights".into(), vec_value(&each(|h| h.weight)));
+                inp.insert("phases".into(), vec_value(&each(|h| h.phase)));
             }
         }
         Input::Samples { path, period, hold, .. } => {

@@ -81,12 +81,7 @@ fn certifies(sys: &System) -> Option<(f64, &'static str)> {
 }
 
 fn amplitudes(sys: &System) -> Option<&[f64]> {
-    match &sys.input {
-        Input::Sine { amplitudes, .. } | Input::Square { amplitudes, .. } | Input::Multisine { amplitudes, .. } => {
-            Some(amplitudes)
-        }
-        _ => None,
-    }
+    sys.input.wave().map(|(amplitudes, _, _)| amplitudes)
 }
 
 fn with_amplitude_factor(sys: &System, f: f64) -> Option<System> {
@@ -148,7 +143,7 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
     };
     if amplitudes(sys).is_some() {
         push("input.amplitude", with_amplitude_factor(sys, up), with_amplitude_factor(sys, dn));
-        if let Input::Sine { omega, .. } | Input::Square { omega, .. } | Input::Multisine { omega, .. } = &sys.input {
+        if let Some((_, omega, _)) = sys.input.wave() {
             push(
                 "input.omega",
                 with(sys, Parameter::InputOmega, omega * up),

@@ -207,7 +207,7 @@ fn csv_inputs() {
     let p = dir.path().join("w.csv");
     let (n, ok, _) = fuzz("csv", 13, |t| {
         std::fs::write(&p, t).unwrap();
-        model::Input::from_csv(&p, None).is_ok()
+        model::Input::from_csv(&p, None, model::input::InputHold::Foh).is_ok()
     });
     assert!(ok < n);
 }

@@ -77,8 +77,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// One drawn system assembled with its measured side: a row if it converges (measured 95 %
-/// interval below 0); under the input `kind` (`sine`, `square` or `multisine`) of its sine's
-/// amplitudes, period and phase.
+/// interval below 0); under the input `kind` (`sine`, `square`, `multisine`, `csv` or
+/// `csv-zoh`) of its sine's amplitudes, period and phase.
 fn measure_system(
     c: &theorems::strategies::systems::SystemParams,
     settings: &ThetaSettings,
@@ -400,10 +400,6 @@ fn kind(r: &Row) -> &'static str {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-// Near the threshold (issue 29 item 4): `THETA_BENCHMARK_NEAR=1`.
-// ---------------------------------------------------------------------------------------------
-
 /// The waveform of `THETA_BENCHMARK_INPUT=multisine`: `sin a + 0.5 sin(2 a + 0.7) + 0.25
 /// sin(3 a + 1.9)`, its weights divided by its peak (on a grid of 2^16 points of a period), so
 /// the input's largest `|w_i|` is the sine's amplitude `a_i`; with
@@ -434,14 +430,15 @@ fn sampled_sine(a: &[f64], omega: f64, phase: f64, zoh: bool) -> model::Input {
     model::Input::Samples { path: "<sampled sine>".into(), t, w, period: Some(period), hold }
 }
 
-/// The system with every input amplitude multiplied by `s` (sine and square inputs).
+// ---------------------------------------------------------------------------------------------
+// Near the threshold (issue 29 item 4): `THETA_BENCHMARK_NEAR=1`.
+// ---------------------------------------------------------------------------------------------
+
+/// The system with every input amplitude multiplied by `s` (sine, square and multisine inputs).
 fn scaled(sys: &model::System, s: f64) -> model::System {
     let mut out = sys.clone();
-    match &mut out.input {
-        model::Input::Sine { amplitudes, .. } | model::Input::Square { amplitudes, .. } => {
-            amplitudes.iter_mut().for_each(|a| *a *= s)
-        }
-        _ => {}
+    if let Some((amplitudes, _, _)) = out.input.wave_mut() {
+        amplitudes.iter_mut().for_each(|a| *a *= s);
     }
     out
 }

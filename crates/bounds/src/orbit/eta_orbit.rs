@@ -192,8 +192,8 @@ impl EtaOrbit {
     /// (relative to the largest sample) of the orbit; `rel_margin` is set so that
     /// `rel_margin osc` and `rel_margin eta_dot_inf` bound the samples' errors, as the sine's.
     pub(super) fn certify_samples(&mut self, margin: f64, verified: bool) {
-        let big = |v: &[Vec<f64>]| v.iter().map(|x| geometry::linalg::norm(x)).fold(0.0, f64::max);
-        let (e_eta, e_deta) = (margin * big(&self.eta), margin * big(&self.deta));
+        let (big_eta, big_deta) = self.largest_samples();
+        let (e_eta, e_deta) = (margin * big_eta, margin * big_deta);
         let diam = self.osc_sampled();
         self.osc = (diam - 2.0 * e_eta) * (1.0 - 1e-12);
         (self.rel_margin, self.eta_dot_inf) = (0.0, 0.0);
@@ -205,6 +205,13 @@ impl EtaOrbit {
         if !self.verified {
             self.rel_margin = 0.0;
         }
+    }
+
+    /// The largest `|eta_T|` and `|eta_T'|` among the samples: what the margin of
+    /// [`EtaOrbit::certify_samples`] is relative to.
+    pub(super) fn largest_samples(&self) -> (f64, f64) {
+        let big = |v: &[Vec<f64>]| v.iter().map(|x| geometry::linalg::norm(x)).fold(0.0, f64::max);
+        (big(&self.eta), big(&self.deta))
     }
 
     /// The jumps of `eta_T'` inside sample intervals `lo..hi`: their one-sided values.

@@ -24,7 +24,7 @@ pub fn input_csv(data: &[u8]) {
     if std::fs::write(&p, data).is_err() {
         return;
     }
-    let _ = model::Input::from_csv(&p, None);
+    let _ = model::Input::from_csv(&p, None, model::input::InputHold::Foh);
 }
 
 /// A recording CSV through the checked reader of `diagnose`.

@@ -13,7 +13,7 @@
 //!   written as an expression of it.
 use super::SweepError;
 use geometry::{Ball, BallIntersection, ConvexSet, Ellipsoid, Interval, Polytope, Shape};
-use model::{Input, System};
+use model::System;
 use nalgebra::DMatrix;
 
 /// A model quantity that an axis varies.
@@ -173,10 +173,9 @@ impl Parameter {
                     return Err(SweepError::IndexOutOfRange { name, i: *i, j: *j, rows: m.nrows(), cols: m.ncols() });
                 }
             }
-            Parameter::InputAmplitude { .. } | Parameter::InputOmega | Parameter::InputPhase => match &base.input {
-                Input::Sine { amplitudes, .. }
-                | Input::Square { amplitudes, .. }
-                | Input::Multisine { amplitudes, .. } => {
+            Parameter::InputAmplitude { .. } | Parameter::InputOmega | Parameter::InputPhase => match base.input.wave()
+            {
+                Some((amplitudes, _, _)) => {
                     if let Parameter::InputAmplitude { component: Some(k) } = self {
                         if *k >= amplitudes.len() {
                             return Err(SweepError::IndexOutOfRange {
@@ -189,7 +188,7 @@ impl Parameter {
                         }
                     }
                 }
-                _ => return na("the base model's input is not a sine, square wave or multisine"),
+                None => return na("the base model's input is not a sine, square wave or multisine"),
             },
             Parameter::ThetaScale => {}
             Parameter::ThetaR => {
@@ -222,10 +221,7 @@ impl Parameter {
             }
             Parameter::InputAmplitude { component } => {
                 self.check_applicable(sys)?;
-                if let Input::Sine { amplitudes, .. }
-                | Input::Square { amplitudes, .. }
-                | Input::Multisine { amplitudes, .. } = &mut sys.input
-                {
+                if let Some((amplitudes, _, _)) = sys.input.wave_mut() {
                     match component {
                         None => amplitudes.iter_mut().for_each(|a| *a = value),
                         Some(k) => amplitudes[*k] = value,
@@ -237,10 +233,7 @@ impl Parameter {
                 if *self == Parameter::InputOmega && (value.is_nan() || value <= 0.0) {
                     return Err(SweepError::NotApplicable { name, reason: "omega must be positive" });
                 }
-                if let Input::Sine { omega, phase, .. }
-                | Input::Square { omega, phase, .. }
-                | Input::Multisine { omega, phase, .. } = &mut sys.input
-                {
+                if let Some((_, omega, phase)) = sys.input.wave_mut() {
                     if *self == Parameter::InputOmega {
                         *omega = value;
                     } else {
