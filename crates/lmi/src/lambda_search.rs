@@ -12,7 +12,8 @@
 //! refinement on the bracket around the best grid point. SDP or verification failures
 //! at some `lambda` become gaps (reported, and treated as `+inf` by the refinement).
 
-use crate::beta_sdp::{certified_checked, BetaSdpSettings, BetaSdpSolution};
+use crate::beta_memo::BetaMemo;
+use crate::beta_sdp::{BetaSdpSettings, BetaSdpSolution};
 use crate::error::{LmiError, Result};
 use crate::spectral_abscissa::{check_system, hurwitz_mu};
 use crate::verify::Certificate;
@@ -107,8 +108,25 @@ pub fn optimise_lambda<T>(
     F: &DMatrix<f64>,
     E: &DMatrix<f64>,
     C: &DMatrix<f64>,
+    theta: T,
+    settings: &LambdaSearchSettings,
+) -> Result<LambdaSearch>
+where
+    T: FnMut(f64, f64) -> f64,
+{
+    optimise_lambda_memo(F, E, C, theta, settings, &mut BetaMemo::new())
+}
+
+/// [`optimise_lambda`] with the beta SDPs taken from (and added to) `memo`: several searches
+/// over one problem with different objectives solve each `lambda` once ([`BetaMemo`]). The
+/// result is the one [`optimise_lambda`] gives, bit for bit.
+pub fn optimise_lambda_memo<T>(
+    F: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+    C: &DMatrix<f64>,
     mut theta: T,
     settings: &LambdaSearchSettings,
+    memo: &mut BetaMemo,
 ) -> Result<LambdaSearch>
 where
     T: FnMut(f64, f64) -> f64,
@@ -121,7 +139,7 @@ where
     let mut best: Option<LambdaOptimum> = None;
 
     let mut eval = |lambda: f64, curve: &mut Vec<CurvePoint>, best: &mut Option<LambdaOptimum>| -> f64 {
-        let value = certified_checked(F, E, C, lambda, mu, &settings.beta).and_then(|cb| {
+        let value = memo.certified(F, E, C, lambda, mu, &settings.beta).and_then(|cb| {
             let (l, b) = (cb.certificate.lambda, cb.certificate.b_hat);
             let t = theta(l, b);
             if t.is_nan() {

@@ -13,8 +13,9 @@
 //! certifies when `(1 - 2/pi) psi(0) - (2/pi) lambda < 0` at some certified `(lambda, b_hat)`.
 use crate::sweep::axis::{apply_all, Parameter};
 use bounds::report::fmt_value as v;
-use bounds::{assemble, Psi, ThetaReport, ThetaSettings};
+use bounds::{assemble_memo, BetaMemo, Psi, ThetaReport, ThetaSettings};
 use model::{Input, System};
+use std::cell::RefCell;
 
 /// Settings of [`guidance`].
 #[derive(Debug, Clone)]
@@ -71,13 +72,19 @@ pub struct Guidance {
     pub notes: Vec<String>,
 }
 
-fn best_verified(sys: &System) -> Option<(f64, &'static str)> {
-    let r = assemble(sys, &ThetaSettings::bound_only()).ok()?;
-    Some((r.theta_best, r.theta_best_method)).filter(|_| r.theta_best_verified)
-}
+/// The bound computations of the guidance: every model varies the input or Theta, never `F`, `E`,
+/// `C`, so one memo serves their lambda searches (bounds::assemble_memo).
+struct Bounds<'m>(RefCell<&'m mut BetaMemo>);
 
-fn certifies(sys: &System) -> Option<(f64, &'static str)> {
-    best_verified(sys).filter(|(t, _)| *t < 0.0)
+impl Bounds<'_> {
+    fn report(&self, sys: &System) -> Option<ThetaReport> {
+        assemble_memo(sys, &ThetaSettings::bound_only(), &mut self.0.borrow_mut()).ok()
+    }
+
+    fn certifies(&self, sys: &System) -> Option<(f64, &'static str)> {
+        let r = self.report(sys)?;
+        Some((r.theta_best, r.theta_best_method)).filter(|(t, _)| r.theta_best_verified && *t < 0.0)
+    }
 }
 
 fn amplitudes(sys: &System) -> Option<&[f64]> {
@@ -96,8 +103,10 @@ fn with(sys: &System, p: Parameter, value: f64) -> Option<System> {
 }
 
 /// Guidance for `sys` whose report is `rep` (meant for reports without a certificate; it
-/// also runs on certified ones).
-pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidance {
+/// also runs on certified ones). `memo` may hold the beta SDPs of `rep`'s own computation
+/// (bounds::assemble_memo): every bound computed here is for the same `F`, `E`, `C`.
+pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mut BetaMemo) -> Guidance {
+    let bounds = Bounds(RefCell::new(memo));
     let mut notes = Vec::new();
     let psi = Psi { alpha: rep.alpha.lower, lambda: rep.lambda_star, beta: rep.beta_star };
     let (p0, pinf) = (psi.at_zero(), psi.eval(rep.gamma_inf));
@@ -133,7 +142,7 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
 
     // Sensitivities of the best verified bound (or of theta when none is verified).
     let mut sensitivities = Vec::new();
-    let value = |sys: &System| assemble(sys, &ThetaSettings::bound_only()).ok().map(|r| r.theta_best);
+    let value = |sys: &System| bounds.report(sys).map(|r| r.theta_best);
     let h = s.step;
     let (up, dn) = (h.exp(), (-h).exp());
     let mut push = |name: &'static str, a: Option<System>, b: Option<System>| {
@@ -161,10 +170,10 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings) -> Guidan
         let mut evaluations = 0;
         let mut eval = |f: f64| {
             evaluations += 1;
-            with_amplitude_factor(sys, f).as_ref().and_then(certifies)
+            with_amplitude_factor(sys, f).as_ref().and_then(|s| bounds.certifies(s))
         };
         let (mut lo, mut hi) = (1.0f64, None);
-        if let Some(v) = certifies(sys) {
+        if let Some(v) = bounds.certifies(sys) {
             notes.push(
                 "already certified: the amplitude search looks for the smallest factor <= 1 that still certifies"
                     .into(),

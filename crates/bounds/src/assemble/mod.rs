@@ -39,7 +39,7 @@ use crate::stationary::{rest_set, RestSet};
 use crate::tube::{tube_diameters_with, SemigroupData, TubeDiameters, TubeSettings};
 use dynamics::rate::lyapunov_exponent::measure_rate;
 use geometry::ConvexSet;
-use lmi::{optimise_lambda, LambdaSearch, LmiError};
+use lmi::{optimise_lambda_memo, BetaMemo, LambdaSearch, LmiError};
 use model::System;
 use nalgebra::DMatrix;
 use rounding::{ulp_down_nonzero, ulp_up};
@@ -51,13 +51,22 @@ use rounding::{ulp_down_nonzero, ulp_up};
 /// quadrature budget. Everything else (singular `Phi`, infinite `R`, unverifiable parts) is
 /// reported in the result.
 pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, BoundsError> {
+    assemble_memo(sys, settings, &mut BetaMemo::new())
+}
+
+/// [`assemble()`] with the beta SDPs of its lambda searches taken from and added to `memo`
+/// ([`lmi::BetaMemo`]): models that share `F`, `E`, `C` (the same plant under other inputs, other
+/// amplitudes or frequencies, a scaled Theta) solve each `lambda` once. The report is the one
+/// [`assemble()`] gives, bit for bit.
+pub fn assemble_memo(sys: &System, settings: &ThetaSettings, memo: &mut BetaMemo) -> Result<ThetaReport, BoundsError> {
     let mut notes = Vec::new();
     let plant = plant(sys, &mut notes)?;
     let tubes = tubes(sys, &plant.F, settings)?;
     let pinned = beyond_paper::pinned_speed(sys, &plant.F, &tubes.diam.tube_CF, &tubes.sg, &tubes.tube)?;
     let orbit = EtaOrbit::new(sys, &settings.orbit)?;
     let gammas = gammas(&plant, &tubes, &orbit, &mut notes);
-    let cert = certificate(sys, &plant.F, &gammas, settings, &mut notes)?;
+    // one memo for the lambda searches of theta, theta* and theta_engaged (lmi::beta_memo)
+    let cert = certificate(sys, &plant.F, &gammas, settings, memo, &mut notes)?;
     let theta = theta(sys, &plant, &tubes, &orbit, &cert, &gammas, &mut notes);
     let paths = path_lengths(&orbit, tubes.d, settings);
     let ext = beyond_paper::extensions(
@@ -87,6 +96,7 @@ pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, B
         },
         &pinned,
         settings,
+        memo,
         &mut notes,
     );
     let stationary = stationary(sys, settings, &mut notes);
@@ -215,6 +225,7 @@ fn certificate(
     F: &DMatrix<f64>,
     gammas: &Gammas,
     settings: &ThetaSettings,
+    memo: &mut BetaMemo,
     notes: &mut Vec<String>,
 ) -> Result<Cert, BoundsError> {
     let (C, E) = (&sys.C, &sys.E);
@@ -222,7 +233,7 @@ fn certificate(
     let al = alpha(C, E);
     let a_low = al.lower;
     let psi = |l: f64, b: f64| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1, gamma_inf);
-    let mut search = optimise_lambda(F, E, C, psi, &settings.lambda);
+    let mut search = optimise_lambda_memo(F, E, C, psi, &settings.lambda, memo);
     // Stiff plants (issue 29 item 1): with ||F|| 1e3-1e4 times |mu| the solver's Pi often
     // satisfies (ALI) with too small a margin to be proven; the search is repeated with the
     // margin imposed in the SDP raised to 1e-3, then 1e-2 (relative), which only enlarges the
@@ -233,7 +244,7 @@ fn certificate(
         }
         let mut retry = settings.lambda.clone();
         retry.beta.tol_ali_margin_rel = margin;
-        search = optimise_lambda(F, E, C, psi, &retry);
+        search = optimise_lambda_memo(F, E, C, psi, &retry, memo);
         if search.is_ok() {
             notes.push(format!(
                 "lambda search: no certificate with the default (ALI) margin; certified with the margin raised to {margin:e} (stiff F: a larger beta)"

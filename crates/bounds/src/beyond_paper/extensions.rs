@@ -17,7 +17,7 @@ use crate::orbit::{partition_bound_local, EtaOrbit};
 use crate::settings::ThetaSettings;
 use crate::tube::{SemigroupData, TubeKernel, TubeSettings};
 use geometry::ConvexSet;
-use lmi::optimise_lambda;
+use lmi::{optimise_lambda_memo, BetaMemo};
 use model::System;
 use nalgebra::DMatrix;
 use rounding::{ulp_down_nonzero, ulp_up};
@@ -123,13 +123,14 @@ pub(crate) fn extensions(
     paper: &FromPaper,
     pinned: &Pinned,
     settings: &ThetaSettings,
+    memo: &mut BetaMemo,
     notes: &mut Vec<String>,
 ) -> Extensions {
     let profiles = speed_profiles(paper, pinned, settings, notes);
     let speeds = speeds_star(paper, pinned, profiles.profile.as_ref());
-    let star = theta_star(paper, &speeds, settings, notes);
+    let star = theta_star(paper, &speeds, settings, memo, notes);
     let profile = theta_profile(paper, &profiles, &star, settings);
-    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, notes);
+    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, memo, notes);
     let (theta_best, theta_best_method, theta_best_verified) = best(paper, &star, &profile, &engaged);
     let evidence = engaged.evidence.or(profile.evidence);
     Extensions {
@@ -330,7 +331,13 @@ struct Star {
 }
 
 /// `theta*`: eq. (theta) with `gamma_1*`, `gamma_inf*`, minimised over certified points.
-fn theta_star(paper: &FromPaper, speeds: &SpeedsStar, settings: &ThetaSettings, notes: &mut Vec<String>) -> Star {
+fn theta_star(
+    paper: &FromPaper,
+    speeds: &SpeedsStar,
+    settings: &ThetaSettings,
+    memo: &mut BetaMemo,
+    notes: &mut Vec<String>,
+) -> Star {
     let (a_low, gamma_1, gamma_inf) = (paper.alpha, paper.gamma_1, paper.gamma_inf);
     let (gamma_1_star, gamma_inf_star) = (speeds.gamma_1_star, speeds.gamma_inf_star);
     let sys = paper.sys;
@@ -339,12 +346,13 @@ fn theta_star(paper: &FromPaper, speeds: &SpeedsStar, settings: &ThetaSettings, 
     // theta's); every point is a verified certificate, so the minimum over all is a bound.
     let mut star_points: Vec<(f64, f64)> = paper.curve.iter().map(|&(l, b, _)| (l, b)).collect();
     if paper.strongly_convex && (gamma_1_star > gamma_1 || gamma_inf_star < gamma_inf) {
-        match optimise_lambda(
+        match optimise_lambda_memo(
             paper.F,
             &sys.E,
             &sys.C,
             |l, b| Psi { alpha: a_low, lambda: l, beta: b }.theta(gamma_1_star, gamma_inf_star),
             &settings.lambda,
+            memo,
         ) {
             Ok(s2) => {
                 star_points.extend(s2.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))))
@@ -419,6 +427,7 @@ fn theta_engaged(
     star: &Star,
     profile: &ProfileBound,
     settings: &ThetaSettings,
+    memo: &mut BetaMemo,
     notes: &mut Vec<String>,
 ) -> EngagedBound {
     let a_low = paper.alpha;
@@ -433,12 +442,13 @@ fn theta_engaged(
             // the floors weigh psi at high speeds more than the chords do: a lambda search of
             // its own (every point a verified certificate, as for theta*)
             let mut points = star.points.clone();
-            match optimise_lambda(
+            match optimise_lambda_memo(
                 paper.F,
                 &sys.E,
                 &sys.C,
                 |l, b| prof.bound(&Psi { alpha: a_low, lambda: l, beta: b }, &nodes),
                 &settings.lambda,
+                memo,
             ) {
                 Ok(s3) => {
                     points.extend(s3.curve.iter().filter_map(|c| c.value.as_ref().ok().map(|v| (v.lambda, v.beta))))

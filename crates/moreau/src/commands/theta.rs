@@ -4,7 +4,7 @@ use super::Source;
 use crate::guidance::Guidance;
 use anyhow::Context;
 use bounds::beyond_paper::floquet::{self, FloquetEnclosure, FloquetSettings};
-use bounds::{assemble, ThetaReport, ThetaSettings};
+use bounds::{assemble_memo, BetaMemo, ThetaReport, ThetaSettings};
 use model::System;
 
 /// Options of `theta` (the CLI's `--no-measure`, `--no-stationary`, `--no-guidance`,
@@ -90,12 +90,14 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
     if !o.stationary {
         settings.stationary = None;
     }
+    // the guidance's bound computations share the report's beta SDPs (same F, E, C)
+    let mut memo = BetaMemo::new();
     let report = match src {
-        Source::File(p) => assemble(&sys, &settings).with_context(|| p.display().to_string())?,
-        Source::Built(..) => assemble(&sys, &settings)?,
+        Source::File(p) => assemble_memo(&sys, &settings, &mut memo).with_context(|| p.display().to_string())?,
+        Source::Built(..) => assemble_memo(&sys, &settings, &mut memo)?,
     };
     let guidance = (o.guidance && !report.convergence_guaranteed && report.effects.is_empty())
-        .then(|| crate::guidance::guidance(&sys, &report, &Default::default()));
+        .then(|| crate::guidance::guidance(&sys, &report, &Default::default(), &mut memo));
     let floquet =
         (o.measure && floquet::applies(&sys)).then(|| floquet::floquet_enclosure(&sys, &FloquetSettings::default()));
     Ok(ThetaRun { sys, report, guidance, floquet })

@@ -8,9 +8,10 @@
 //! `transient_periods` (default `10`), `pairs` (default `2`), `seed` (default `11`).
 use super::eval::{Cell, Column, Evaluator, PointError};
 use super::SweepError;
-use bounds::{assemble, ThetaSettings};
+use bounds::{assemble_memo, BetaMemo, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use model::System;
+use std::cell::RefCell;
 use std::path::Path;
 use toml::{Table, Value};
 
@@ -116,6 +117,11 @@ fn def(key: &str) -> &'static bounds::report::QuantityDef {
     bounds::report::defs::by_key(key).expect("sweep columns name declared quantities")
 }
 
+thread_local! {
+    /// One [`BetaMemo`] per worker thread of the sweep (it forgets a plant when it meets another).
+    static MEMO: RefCell<BetaMemo> = RefCell::new(BetaMemo::new());
+}
+
 /// Column names of [`ThetaEvaluator`], in order.
 pub fn column_names() -> Vec<&'static str> {
     let mut v: Vec<&str> = QUANTITY_COLUMNS.to_vec();
@@ -151,7 +157,9 @@ impl Evaluator for ThetaEvaluator {
     }
 
     fn evaluate(&self, sys: &System) -> Result<Vec<Cell>, PointError> {
-        let r = assemble(sys, &self.settings)?;
+        // each worker keeps the beta SDPs of its last plant: points that vary only the input or
+        // Theta (amplitude, omega, theta.scale axes) solve each lambda once (bounds::assemble_memo)
+        let r = MEMO.with(|m| assemble_memo(sys, &self.settings, &mut m.borrow_mut()))?;
         let num = Cell::Num;
         let (rate, lo, hi, path) = match &r.measured {
             Some(m) => (num(m.rate), num(m.ci_low), num(m.ci_high), num(m.path_length_per_period)),
