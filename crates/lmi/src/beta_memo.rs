@@ -5,8 +5,9 @@
 //! `theta(lambda, beta)` a search minimises, so a second search with another objective (the
 //! bounds beyond the paper run up to three) re-uses every `lambda` it meets again: the whole
 //! grid, and the golden-section steps while its comparisons agree with the first search's.
-//! The memo is keyed by the problem `(F, E, C, settings)` as well: asked about another problem,
-//! it forgets what it had, so a stale answer is never returned. Every remembered value is
+//! The memo is keyed by the problem `(F, E, C)` and the SDP settings as well: asked about
+//! another plant, it forgets what it had, so a stale answer is never returned; other settings
+//! (the retry with a larger (ALI) margin on stiff plants) are remembered beside the first. Every remembered value is
 //! the same certified result (or the same error) a fresh solve gives, bit for bit.
 use crate::beta_sdp::{certified_checked, BetaSdpSettings, CertifiedBeta};
 use crate::error::Result;
@@ -16,18 +17,11 @@ use std::collections::HashMap;
 /// See the module docs.
 #[derive(Debug, Default)]
 pub struct BetaMemo {
-    problem: Option<Problem>,
-    by_lambda: HashMap<u64, Result<CertifiedBeta>>,
+    plant: Option<[DMatrix<f64>; 3]>,
+    /// Per SDP settings, the answers by the bits of the requested lambda.
+    by_settings: Vec<(BetaSdpSettings, HashMap<u64, Result<CertifiedBeta>>)>,
     solves: usize,
     hits: usize,
-}
-
-#[derive(Debug, PartialEq)]
-struct Problem {
-    F: DMatrix<f64>,
-    E: DMatrix<f64>,
-    C: DMatrix<f64>,
-    settings: BetaSdpSettings,
 }
 
 impl BetaMemo {
@@ -57,19 +51,26 @@ impl BetaMemo {
         mu: f64,
         settings: &BetaSdpSettings,
     ) -> Result<CertifiedBeta> {
-        let same =
-            self.problem.as_ref().is_some_and(|p| p.F == *F && p.E == *E && p.C == *C && p.settings == *settings);
-        if !same {
-            self.by_lambda.clear();
-            self.problem = Some(Problem { F: F.clone(), E: E.clone(), C: C.clone(), settings: settings.clone() });
+        let same_plant = self.plant.as_ref().is_some_and(|[f, e, c]| f == F && e == E && c == C);
+        if !same_plant {
+            self.by_settings.clear();
+            self.plant = Some([F.clone(), E.clone(), C.clone()]);
         }
-        if let Some(r) = self.by_lambda.get(&lambda.to_bits()) {
+        let k = match self.by_settings.iter().position(|(s, _)| s == settings) {
+            Some(k) => k,
+            None => {
+                self.by_settings.push((settings.clone(), HashMap::new()));
+                self.by_settings.len() - 1
+            }
+        };
+        let by_lambda = &mut self.by_settings[k].1;
+        if let Some(r) = by_lambda.get(&lambda.to_bits()) {
             self.hits += 1;
             return r.clone();
         }
         self.solves += 1;
         let r = certified_checked(F, E, C, lambda, mu, settings);
-        self.by_lambda.insert(lambda.to_bits(), r.clone());
+        by_lambda.insert(lambda.to_bits(), r.clone());
         r
     }
 }
@@ -102,10 +103,13 @@ mod tests {
         let c = memo.certified(&F2, &E, &C, 0.1, mu2, &s).unwrap();
         assert_eq!((memo.solves(), memo.hits()), (3, 1));
         assert_ne!(c.solution.beta, a.solution.beta);
-        // other settings: solved again
+        // other settings: solved again, and both kept
         let mut s2 = s.clone();
         s2.tol_ali_margin_rel *= 10.0;
-        memo.certified(&F2, &E, &C, 0.1, mu2, &s2).unwrap();
+        let d = memo.certified(&F2, &E, &C, 0.1, mu2, &s2).unwrap();
         assert_eq!((memo.solves(), memo.hits()), (4, 1));
+        assert_eq!(memo.certified(&F2, &E, &C, 0.1, mu2, &s).unwrap(), c);
+        assert_eq!(memo.certified(&F2, &E, &C, 0.1, mu2, &s2).unwrap(), d);
+        assert_eq!((memo.solves(), memo.hits()), (4, 3));
     }
 }
