@@ -210,6 +210,16 @@ pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64, band: &dyn Fn(&[f64]) -> f64) -
     // omega_max (block length) / 2 of a direction at the block's ends (plus the samples'
     // direction error 2 sample_err / m), and the band's support is D-Lipschitz.
     let blocks = K.div_ceil(BAND_STRIDE);
+    // the band against and along the motion at a block boundary, evaluated once for the two
+    // blocks that share it
+    let mut at_boundary: Vec<Option<(f64, f64)>> = vec![None; blocks + 1];
+    let mut band_at = |i: usize| -> (f64, f64) {
+        let slot = &mut at_boundary[i.div_ceil(BAND_STRIDE)];
+        *slot.get_or_insert_with(|| {
+            let d = &orbit.deta[i];
+            (band(&unit(d, -1.0)), band(&unit(d, 1.0)))
+        })
+    };
     let block_band: Vec<(f64, f64)> = (0..blocks)
         .map(|bk| {
             let (i0, i1) = (bk * BAND_STRIDE, ((bk + 1) * BAND_STRIDE).min(K));
@@ -220,9 +230,9 @@ pub fn substeps(orbit: &EtaOrbit, d_ftheta: f64, band: &dyn Fn(&[f64]) -> f64) -
             let omega = pad_up(lip / m_min, REL);
             let span = (i1 - i0) as f64 * dt;
             let turn = pad_up(d_ftheta * (omega * 0.5 * span + 2.0 * sample_err / m_min + 1e-9), REL);
-            let (a, b) = (&orbit.deta[i0], &orbit.deta[i1]);
-            let back = pad_up(band(&unit(a, -1.0)).max(band(&unit(b, -1.0))) + turn, REL).min(d_ftheta);
-            let fwd = pad_up(band(&unit(a, 1.0)).max(band(&unit(b, 1.0))) + turn, REL).min(d_ftheta);
+            let ((back_a, fwd_a), (back_b, fwd_b)) = (band_at(i0), band_at(i1));
+            let back = pad_up(back_a.max(back_b) + turn, REL).min(d_ftheta);
+            let fwd = pad_up(fwd_a.max(fwd_b) + turn, REL).min(d_ftheta);
             (back, fwd)
         })
         .collect();
