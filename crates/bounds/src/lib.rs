@@ -57,10 +57,9 @@ pub mod settings;
 pub mod stationary;
 pub mod tube;
 
-pub use assemble::{assemble, assemble_memo};
+pub use assemble::{assemble, assemble_memo, Memo};
 pub use error::BoundsError;
 pub use exponent::Psi;
-pub use lmi::BetaMemo;
 pub use report::{BoundKind, Quantity};
 pub use report::{MeasuredSide, ThetaReport};
 pub use settings::ThetaSettings;

@@ -53,20 +53,20 @@ fn a_stiff_plant_gets_a_verified_answer_not_an_error() {
 /// sweep ask) every lambda of the grid is answered from the memo.
 #[test]
 fn the_memo_changes_no_report_and_saves_the_solves() {
-    use bounds::{assemble_memo, BetaMemo};
+    use bounds::{assemble_memo, Memo};
     let sys = model::parse_str(RATIO_1E3).unwrap();
     let mut louder = sys.clone();
     louder.input.wave_mut().expect("a sine").0[0] *= 3.0;
     let s = ThetaSettings::bound_only();
-    let mut memo = BetaMemo::new();
+    let mut memo = Memo::new();
     let json = |r: &bounds::ThetaReport| serde_json::to_string(r).unwrap();
     let first = assemble_memo(&sys, &s, &mut memo).unwrap();
-    let solves_first = memo.solves();
+    let solves_first = memo.beta.solves();
     assert_eq!(json(&first), json(&assemble(&sys, &s).unwrap()));
     let second = assemble_memo(&louder, &s, &mut memo).unwrap();
     assert_eq!(json(&second), json(&assemble(&louder, &s).unwrap()));
-    let solves_second = memo.solves() - solves_first;
-    assert!(memo.hits() >= 12, "the grid of the second report comes from the memo: {} hits", memo.hits());
+    let solves_second = memo.beta.solves() - solves_first;
+    assert!(memo.beta.hits() >= 12, "the grid of the second report comes from the memo: {} hits", memo.beta.hits());
     assert!(solves_second < solves_first, "{solves_second} solves for the second report, {solves_first} for the first");
     // negative control: the reports differ (the amplitude matters), only their SDPs are shared
     assert_ne!(first.theta_best, second.theta_best);

@@ -13,7 +13,7 @@
 //! certifies when `(1 - 2/pi) psi(0) - (2/pi) lambda < 0` at some certified `(lambda, b_hat)`.
 use crate::sweep::axis::{apply_all, Parameter};
 use bounds::report::fmt_value as v;
-use bounds::{assemble_memo, BetaMemo, Psi, ThetaReport, ThetaSettings};
+use bounds::{assemble_memo, Memo, Psi, ThetaReport, ThetaSettings};
 use model::{Input, System};
 use std::cell::RefCell;
 
@@ -74,7 +74,7 @@ pub struct Guidance {
 
 /// The bound computations of the guidance: every model varies the input or Theta, never `F`, `E`,
 /// `C`, so one memo serves their lambda searches (bounds::assemble_memo).
-struct Bounds<'m>(RefCell<&'m mut BetaMemo>);
+struct Bounds<'m>(RefCell<&'m mut Memo>);
 
 impl Bounds<'_> {
     fn report(&self, sys: &System) -> Option<ThetaReport> {
@@ -105,7 +105,7 @@ fn with(sys: &System, p: Parameter, value: f64) -> Option<System> {
 /// Guidance for `sys` whose report is `rep` (meant for reports without a certificate; it
 /// also runs on certified ones). `memo` may hold the beta SDPs of `rep`'s own computation
 /// (bounds::assemble_memo): every bound computed here is for the same `F`, `E`, `C`.
-pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mut BetaMemo) -> Guidance {
+pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mut Memo) -> Guidance {
     let bounds = Bounds(RefCell::new(memo));
     let mut notes = Vec::new();
     let psi = Psi { alpha: rep.alpha.lower, lambda: rep.lambda_star, beta: rep.beta_star };

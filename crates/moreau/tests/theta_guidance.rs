@@ -20,7 +20,7 @@ fn smallest_certifying_amplitude_is_certified_and_the_factor_below_is_not() {
     let sys = worked_example_with_amplitude(0.2);
     let rep = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
     assert!(!rep.convergence_guaranteed, "amplitude 0.2 is not certified: {}", rep.theta_best);
-    let g = guidance(&sys, &rep, &GuidanceSettings::default(), &mut bounds::BetaMemo::new());
+    let g = guidance(&sys, &rep, &GuidanceSettings::default(), &mut bounds::Memo::new());
     assert!(g.blocking.contains("kappa"), "{}", g.blocking);
     assert!(g.kappa_star < g.kappa_needed);
     let amp = g.sensitivities.iter().find(|s| s.parameter == "input.amplitude").unwrap();
@@ -43,11 +43,7 @@ fn polytope_guidance_says_no_certificate_exists() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/polytope-p2.toml");
     let sys = model::load(std::path::Path::new(path)).unwrap();
     let rep = assemble(&sys, &ThetaSettings::bound_only()).unwrap();
-    let g = guidance(
-        &sys,
-        &rep,
-        &GuidanceSettings { bisection_steps: 2, ..Default::default() },
-        &mut bounds::BetaMemo::new(),
-    );
+    let g =
+        guidance(&sys, &rep, &GuidanceSettings { bisection_steps: 2, ..Default::default() }, &mut bounds::Memo::new());
     assert!(g.blocking.contains("not strongly convex") && g.amplitude.is_none(), "{}", g.blocking);
 }

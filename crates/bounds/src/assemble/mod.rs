@@ -40,6 +40,9 @@ use crate::tube::{tube_diameters_with, SemigroupData, TubeDiameters, TubeSetting
 use dynamics::rate::lyapunov_exponent::measure_rate;
 use geometry::ConvexSet;
 use lmi::{optimise_lambda_memo, BetaMemo, LambdaSearch, LmiError};
+
+mod memo;
+pub use memo::Memo;
 use model::System;
 use nalgebra::DMatrix;
 use rounding::{ulp_down_nonzero, ulp_up};
@@ -51,14 +54,14 @@ use rounding::{ulp_down_nonzero, ulp_up};
 /// quadrature budget. Everything else (singular `Phi`, infinite `R`, unverifiable parts) is
 /// reported in the result.
 pub fn assemble(sys: &System, settings: &ThetaSettings) -> Result<ThetaReport, BoundsError> {
-    assemble_memo(sys, settings, &mut BetaMemo::new())
+    assemble_memo(sys, settings, &mut Memo::new())
 }
 
-/// [`assemble()`] with the beta SDPs of its lambda searches taken from and added to `memo`
-/// ([`lmi::BetaMemo`]): models that share `F`, `E`, `C` (the same plant under other inputs, other
-/// amplitudes or frequencies, a scaled Theta) solve each `lambda` once. The report is the one
-/// [`assemble()`] gives, bit for bit.
-pub fn assemble_memo(sys: &System, settings: &ThetaSettings, memo: &mut BetaMemo) -> Result<ThetaReport, BoundsError> {
+/// [`assemble()`] with what reports of one plant share taken from and added to `memo` ([`Memo`]:
+/// the beta SDPs, the engaged history): models that share `F`, `E`, `C` (the same plant under
+/// other inputs, amplitudes or frequencies, a scaled Theta) solve each `lambda` once. The report
+/// is the one [`assemble()`] gives, bit for bit.
+pub fn assemble_memo(sys: &System, settings: &ThetaSettings, memo: &mut Memo) -> Result<ThetaReport, BoundsError> {
     let mut notes = Vec::new();
     let plant = plant(sys, &mut notes)?;
     let tubes = tubes(sys, &plant.F, settings)?;
@@ -66,7 +69,7 @@ pub fn assemble_memo(sys: &System, settings: &ThetaSettings, memo: &mut BetaMemo
     let orbit = EtaOrbit::new(sys, &settings.orbit)?;
     let gammas = gammas(&plant, &tubes, &orbit, &mut notes);
     // one memo for the lambda searches of theta, theta* and theta_engaged (lmi::beta_memo)
-    let cert = certificate(sys, &plant.F, &gammas, settings, memo, &mut notes)?;
+    let cert = certificate(sys, &plant.F, &gammas, settings, &mut memo.beta, &mut notes)?;
     let theta = theta(sys, &plant, &tubes, &orbit, &cert, &gammas, &mut notes);
     let paths = path_lengths(&orbit, tubes.d, settings);
     let ext = beyond_paper::extensions(

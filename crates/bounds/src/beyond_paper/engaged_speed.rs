@@ -93,6 +93,26 @@ impl EngagedHistory {
         dtau: f64,
         steps: usize,
     ) -> Result<Option<Self>, BoundsError> {
+        Self::new_reusing(None, tube_CF, C, F, E, (lo, hi), sg, tube, dtau, steps)
+    }
+
+    /// [`Self::new`], with the entries `tau_j` it shares with `known` taken from there instead of
+    /// computed again. `known` must come from `new` (or this function) with the same arguments
+    /// but `steps`: entry `j` depends on `j dtau` and those arguments only, so the result is the
+    /// one `new` gives, bit for bit ([`HistoryMemo`] keeps that promise).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new_reusing(
+        known: Option<&Self>,
+        tube_CF: &TubeKernel,
+        C: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        (lo, hi): (f64, f64),
+        sg: &SemigroupData,
+        tube: &TubeSettings,
+        dtau: f64,
+        steps: usize,
+    ) -> Result<Option<Self>, BoundsError> {
         let shape_ok = C.nrows() == 1 && E.ncols() == 1 && C.ncols() == E.nrows() && lo <= 0.0 && 0.0 <= hi;
         if !shape_ok || (steps > 0 && !(dtau > 0.0 && dtau.is_finite())) || sg.exp_norm().is_none() {
             return Ok(None);
@@ -116,7 +136,14 @@ impl EngagedHistory {
             tail_up: vec![pad_up(s_up + d_theta * l_err, PAD)],
             tail_down: vec![pad_up(s_down + d_theta * l_err, PAD)],
         };
-        for j in 1..=steps {
+        let reused = known.map_or(0, |k| (k.tail_up.len() - 1).min(steps));
+        if let Some(k) = known.filter(|_| reused > 0) {
+            out.known_lo = k.known_lo[..=reused].to_vec();
+            out.known_hi = k.known_hi[..=reused].to_vec();
+            out.tail_up = k.tail_up[..=reused].to_vec();
+            out.tail_down = k.tail_down[..=reused].to_vec();
+        }
+        for j in reused + 1..=steps {
             let tau = j as f64 * dtau;
             let h = Horizon::Finite(tau);
             let kt = TubeKernel::with_shared(&CF, F, E, &theta, d_theta, sg, h, tube)?;
@@ -157,6 +184,63 @@ impl EngagedHistory {
     }
 }
 
+/// The longest [`EngagedHistory`] computed for one problem, for the next report on the same
+/// plant, Theta, period and tube settings (another amplitude, a sweep point): its entries are a
+/// prefix of any longer table ([`EngagedHistory::new_reusing`]). Asked about another problem, it
+/// forgets what it had.
+#[derive(Debug, Default)]
+pub struct HistoryMemo {
+    key: Option<HistoryKey>,
+    longest: Option<EngagedHistory>,
+}
+
+#[derive(Debug, PartialEq)]
+struct HistoryKey {
+    C: DMatrix<f64>,
+    F: DMatrix<f64>,
+    E: DMatrix<f64>,
+    /// `lo`, `hi`, `dtau` and `sigma_{C F Xi_inf}(+-1)` from above, as bits.
+    bits: [u64; 5],
+    tube: TubeSettings,
+}
+
+impl HistoryMemo {
+    /// [`EngagedHistory::new`] through the memo (the same arguments, the same result).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn history(
+        &mut self,
+        tube_CF: &TubeKernel,
+        C: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        (lo, hi): (f64, f64),
+        sg: &SemigroupData,
+        tube: &TubeSettings,
+        dtau: f64,
+        steps: usize,
+    ) -> Result<Option<EngagedHistory>, BoundsError> {
+        let (s_up, s_down) = (tube_CF.support_upper(&[1.0]), tube_CF.support_upper(&[-1.0]));
+        let key = HistoryKey {
+            C: C.clone(),
+            F: F.clone(),
+            E: E.clone(),
+            bits: [lo.to_bits(), hi.to_bits(), dtau.to_bits(), s_up.to_bits(), s_down.to_bits()],
+            tube: *tube,
+        };
+        if self.key.as_ref() != Some(&key) {
+            self.key = Some(key);
+            self.longest = None;
+        }
+        let h = EngagedHistory::new_reusing(self.longest.as_ref(), tube_CF, C, F, E, (lo, hi), sg, tube, dtau, steps)?;
+        if let Some(h) = &h {
+            if self.longest.as_ref().is_none_or(|l| l.tail_up.len() < h.tail_up.len()) {
+                self.longest = Some(h.clone());
+            }
+        }
+        Ok(h)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,6 +265,32 @@ mod tests {
         EngagedHistory::new(k, C, F, E, (lo, hi), &SemigroupData::new(F), &st, 1.0, 0)
             .unwrap()
             .map(|h| h.pinned(lo, hi))
+    }
+
+    /// The memo gives what `new` gives, bit for bit, for a shorter table (a prefix of the one it
+    /// holds) and a longer one (extended from it); negative control: another Theta at the same
+    /// plant is computed afresh, not taken from the memo (its tails differ).
+    #[test]
+    fn history_memo_equals_new_bit_for_bit() {
+        let F = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.6]);
+        let C = DMatrix::from_row_slice(1, 2, &[1.0, 0.3]);
+        let E = DMatrix::from_row_slice(2, 1, &[0.2, 1.0]);
+        let st = TubeSettings::default();
+        let sg = SemigroupData::new(&F);
+        let (lo, hi) = (-0.1, 0.2);
+        let k = kernel(&C, &F, &E, &Shape::Interval(Interval::new(lo, hi).unwrap()));
+        let fresh = |steps| EngagedHistory::new(&k, &C, &F, &E, (lo, hi), &sg, &st, 0.5, steps).unwrap().unwrap();
+        let mut memo = HistoryMemo::default();
+        let mut via = |steps| memo.history(&k, &C, &F, &E, (lo, hi), &sg, &st, 0.5, steps).unwrap().unwrap();
+        for steps in [4, 2, 8, 6, 8] {
+            assert_eq!(via(steps), fresh(steps), "{steps} steps");
+        }
+        let (lo2, hi2) = (-0.2, 0.2);
+        let k2 = kernel(&C, &F, &E, &Shape::Interval(Interval::new(lo2, hi2).unwrap()));
+        let other = memo.history(&k2, &C, &F, &E, (lo2, hi2), &sg, &st, 0.5, 4).unwrap().unwrap();
+        let other_fresh = EngagedHistory::new(&k2, &C, &F, &E, (lo2, hi2), &sg, &st, 0.5, 4).unwrap().unwrap();
+        assert_eq!(other, other_fresh);
+        assert_ne!(other.tail_up, fresh(4).tail_up);
     }
 
     /// The ceilings never exceed D (which allows any v in Theta); with CE > 0 they are lower

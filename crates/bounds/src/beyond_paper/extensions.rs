@@ -8,8 +8,9 @@
 //! [`extensions`] is a list of named steps: [`speed_profiles`] -> [`speeds_star`] ->
 //! [`theta_star`] -> [`theta_profile`] -> [`theta_engaged`] -> [`best`]. [`pinned_speed`] runs
 //! earlier, right after the paper's tube stage whose kernels it shares.
+use crate::assemble::Memo;
 use crate::beyond_paper::contact_floors::{contact_floors, Band, ContactGeometry};
-use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed};
+use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed, HistoryMemo};
 use crate::beyond_paper::speed_profile::{ProfileEvidence, SpeedProfile};
 use crate::error::BoundsError;
 use crate::exponent::psi::Psi;
@@ -123,14 +124,14 @@ pub(crate) fn extensions(
     paper: &FromPaper,
     pinned: &Pinned,
     settings: &ThetaSettings,
-    memo: &mut BetaMemo,
+    memo: &mut Memo,
     notes: &mut Vec<String>,
 ) -> Extensions {
-    let profiles = speed_profiles(paper, pinned, settings, notes);
+    let profiles = speed_profiles(paper, pinned, settings, &mut memo.history, notes);
     let speeds = speeds_star(paper, pinned, profiles.profile.as_ref());
-    let star = theta_star(paper, &speeds, settings, memo, notes);
+    let star = theta_star(paper, &speeds, settings, &mut memo.beta, notes);
     let profile = theta_profile(paper, &profiles, &star, settings);
-    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, memo, notes);
+    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, &mut memo.beta, notes);
     let (theta_best, theta_best_method, theta_best_verified) = best(paper, &star, &profile, &engaged);
     let evidence = engaged.evidence.or(profile.evidence);
     Extensions {
@@ -173,7 +174,13 @@ struct Profiles {
 
 /// Speed profile per cell (theta_profile, theta_engaged), built before theta* because its
 /// largest ceiling also bounds limsup |z'|.
-fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, notes: &mut Vec<String>) -> Profiles {
+fn speed_profiles(
+    paper: &FromPaper,
+    pinned: &Pinned,
+    settings: &ThetaSettings,
+    histories: &mut HistoryMemo,
+    notes: &mut Vec<String>,
+) -> Profiles {
     let (T, R, d, d_ftheta, orbit) = (paper.T, paper.R, paper.d, paper.d_ftheta, paper.orbit);
     let cells = largest_divisor_at_most(orbit.t.len() - 1, settings.profile_cells.max(1));
     let profile = match (paper.strongly_convex, orbit.eta_dot_cells(cells)) {
@@ -207,21 +214,12 @@ fn speed_profiles(paper: &FromPaper, pinned: &Pinned, settings: &ThetaSettings, 
             let needed = ((oldest / dtau).floor() as usize).min(steps);
             let history = if needed > 0 {
                 let sys = paper.sys;
-                EngagedHistory::new(
-                    paper.tube_CF,
-                    &sys.C,
-                    paper.F,
-                    &sys.E,
-                    (lo, hi),
-                    paper.sg,
-                    paper.tube,
-                    dtau,
-                    needed,
-                )
-                .unwrap_or_else(|e| {
-                    notes.push(format!("engaged history not computed: {e}"));
-                    None
-                })
+                histories
+                    .history(paper.tube_CF, &sys.C, paper.F, &sys.E, (lo, hi), paper.sg, paper.tube, dtau, needed)
+                    .unwrap_or_else(|e| {
+                        notes.push(format!("engaged history not computed: {e}"));
+                        None
+                    })
             } else {
                 None
             };

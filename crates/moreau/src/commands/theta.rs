@@ -4,7 +4,7 @@ use super::Source;
 use crate::guidance::Guidance;
 use anyhow::Context;
 use bounds::beyond_paper::floquet::{self, FloquetEnclosure, FloquetSettings};
-use bounds::{assemble_memo, BetaMemo, ThetaReport, ThetaSettings};
+use bounds::{assemble_memo, Memo, ThetaReport, ThetaSettings};
 use model::System;
 
 /// Options of `theta` (the CLI's `--no-measure`, `--no-stationary`, `--no-guidance`,
@@ -91,7 +91,7 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
         settings.stationary = None;
     }
     // the guidance's bound computations share the report's beta SDPs (same F, E, C)
-    let mut memo = BetaMemo::new();
+    let mut memo = Memo::new();
     let report = match src {
         Source::File(p) => assemble_memo(&sys, &settings, &mut memo).with_context(|| p.display().to_string())?,
         Source::Built(..) => assemble_memo(&sys, &settings, &mut memo)?,

@@ -8,7 +8,7 @@
 //! `transient_periods` (default `10`), `pairs` (default `2`), `seed` (default `11`).
 use super::eval::{Cell, Column, Evaluator, PointError};
 use super::SweepError;
-use bounds::{assemble_memo, BetaMemo, ThetaSettings};
+use bounds::{assemble_memo, Memo, ThetaSettings};
 use dynamics::rate::lyapunov_exponent::RateSettings;
 use model::System;
 use std::cell::RefCell;
@@ -118,8 +118,8 @@ fn def(key: &str) -> &'static bounds::report::QuantityDef {
 }
 
 thread_local! {
-    /// One [`BetaMemo`] per worker thread of the sweep (it forgets a plant when it meets another).
-    static MEMO: RefCell<BetaMemo> = RefCell::new(BetaMemo::new());
+    /// One [`Memo`] per worker thread of the sweep (it forgets a plant when it meets another).
+    static MEMO: RefCell<Memo> = RefCell::new(Memo::new());
 }
 
 /// Column names of [`ThetaEvaluator`], in order.
