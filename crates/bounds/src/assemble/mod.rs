@@ -99,7 +99,7 @@ pub fn assemble_memo(sys: &System, settings: &ThetaSettings, memo: &mut Memo) ->
         },
         &pinned,
         settings,
-        memo,
+        (&mut memo.beta, &mut memo.history),
         &mut notes,
     );
     let stationary = stationary(sys, settings, &mut notes);

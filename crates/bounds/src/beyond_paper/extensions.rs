@@ -8,7 +8,6 @@
 //! [`extensions`] is a list of named steps: [`speed_profiles`] -> [`speeds_star`] ->
 //! [`theta_star`] -> [`theta_profile`] -> [`theta_engaged`] -> [`best`]. [`pinned_speed`] runs
 //! earlier, right after the paper's tube stage whose kernels it shares.
-use crate::assemble::Memo;
 use crate::beyond_paper::contact_floors::{contact_floors, Band, ContactGeometry};
 use crate::beyond_paper::engaged_speed::{EngagedHistory, EngagedSpeed, HistoryMemo};
 use crate::beyond_paper::speed_profile::{ProfileEvidence, SpeedProfile};
@@ -124,14 +123,14 @@ pub(crate) fn extensions(
     paper: &FromPaper,
     pinned: &Pinned,
     settings: &ThetaSettings,
-    memo: &mut Memo,
+    (betas, histories): (&mut BetaMemo, &mut HistoryMemo),
     notes: &mut Vec<String>,
 ) -> Extensions {
-    let profiles = speed_profiles(paper, pinned, settings, &mut memo.history, notes);
+    let profiles = speed_profiles(paper, pinned, settings, histories, notes);
     let speeds = speeds_star(paper, pinned, profiles.profile.as_ref());
-    let star = theta_star(paper, &speeds, settings, &mut memo.beta, notes);
+    let star = theta_star(paper, &speeds, settings, betas, notes);
     let profile = theta_profile(paper, &profiles, &star, settings);
-    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, &mut memo.beta, notes);
+    let engaged = theta_engaged(paper, &profiles, &star, &profile, settings, betas, notes);
     let (theta_best, theta_best_method, theta_best_verified) = best(paper, &star, &profile, &engaged);
     let evidence = engaged.evidence.or(profile.evidence);
     Extensions {
