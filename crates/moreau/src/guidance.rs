@@ -103,8 +103,8 @@ fn with(sys: &System, p: Parameter, value: f64) -> Option<System> {
 }
 
 /// Guidance for `sys` whose report is `rep` (meant for reports without a certificate; it
-/// also runs on certified ones). `memo` may hold the beta SDPs of `rep`'s own computation
-/// (bounds::assemble_memo): every bound computed here is for the same `F`, `E`, `C`.
+/// also runs on certified ones). `memo` may hold what `rep`'s own computation left
+/// (bounds::Memo): every bound computed here is for the same `F`, `E`, `C`.
 pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mut Memo) -> Guidance {
     let bounds = Bounds(RefCell::new(memo));
     let mut notes = Vec::new();

@@ -40,12 +40,12 @@ use crate::tube::{tube_diameters_with, SemigroupData, TubeDiameters, TubeSetting
 use dynamics::rate::lyapunov_exponent::measure_rate;
 use geometry::ConvexSet;
 use lmi::{optimise_lambda_memo, BetaMemo, LambdaSearch, LmiError};
-
-mod memo;
-pub use memo::Memo;
 use model::System;
 use nalgebra::DMatrix;
 use rounding::{ulp_down_nonzero, ulp_up};
+
+mod memo;
+pub use memo::Memo;
 
 /// Computes `theta` and all its parts for `sys`; see the module docs.
 ///

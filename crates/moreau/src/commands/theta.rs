@@ -90,7 +90,8 @@ pub fn theta(src: &Source, o: &ThetaOptions) -> anyhow::Result<ThetaRun> {
     if !o.stationary {
         settings.stationary = None;
     }
-    // the guidance's bound computations share the report's beta SDPs (same F, E, C)
+    // the guidance's bound computations share the report's memo (same F, E, C: its beta SDPs
+    // and engaged history, bounds::Memo)
     let mut memo = Memo::new();
     let report = match src {
         Source::File(p) => assemble_memo(&sys, &settings, &mut memo).with_context(|| p.display().to_string())?,

@@ -157,8 +157,8 @@ impl Evaluator for ThetaEvaluator {
     }
 
     fn evaluate(&self, sys: &System) -> Result<Vec<Cell>, PointError> {
-        // each worker keeps the beta SDPs of its last plant: points that vary only the input or
-        // Theta (amplitude, omega, theta.scale axes) solve each lambda once (bounds::assemble_memo)
+        // each worker keeps the memo of its last plant (bounds::Memo): points that vary only the
+        // input or Theta (amplitude, omega, theta.scale axes) solve each lambda once
         let r = MEMO.with(|m| assemble_memo(sys, &self.settings, &mut m.borrow_mut()))?;
         let num = Cell::Num;
         let (rate, lo, hi, path) = match &r.measured {
