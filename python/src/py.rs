@@ -456,6 +456,7 @@ fn diagnose_options(
         estimate_x0,
         metric,
         refit_nominal: !no_refit,
+        ..Default::default()
     })
 }
 

@@ -61,10 +61,11 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                 (fit_under(InputHold::Zoh), fit_under(InputHold::Foh))
             };
             let (bz, bf) = (select::bic(fz.sse, data.n_res, 0), select::bic(ff.sse, data.n_res, 0));
-            let hold = if bz < bf { InputHold::Zoh } else { InputHold::Foh };
+            let preferred = if bz < bf { InputHold::Zoh } else { InputHold::Foh };
             let d = (bz - bf).abs();
             let (sse_zoh, sse_foh) = (fz.sse, ff.sse);
             fits = vec![(InputHold::Zoh, disc.substeps, fz), (InputHold::Foh, disc.substeps, ff)];
+            let (hold, effect_delta_bic, switched) = second_look_of_screening(s.screened_hold, preferred);
             (
                 hold,
                 HoldReport {
@@ -74,8 +75,8 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                     sse_foh: Some(sse_foh),
                     delta_bic: Some(d),
                     decisive: d >= s.select.tie_bic,
-                    effect_delta_bic: None,
-                    switched: false,
+                    effect_delta_bic,
+                    switched,
                     delay_delta_bic: None,
                     delay_other_hold: vec![],
                     delay_ambiguous: false,
@@ -87,6 +88,32 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
         disc = data.converge_nominal(hold, disc.substeps);
     }
     (hold, hold_report, disc, fits)
+}
+
+/// The hold of a long record diagnosed whole after its screening ([`super::screen`]): the
+/// screening's second look ([`overturned_by_effects`]) stands for the whole record where the
+/// whole record's nominal prefers (`preferred`) the hold the screening's nominal did. Returns the hold, the effects' BIC
+/// preference and whether the hold was switched by them; `(preferred, None, false)`: the second
+/// look is taken on the whole record.
+fn second_look_of_screening(screened: Option<ScreenedHold>, preferred: InputHold) -> (InputHold, Option<f64>, bool) {
+    match screened {
+        Some(h) if h.switched && other_hold(h.hold) == preferred => (h.hold, h.effect_delta_bic, true),
+        Some(h) if !h.switched && h.hold == preferred && h.effect_delta_bic.is_some() => {
+            (preferred, h.effect_delta_bic, false)
+        }
+        _ => (preferred, None, false),
+    }
+}
+
+/// What a screening's hold choice found ([`super::screen`]; `DiagnoseSettings::screened_hold`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenedHold {
+    /// The hold the screening settled on.
+    pub hold: InputHold,
+    /// Its effects' BIC preference for it (the second look), where taken.
+    pub effect_delta_bic: Option<f64>,
+    /// Whether the effects switched it from the nominal's preference.
+    pub switched: bool,
 }
 
 /// Auto hold: do the best effects confirm the nominal's choice `hold`? The nominal's

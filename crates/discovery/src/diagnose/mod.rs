@@ -27,6 +27,10 @@
 //! 6. Report: `verdict` (headline and text), `notes`, [`report`] (the types of
 //!    `report.json`) and `markdown` (`report.md`, [`Report::to_markdown`]).
 //!
+//! Long records: [`screen`] runs the above on a leading part with every hypothesis, then on the
+//! whole record with the hypotheses it kept (again with every one where the whole record shows
+//! more than the leading part did).
+//!
 //! Several recordings of one machine: [`joint`] ([`diagnose_recordings`]) runs the above on
 //! each, then selects among the models they selected by leave-one-recording-out validation
 //! and fits the selected one jointly.
@@ -39,9 +43,11 @@ mod markdown;
 mod notes;
 mod pass;
 mod refit;
+pub mod screen;
 mod setup;
 mod verdict;
 
+pub use hold::ScreenedHold;
 pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
 pub use joint::{diagnose_recordings, JointReport};
 pub use report::{
@@ -82,6 +88,15 @@ pub(crate) fn diagnose_selected(
     s: &DiagnoseSettings,
 ) -> Result<(Report, Selected), DiscoveryError> {
     s.validate(sys, rec)?;
+    match screen::head(rec, s) {
+        Some(head) => screen::diagnose_screened(sys, rec, &head, s, diagnose_whole),
+        None => diagnose_whole(sys, rec, s),
+    }
+}
+
+/// [`diagnose_selected`] on the whole of `rec` with the library the settings allow (no
+/// screening).
+fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result<(Report, Selected), DiscoveryError> {
     // `parallel: false` holds for the fits' Jacobians and starts too.
     let serial = s.serial_fits();
     let s = serial.as_ref().unwrap_or(s);
@@ -386,6 +401,7 @@ fn assemble(
         localisation: LocalisationInfo { scales: loc.scales, null: loc.null },
         ranking: outcome.ranking,
         notes,
+        screening: None,
         fitted_model: Some(fitted.system),
         series,
     }

@@ -33,7 +33,7 @@ pub(super) struct Pass<'a> {
     pub notes: Vec<String>,
     /// Passes rerun for the selected model's sub-steps (at most one).
     substep_reruns: usize,
-    /// Singles of the previous pass (warm starts).
+    /// Singles of the previous pass, or of a long record's screening (warm starts).
     prev_singles: Option<Vec<Ranked>>,
     /// The selected model's gain checked at a finer stepping: `(sub-steps, gain at the
     /// pass's sub-steps, gain there)` in BIC.
@@ -101,7 +101,8 @@ impl<'a> Pass<'a> {
             nom,
             notes: Vec::new(),
             substep_reruns: 0,
-            prev_singles: None,
+            // a long record's screening warm-starts the whole record's singles
+            prev_singles: data.s.screened_singles.clone(),
             finer_check: None,
             finer_fit: None,
         }
@@ -239,6 +240,9 @@ impl<'a> Pass<'a> {
         self.finer_fit = None;
         let c = selection.chosen.as_ref()?;
         let s = data.s;
+        if !s.finer_check {
+            return None;
+        }
         let k = self.ctx.substeps;
         // Within the sub-step budget (at least twice the sub-steps; none left: no check).
         let kf = (FINER_STEPPING * k).min((2 * k).max(super::setup::SUBSTEP_BUDGET / data.n_samp.max(1)));
@@ -249,7 +253,14 @@ impl<'a> Pass<'a> {
         let warm = FitSettings { max_iter: 20, ..s.fit.clone() };
         let nominal_f = || fit::fit(&ctx_f.problem(vec![], vec![]), &self.nom.x0, &ctx_f.x_scale, None, &s.fit);
         let chosen_f = || fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, Some(&c.params), &warm);
-        let (nom_f, c_f) = if s.parallel { rayon::join(nominal_f, chosen_f) } else { (nominal_f(), chosen_f()) };
+        // The refit from the hypotheses' own starts (used below where the effect stands) runs
+        // beside the two: on a long record the three are the check's whole cost.
+        let cold_f = || fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, None, &s.fit);
+        let ((nom_f, c_f), cold) = if s.parallel {
+            rayon::join(|| rayon::join(nominal_f, chosen_f), || Some(cold_f()))
+        } else {
+            ((nominal_f(), chosen_f()), None)
+        };
         let (n, nx) = (data.n_res, ctx_f.x_scale.len());
         let k_c = c.params.len() + if c.refit { c.nominal.len() } else { 0 };
         let g = select::bic(self.nom.sse, n, nx) - c.bic;
@@ -263,7 +274,7 @@ impl<'a> Pass<'a> {
             // (backlash inertia 7 % low at 2 sub-steps: the warm refit at 8 moved 2 %, the one
             // from the starts found the optimum 9 % away at a far lower cost). The gain check
             // above keeps the warm refit.
-            let cold = fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, None, &s.fit);
+            let cold = cold.unwrap_or_else(cold_f);
             let best = [c_f, cold]
                 .into_iter()
                 .filter(|f| f.status != fit::FitStatus::Failed && f.sse.is_finite())

@@ -282,6 +282,10 @@ pub struct Report {
     pub localisation: LocalisationInfo,
     pub ranking: Vec<Ranked>,
     pub notes: Vec<String>,
+    /// A long record's screening on its leading part (absent where the record was diagnosed
+    /// as a whole with every hypothesis; see [`super::screen`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub screening: Option<super::screen::Screening>,
     #[serde(skip)]
     pub fitted_model: Option<System>,
     #[serde(skip)]

@@ -38,6 +38,10 @@ pub struct DiagnoseSettings {
     /// model-error spread over `cv_folds` contiguous folds of the estimation segment, see
     /// [`crate::fit::jackknife`]); 0 leaves the jackknife out. Default 6.
     pub jackknife_iter: usize,
+    /// Check the selected model's gain at a finer stepping (an effect whose gain is within the
+    /// simulator's stepping error is not reported). Default true; a long record's screening
+    /// leaves it to the whole record's diagnosis.
+    pub finer_check: bool,
     /// Greatest number of effects added by forward selection. Default 2.
     pub max_effects: usize,
     /// How many of the best single hypotheses are tried as second effects. Default 4.
@@ -50,6 +54,20 @@ pub struct DiagnoseSettings {
     pub parallel: bool,
     /// Refit the nominal parameters the model file frees (`[fit] free`). Default true.
     pub refit_nominal: bool,
+    /// Records longer than twice this are screened on their leading part of this many samples,
+    /// then judged whole with the hypotheses the screening kept ([`super::screen`]); `0` never
+    /// screens. Default [`super::screen::SCREEN_SAMPLES`].
+    pub screen_samples: usize,
+    /// The single hypotheses (labels, e.g. `coulomb_friction(x2)`) the diagnosis may use;
+    /// `None`: the whole library. The grey-box refit is kept where the model frees parameters.
+    pub library: Option<Vec<String>>,
+    /// Set by the screening of a long record for the whole record's diagnosis: the hold its
+    /// effects settled on (an `auto` hold then takes it without a second look where the whole
+    /// record's nominal agrees with the screening's). `None` otherwise.
+    pub screened_hold: Option<super::hold::ScreenedHold>,
+    /// Set by the screening of a long record: its single hypotheses' fits, the whole record's
+    /// warm starts (as after a change of hold). `None` otherwise.
+    pub screened_singles: Option<Vec<crate::select::Ranked>>,
     /// Headline metric of the verdict: `Auto` (RMSE in the output's units when a validation
     /// fit % exceeds 99 %, else fit %), `Fit` or `Rmse`.
     pub metric: Metric,
@@ -96,6 +114,7 @@ impl Default for DiagnoseSettings {
             max_cv: 3,
             cv_iter: 6,
             jackknife_iter: 6,
+            finer_check: true,
             max_effects: 2,
             max_second: 4,
             lags: 20,
@@ -103,6 +122,10 @@ impl Default for DiagnoseSettings {
             select: SelectSettings::default(),
             parallel: true,
             refit_nominal: true,
+            screen_samples: super::screen::SCREEN_SAMPLES,
+            library: None,
+            screened_hold: None,
+            screened_singles: None,
             metric: Metric::Auto,
         }
     }
@@ -181,6 +204,7 @@ impl DiagnoseSettings {
             max_effects: self.max_effects,
             max_second: self.max_second,
             parallel: self.parallel,
+            library: self.library.as_deref(),
             whiteness: None,
         }
     }

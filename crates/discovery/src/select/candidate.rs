@@ -158,6 +158,9 @@ pub(crate) fn fit_singles(
     let mut cands = hypothesis::candidates(sys, &ctx.scales);
     // Several inputs: play, saturation and delay on each input alone, too.
     cands.extend(crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w));
+    if let Some(lib) = plan.library {
+        cands.retain(|h| lib.contains(&h.kind.label()));
+    }
     let warm = |h: &Hypothesis| -> Option<Vec<f64>> {
         let label = h.kind.label();
         prev?

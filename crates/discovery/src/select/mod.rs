@@ -56,6 +56,9 @@ pub struct Plan<'a> {
     pub max_effects: usize,
     pub max_second: usize,
     pub parallel: bool,
+    /// The single hypotheses (labels) allowed; `None`: the whole library
+    /// (`DiagnoseSettings::library`).
+    pub library: Option<&'a [String]>,
     /// `(lags, lag_step)` of the residual whiteness test (`None`: not known, no pair search):
     /// where the greedy forward selection stops with a residual that is not white, pairs of the
     /// best singles are fitted jointly ([`forward`], issue 27 item 4).

@@ -55,6 +55,12 @@ pub struct Args {
     /// no grey-box refit.
     #[arg(long)]
     pub no_refit: bool,
+    /// A recording longer than twice this many samples is screened on its leading part of this
+    /// length (every hypothesis fitted there), then diagnosed whole with the hypotheses the
+    /// screening kept; where the whole record finds that model incomplete and the leading
+    /// part did not, it is diagnosed again with every hypothesis. `0`: never screen.
+    #[arg(long, default_value_t = discovery::diagnose::screen::SCREEN_SAMPLES)]
+    pub screen_samples: usize,
     /// Size preset of the figures for papers, in points, as `moreau figure --size`: `column`
     /// (3.5 in, 252 pt wide) or `two-column` (7.16 in, 515 pt), text 8-9 pt, the legends below
     /// the axes; each panel of a stack two thirds of the preset's height (`fit` and `residual`
@@ -82,6 +88,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
         estimate_x0: a.estimate_x0,
         metric: discovery::diagnose::Metric::parse(&a.metric).unwrap_or_default(),
         refit_nominal: !a.no_refit,
+        screen_samples: a.screen_samples,
     };
     let staged = StagedDir::replacing(&a.out)?;
     if a.data.len() > 1 || !a.validate_on.is_empty() {

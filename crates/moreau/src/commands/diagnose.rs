@@ -22,7 +22,7 @@ pub enum RecordingSource {
 }
 
 /// Options of `diagnose` (the CLI's `--estimation-fraction`, `--max-effects`,
-/// `--input-hold`, `--estimate-x0`, `--metric`, `--no-refit`).
+/// `--input-hold`, `--estimate-x0`, `--metric`, `--no-refit`, `--screen-samples`).
 #[derive(Debug, Clone)]
 pub struct DiagnoseOptions {
     /// Fraction of the record used for estimation (the rest validates). Default 0.7.
@@ -35,6 +35,10 @@ pub struct DiagnoseOptions {
     pub metric: Metric,
     /// Refit the nominal parameters the model file frees (`[fit] free`). Default true.
     pub refit_nominal: bool,
+    /// Records longer than twice this are screened on their leading part of this many samples
+    /// (`0`: never; see [`discovery::diagnose::screen`]). Default
+    /// [`discovery::diagnose::screen::SCREEN_SAMPLES`].
+    pub screen_samples: usize,
 }
 
 impl Default for DiagnoseOptions {
@@ -46,6 +50,7 @@ impl Default for DiagnoseOptions {
             estimate_x0: false,
             metric: Metric::Auto,
             refit_nominal: true,
+            screen_samples: discovery::diagnose::screen::SCREEN_SAMPLES,
         }
     }
 }
@@ -115,6 +120,7 @@ fn model_and_settings(model_src: &Source, o: &DiagnoseOptions) -> anyhow::Result
         estimate_x0: o.estimate_x0,
         metric: o.metric,
         refit_nominal: o.refit_nominal,
+        screen_samples: o.screen_samples,
         ..Default::default()
     };
     Ok((sys, settings))
