@@ -2,6 +2,8 @@
 //! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital|mixed]
 //! [CLASSES]`, `CLASSES` one of `classic` (default: the original 9 classes), `friction`
 //! (none, coulomb_friction and the friction library), `all`, or a comma-separated list.
+//! `SCREEN=N` in the environment sets `screen_samples` (0: never screen); `BENCH_LENGTH=F`
+//! makes the recordings F times longer.
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1);
@@ -12,7 +14,11 @@ fn main() {
         .unwrap_or(discovery::bench_gen::Profile::Classic);
     let classes = discovery::bench::class_set(args.get(4).map_or("classic", |s| s.as_str()))
         .expect("classes: classic, friction, all or a comma-separated list of class names");
-    let r = discovery::bench::run_classes(&classes, cases, seed, profile, &Default::default(), |c| {
+    let mut s = discovery::DiagnoseSettings::default();
+    if let Some(n) = std::env::var("SCREEN").ok().and_then(|v| v.parse().ok()) {
+        s.screen_samples = n;
+    }
+    let r = discovery::bench::run_classes(&classes, cases, seed, profile, &s, |c| {
         println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
     });
     println!("{}", r.to_text());

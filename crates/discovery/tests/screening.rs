@@ -49,7 +49,8 @@ fn an_effect_acting_after_the_leading_part_is_not_hidden_by_the_screening() {
         .collect();
     let truth = [Effect::InputSaturation { limit: 0.8 }];
     let out = ExtendedModel::new(&sys, &truth, dt, 8).unwrap().simulate(&w, dt, sys.x0.as_slice());
-    let yr = out.y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - out.y.iter().copied().fold(f64::INFINITY, f64::min);
+    let yr =
+        out.y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - out.y.iter().copied().fold(f64::INFINITY, f64::min);
     // seeded white noise, uniform, 0.3 % of the range
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let y: Vec<Vec<f64>> = out.y.iter().map(|v| vec![v + 0.003 * yr * (rng.random::<f64>() - 0.5)]).collect();
@@ -67,4 +68,3 @@ fn rec_head(rec: &Recording, n: usize) -> Recording {
     let t: Vec<f64> = (0..n).map(|k| rec.time(k)).collect();
     Recording::from_samples("head", &t, rec.w[..n].to_vec(), rec.y[..n].to_vec(), None)
 }
-

@@ -129,6 +129,18 @@ pub fn converged_truth() -> bool {
     !std::env::var("BENCH_TRUTH").is_ok_and(|v| v == "coarse")
 }
 
+/// Each recording's duration is multiplied by `BENCH_LENGTH` (a positive number; default 1):
+/// the long records of the screening benchmark (BENCHMARKS "Long records screened"). The
+/// draws after the input signal differ from the default length's (the signal's draws depend
+/// on its duration): fresh cases, not the short ones made long.
+pub fn length_factor() -> f64 {
+    std::env::var("BENCH_LENGTH")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|f| f.is_finite() && *f > 0.0)
+        .unwrap_or(1.0)
+}
+
 /// The sampling and noise conditions of one case (reported per case by the benchmark).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Conditions {
@@ -511,7 +523,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     };
     let period = TAU / plant.omega0;
     let dt = dig_dt.unwrap_or(period / 60.0);
-    let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period);
+    let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period) * length_factor();
     let ns = (duration / dt) as usize + 1;
     let (signal, sig_name) = random_signal(&mut rng, plant.omega0, duration);
     let t: Vec<f64> = (0..ns).map(|k| k as f64 * dt).collect();

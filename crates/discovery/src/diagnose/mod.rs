@@ -47,8 +47,8 @@ pub mod screen;
 mod setup;
 mod verdict;
 
-pub use hold::ScreenedHold;
 pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
+pub use hold::ScreenedHold;
 pub use joint::{diagnose_recordings, JointReport};
 pub use report::{
     DerivedParameter, FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Remaining, Report,

@@ -8,7 +8,7 @@
 //! 1. the leading `screen_samples` samples are diagnosed in full (every hypothesis of the
 //!    library);
 //! 2. the whole record is diagnosed with the library narrowed to what that screening kept
-//!    ([`kept`]): the parts of its selected model and their simpler forms, its ties and
+//!    (`kept`): the parts of its selected model and their simpler forms, its ties and
 //!    equivalent readings, and its best singles by BIC, each started from its screening fit. The
 //!    whole record's nominal fit,
 //!    residual tests, hold, sub-steps, selection, cross-validation, stepping check and
