@@ -159,7 +159,7 @@ pub(crate) fn fit_singles(
     // Several inputs: play, saturation and delay on each input alone, too.
     cands.extend(crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w));
     if let Some(lib) = plan.library {
-        cands.retain(|h| lib.contains(&h.kind.label()));
+        cands.retain(|h| lib.iter().any(|l| *l == h.kind.label() || l == h.kind.name()));
     }
     let warm = |h: &Hypothesis| -> Option<Vec<f64>> {
         let label = h.kind.label();
