@@ -85,7 +85,8 @@ fn main() {
 
 /// `BENCH_PAIRS_TRUTH` set: the case with only its true effects offered.
 fn print_truth_ceiling(p: [&'static str; 2], seed: u64, i: usize, profile: discovery::bench_gen::Profile, gain: f64) {
-    let s = discovery::DiagnoseSettings { library: Some(vec![p[0].to_string(), p[1].to_string()]), ..Default::default() };
+    let s =
+        discovery::DiagnoseSettings { library: Some(vec![p[0].to_string(), p[1].to_string()]), ..Default::default() };
     let Some(t) = discovery::bench::run_pair_case(p, seed, i, profile, &s) else { return };
     println!(
         "{:>36}    truth only -> {:<40} named {} dBIC {:.1} (selected from the library {:.1}: truth {}) Q {:.1}/{:.1} incomplete {}",
