@@ -385,7 +385,7 @@ fn check(
 /// `moreau diagnose`: (report JSON, fitted System or None, p, {t, y, yhat_nominal, yhat_fitted}).
 /// The recording is a path (`data`) or CSV text (`text`, named `source` in messages).
 #[pyfunction]
-#[pyo3(signature = (model, *, data=None, text=None, source_name="<recording>".to_string(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, out=None))]
+#[pyo3(signature = (model, *, data=None, text=None, source_name="<recording>".to_string(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, screen_samples=None, out=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn diagnose<'py>(
     py: Python<'py>,
@@ -399,6 +399,7 @@ fn diagnose<'py>(
     estimate_x0: bool,
     metric: String,
     no_refit: bool,
+    screen_samples: Option<usize>,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>, usize, Bound<'py, PyDict>)> {
     use commands::diagnose::{diagnose, write_outputs, RecordingSource};
@@ -408,7 +409,15 @@ fn diagnose<'py>(
         (None, Some(text)) => RecordingSource::Text { text, source: source_name },
         _ => return Err(PyTypeError::new_err("give exactly one of data= (a path) and text= (CSV text)")),
     };
-    let o = diagnose_options(estimation_fraction, max_effects, &input_hold, estimate_x0, &metric, no_refit)?;
+    let o = diagnose_options(
+        estimation_fraction,
+        max_effects,
+        &input_hold,
+        estimate_x0,
+        &metric,
+        no_refit,
+        screen_samples,
+    )?;
     let run = move || -> anyhow::Result<discovery::Report> {
         let staged = out.as_deref().map(moreau::output::StagedDir::replacing).transpose()?;
         let r = diagnose(&src, &rec, &o)?.report;
@@ -438,7 +447,9 @@ fn diagnose_options(
     estimate_x0: bool,
     metric: &str,
     no_refit: bool,
+    screen_samples: Option<usize>,
 ) -> PyResult<commands::diagnose::DiagnoseOptions> {
+    let default = commands::diagnose::DiagnoseOptions::default();
     let Some(input_hold) = discovery::HoldChoice::parse(input_hold) else {
         return Err(MoreauError::new_err(format!(
             "invalid value '{input_hold}' for '--input-hold <INPUT_HOLD>' [possible values: auto, zoh, foh]"
@@ -456,14 +467,14 @@ fn diagnose_options(
         estimate_x0,
         metric,
         refit_nominal: !no_refit,
-        ..Default::default()
+        screen_samples: screen_samples.unwrap_or(default.screen_samples),
     })
 }
 
 /// `moreau diagnose --data A --data B [--validate-on C]` (several recordings of one machine,
 /// paths): (joint report JSON, fitted System or None).
 #[pyfunction]
-#[pyo3(signature = (model, *, data, validate_on=Vec::new(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, out=None))]
+#[pyo3(signature = (model, *, data, validate_on=Vec::new(), estimation_fraction=0.7, max_effects=2, input_hold="auto".to_string(), estimate_x0=false, metric="auto".to_string(), no_refit=false, screen_samples=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose_recordings(
     py: Python<'_>,
@@ -476,11 +487,20 @@ fn diagnose_recordings(
     estimate_x0: bool,
     metric: String,
     no_refit: bool,
+    screen_samples: Option<usize>,
     out: Option<PathBuf>,
 ) -> PyResult<(String, Option<PySystem>)> {
     use commands::diagnose::{diagnose_recordings, write_joint_outputs, RecordingSource};
     let src = source(model)?;
-    let o = diagnose_options(estimation_fraction, max_effects, &input_hold, estimate_x0, &metric, no_refit)?;
+    let o = diagnose_options(
+        estimation_fraction,
+        max_effects,
+        &input_hold,
+        estimate_x0,
+        &metric,
+        no_refit,
+        screen_samples,
+    )?;
     let files = |v: Vec<PathBuf>| v.into_iter().map(RecordingSource::File).collect::<Vec<_>>();
     let (fit, val) = (files(data), files(validate_on));
     let run = move || -> anyhow::Result<discovery::diagnose::JointReport> {

@@ -1,6 +1,6 @@
 """Results that feel like Python (issue 32 item 4): result objects with attributes, a short
 repr and to_dict(); numpydoc on every public function; sweeps from an in-memory grid;
-diagnose with the CLI's metric and no_refit."""
+diagnose with the CLI's metric, no_refit and screen_samples."""
 import inspect
 import json
 import re
@@ -113,6 +113,18 @@ def test_diagnose_takes_the_cli_metric_and_no_refit():
     assert refit.nominal_refit and not kept.nominal_refit, (refit.nominal_refit, kept.nominal_refit)
     with pytest.raises(moreau.MoreauError, match="possible values: auto, fit, rmse"):
         moreau.diagnose(BAM_MODEL, BAM_DATA, metric="r2")
+
+
+def test_diagnose_takes_the_cli_screen_samples():
+    # the BAM log (1,132 samples on its uniform grid) is longer than twice 300: screened on
+    # its first 300, every reported number the whole record's
+    screened = moreau.diagnose(BAM_MODEL, BAM_DATA, screen_samples=300)
+    assert screened["screening"]["samples"] == 300, screened.get("screening")
+    assert screened.samples == 1132
+    assert screened.notes[0].startswith("Record of 1132 samples: the hypotheses were screened on its first 300")
+    # the default (4,000) and 0 (never) leave a short record whole
+    assert "screening" not in moreau.diagnose(BAM_MODEL, BAM_DATA)
+    assert "screening" not in moreau.diagnose(BAM_MODEL, BAM_DATA, screen_samples=0)
 
 
 def test_figures_from_python_for_a_system_and_a_sweep(tmp_path):

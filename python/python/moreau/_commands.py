@@ -316,6 +316,7 @@ def diagnose(
     estimate_x0: bool = False,
     metric: str = "auto",
     no_refit: bool = False,
+    screen_samples: Optional[int] = None,
     out: Optional[PathLike] = None,
     validate_on: Optional[List[PathLike]] = None,
 ) -> Diagnosis:
@@ -344,6 +345,10 @@ def diagnose(
         Headline of the verdict (the CLI's ``--metric``).
     no_refit : bool, default False
         Keep the parameters the model frees at their values (the CLI's ``--no-refit``).
+    screen_samples : int, optional
+        A recording longer than twice this is screened on its leading part of this many
+        samples, then diagnosed whole with what the screening kept (the CLI's
+        ``--screen-samples``; None: the CLI's default, 0: never screen).
     out : path-like, optional
         Write the CLI's report folder (report.md, report.json, fitted.toml, figures).
     validate_on : list of path-likes, optional
@@ -367,6 +372,7 @@ def diagnose(
         estimate_x0=estimate_x0,
         metric=metric,
         no_refit=no_refit,
+        screen_samples=screen_samples,
         out=None if out is None else os.fspath(out),
     )
     if isinstance(recording, (list, tuple)) or validate_on is not None:
