@@ -30,9 +30,11 @@ fn a_screened_long_record_gives_the_unscreened_answer() {
     let (a, b) = (screened.effects[0].params[0].1, whole.effects[0].params[0].1);
     let sigma = whole.effects[0].uncertainty[0].1;
     assert!((a - b).abs() <= 0.1 * sigma, "level {a} vs unscreened {b} +- {sigma}");
-    // a short record is not screened
+    // a short record is not screened, nor any record under the largest setting (no overflow)
     let short = diagnose(&sys, &rec_head(&rec, 900), &settings(1_000)).unwrap();
     assert!(short.screening.is_none());
+    let huge = diagnose(&sys, &rec_head(&rec, 900), &settings(usize::MAX)).unwrap();
+    assert!(huge.screening.is_none());
 }
 
 #[test]

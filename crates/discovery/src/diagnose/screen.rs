@@ -58,7 +58,7 @@ pub struct Screening {
 /// (`None`: diagnose as a whole).
 pub(super) fn head(rec: &Recording, s: &DiagnoseSettings) -> Option<Recording> {
     let h = s.screen_samples;
-    if h == 0 || rec.len() <= SCREEN_FACTOR * h || s.library.is_some() {
+    if h == 0 || rec.len() <= h.saturating_mul(SCREEN_FACTOR) || s.library.is_some() {
         return None;
     }
     Some(Recording {
