@@ -98,6 +98,7 @@ def diagnose(
     estimate_x0: bool = False,
     metric: str = "auto",
     no_refit: bool = False,
+    screen_samples: Optional[int] = None,
     out: Optional[_Path] = None,
 ) -> Tuple[str, Optional[System], int, Dict[str, bytes]]: ...
 def diagnose_recordings(
@@ -111,6 +112,7 @@ def diagnose_recordings(
     estimate_x0: bool = False,
     metric: str = "auto",
     no_refit: bool = False,
+    screen_samples: Optional[int] = None,
     out: Optional[_Path] = None,
 ) -> Tuple[str, Optional[System]]: ...
 def figure(
