@@ -127,6 +127,23 @@ impl Recording {
         self.t0 + self.dt * k as f64
     }
 
+    /// Its first `n` samples (every column), named as such in messages; the whole recording
+    /// where it is no longer.
+    pub fn leading(&self, n: usize) -> Self {
+        let n = n.min(self.len());
+        Self {
+            source: format!("{} (first {n} samples)", self.source),
+            t0: self.t0,
+            dt: self.dt,
+            w: self.w[..n].to_vec(),
+            y: self.y[..n].to_vec(),
+            z: self.z.as_ref().map(|z| z[..n].to_vec()),
+            resampled: self.resampled,
+            rows_in_file: n,
+            extra: self.extra.iter().map(|(name, v)| (name.clone(), v[..n].to_vec())).collect(),
+        }
+    }
+
     /// Reads a CSV file after the file checks of [`checks::read_checked`] (as `recording` in
     /// messages).
     pub fn load(path: &Path) -> Result<Self, RecordingError> {

@@ -31,9 +31,9 @@ fn a_screened_long_record_gives_the_unscreened_answer() {
     let sigma = whole.effects[0].uncertainty[0].1;
     assert!((a - b).abs() <= 0.1 * sigma, "level {a} vs unscreened {b} +- {sigma}");
     // a short record is not screened, nor any record under the largest setting (no overflow)
-    let short = diagnose(&sys, &rec_head(&rec, 900), &settings(1_000)).unwrap();
+    let short = diagnose(&sys, &rec.leading(900), &settings(1_000)).unwrap();
     assert!(short.screening.is_none());
-    let huge = diagnose(&sys, &rec_head(&rec, 900), &settings(usize::MAX)).unwrap();
+    let huge = diagnose(&sys, &rec.leading(900), &settings(usize::MAX)).unwrap();
     assert!(huge.screening.is_none());
 }
 
@@ -64,9 +64,4 @@ fn an_effect_acting_after_the_leading_part_is_not_hidden_by_the_screening() {
     assert_eq!(sc.selected, "none", "the first part has nothing missing: {sc:?}");
     assert!(sc.full_library, "the whole record must be diagnosed again with every hypothesis: {sc:?}");
     assert_eq!(r.selected(), "input_saturation", "{}", r.verdict);
-}
-
-fn rec_head(rec: &Recording, n: usize) -> Recording {
-    let t: Vec<f64> = (0..n).map(|k| rec.time(k)).collect();
-    Recording::from_samples("head", &t, rec.w[..n].to_vec(), rec.y[..n].to_vec(), None)
 }

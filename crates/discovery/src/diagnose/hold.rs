@@ -92,9 +92,9 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
 
 /// The hold of a long record diagnosed whole after its screening ([`super::screen`]): the
 /// screening's second look ([`overturned_by_effects`]) stands for the whole record where the
-/// whole record's nominal prefers (`preferred`) the hold the screening's nominal did. Returns the hold, the effects' BIC
-/// preference and whether the hold was switched by them; `(preferred, None, false)`: the second
-/// look is taken on the whole record.
+/// whole record's nominal prefers (`preferred`) the hold the screening's nominal did. Returns
+/// the hold, the effects' BIC preference and whether the hold was switched by them;
+/// `(preferred, None, false)`: the second look is taken on the whole record.
 fn second_look_of_screening(screened: Option<ScreenedHold>, preferred: InputHold) -> (InputHold, Option<f64>, bool) {
     match screened {
         Some(h) if h.switched && other_hold(h.hold) == preferred => (h.hold, h.effect_delta_bic, true),

@@ -9,11 +9,10 @@
 //!    library);
 //! 2. the whole record is diagnosed with the library narrowed to what that screening kept
 //!    (`kept`): the parts of its selected model and their simpler forms, its ties and
-//!    equivalent readings, and its best singles by BIC, each started from its screening fit. The
-//!    whole record's nominal fit,
-//!    residual tests, hold, sub-steps, selection, cross-validation, stepping check and
-//!    uncertainty are computed as always, on every sample: every number reported is the whole
-//!    record's;
+//!    equivalent readings, and its best singles by BIC, each started from its screening fit.
+//!    The whole record's nominal fit, residual tests, hold, sub-steps, selection,
+//!    cross-validation, stepping check and uncertainty are computed as always, on every
+//!    sample: every number reported is the whole record's;
 //! 3. where the whole record says the narrowed model is incomplete and the screening's was not
 //!    (something acts outside the leading part), the whole record is diagnosed again with the
 //!    full library: the screening never hides what the record shows, it only spares work where
@@ -61,17 +60,7 @@ pub(super) fn head(rec: &Recording, s: &DiagnoseSettings) -> Option<Recording> {
     if h == 0 || rec.len() <= h.saturating_mul(SCREEN_FACTOR) || s.library.is_some() {
         return None;
     }
-    Some(Recording {
-        source: format!("{} (first {h} samples)", rec.source),
-        t0: rec.t0,
-        dt: rec.dt,
-        w: rec.w[..h].to_vec(),
-        y: rec.y[..h].to_vec(),
-        z: rec.z.as_ref().map(|z| z[..h].to_vec()),
-        resampled: rec.resampled,
-        rows_in_file: h,
-        extra: rec.extra.iter().map(|(n, v)| (n.clone(), v[..h].to_vec())).collect(),
-    })
+    Some(rec.leading(h))
 }
 
 /// The single hypotheses (labels) the whole record is diagnosed with after a screening that
@@ -132,7 +121,7 @@ pub(super) fn diagnose_screened(
         rec.len(),
         head_rep.selected(),
         if keep.is_empty() { "the nominal model".to_string() } else { keep.join(", ") },
-        if sys_frees(&rep) { " and the grey-box refit" } else { "" },
+        if rep.free_parameters.is_empty() { "" } else { " and the grey-box refit" },
     );
     let full_library = shows_more(&rep, &head_rep);
     if full_library {
@@ -170,9 +159,4 @@ fn shows_more(whole: &Report, head: &Report) -> bool {
         (Some(_), None) => true,
         (Some(_), Some(_)) => worst(whole) > MORE_LEFT_RATIO * worst(head),
     }
-}
-
-/// Whether the model frees nominal parameters (the grey-box refit is a single of its own).
-fn sys_frees(rep: &Report) -> bool {
-    !rep.free_parameters.is_empty()
 }

@@ -59,7 +59,8 @@ pub struct DiagnoseSettings {
     /// screens. Default [`super::screen::SCREEN_SAMPLES`].
     pub screen_samples: usize,
     /// The single hypotheses the diagnosis may use, by label (`coulomb_friction(x2)`) or by
-    /// kind (`coulomb_friction`: on every state); `None`: the whole library. The grey-box refit is kept where the model frees parameters.
+    /// kind (`coulomb_friction`: on every state); `None`: the whole library. The grey-box
+    /// refit is kept where the model frees parameters.
     pub library: Option<Vec<String>>,
     /// Set by the screening of a long record for the whole record's diagnosis: the hold its
     /// effects settled on (an `auto` hold then takes it without a second look where the whole

@@ -56,7 +56,7 @@ pub struct Plan<'a> {
     pub max_effects: usize,
     pub max_second: usize,
     pub parallel: bool,
-    /// The single hypotheses (labels) allowed; `None`: the whole library
+    /// The single hypotheses allowed, by label or kind; `None`: the whole library
     /// (`DiagnoseSettings::library`).
     pub library: Option<&'a [String]>,
     /// `(lags, lag_step)` of the residual whiteness test (`None`: not known, no pair search):
