@@ -81,7 +81,7 @@ pub fn tube_diameters_with(
             tube_C.support_upper(v) + tube_C.support_upper(&neg) + sigma_sym(theta, v)
         },
         lip_d,
-        sphere,
+        &within_work(sphere, 2 * tube_C.cells()),
     );
     let d_lower = d_b.lower - 2.0 * (tube_C.remainder_bound() + tube_C.tail_bound());
 
@@ -95,7 +95,7 @@ pub fn tube_diameters_with(
             tube_CF.support_upper(v) + theta.support(w.as_slice())
         },
         lip_f,
-        sphere,
+        &within_work(sphere, tube_CF.cells()),
     );
     // the kernel's L = fl(C F) against C F_exact (tube::cf_rounding::cf_support_error)
     let df_b = Enclosure {
@@ -119,6 +119,24 @@ pub fn tube_diameters_with(
         d_ftheta: Enclosure { lower: df_lower, upper: df_b.upper },
         verified,
     })
+}
+
+/// Most kernel cells visited by one sphere maximum (evaluations x cells per evaluation). A
+/// tube of a stiff or strongly coupled plant can need tens of thousands of cells; with the full
+/// evaluation budget its maximum took 40 s (fuzz finding, n = p = 4 with 30,276 cells). Beyond
+/// this work the evaluation budget shrinks: the maximum stays a proven upper bound, only wider
+/// (`geometry::sublinear_sphere_max` is valid whenever its budget runs out). The examples visit
+/// at most 8.5e7 cells (`ellipsoid-p3`), so their numbers are unchanged.
+const SPHERE_WORK: usize = 100_000_000;
+
+/// Fewest evaluations one sphere maximum keeps under [`SPHERE_WORK`].
+const MIN_SPHERE_EVALS: usize = 200;
+
+/// `sphere` with its evaluation budget cut so that `max_evals x cells_per_eval` stays within
+/// [`SPHERE_WORK`] (never below [`MIN_SPHERE_EVALS`]).
+fn within_work(sphere: &SphereMaxSettings, cells_per_eval: usize) -> SphereMaxSettings {
+    let affordable = (SPHERE_WORK / cells_per_eval.max(1)).max(MIN_SPHERE_EVALS);
+    SphereMaxSettings { max_evals: sphere.max_evals.min(affordable), ..sphere.clone() }
 }
 
 /// The cross-section `C Xi_inf + Theta` of the tube around the orbit `eta_T` (Fig. loop of the
@@ -147,5 +165,24 @@ impl OutputTube {
     /// Upper bound of `sigma_{C Xi_inf + Theta}(v)`.
     pub fn support_upper(&self, v: &[f64]) -> f64 {
         self.kernel.support_upper(v) + self.theta.support(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sphere_budget_is_cut_only_beyond_the_work_limit() {
+        let s = SphereMaxSettings { tol_abs: 1e-9, tol_rel: 1e-6, max_evals: 20_000 };
+        // ellipsoid-p3's largest maximum (2 x 2,128 cells): unchanged
+        assert_eq!(within_work(&s, 2 * 2128).max_evals, 20_000);
+        // the fuzz finding's 30,276 cells: cut to what 1e8 visits allow
+        assert_eq!(within_work(&s, 30_276).max_evals, SPHERE_WORK / 30_276);
+        assert!(within_work(&s, 30_276).max_evals < 20_000);
+        // never below the floor, and no division by zero for an empty kernel
+        assert_eq!(within_work(&s, 400_000 * 2).max_evals, MIN_SPHERE_EVALS);
+        assert_eq!(within_work(&s, 0).max_evals, 20_000);
+        assert_eq!(within_work(&s, 30_276).tol_rel, s.tol_rel);
     }
 }
