@@ -3,7 +3,8 @@
 //! [CLASSES]`, `CLASSES` one of `classic` (default: the original 9 classes), `friction`
 //! (none, coulomb_friction and the friction library), `all`, or a comma-separated list.
 //! `SCREEN=N` in the environment sets `screen_samples` (0: never screen); `BENCH_LENGTH=F`
-//! makes the recordings F times longer.
+//! makes the recordings F times longer. A miss is followed by a line comparing the selected
+//! model's BIC gain with the best ranked single of the true class.
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1);
@@ -20,6 +21,17 @@ fn main() {
     }
     let r = discovery::bench::run_classes(&classes, cases, seed, profile, &s, |c| {
         println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
+        if !c.correct {
+            println!(
+                "{:>18}    miss: selected dBIC {:.1}, best single of the truth {}",
+                "",
+                c.delta_bic_selected,
+                c.delta_bic_truth.map_or("not ranked".into(), |t| format!(
+                    "{t:.1} ({})",
+                    if t > c.delta_bic_selected { "better: a selection gap" } else { "not better: the recording's" }
+                ))
+            );
+        }
     });
     println!("{}", r.to_text());
 }

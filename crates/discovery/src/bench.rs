@@ -50,6 +50,12 @@ pub struct CaseResult {
     pub est_std_jackknife: Option<f64>,
     pub fit_before: f64,
     pub fit_after: f64,
+    /// BIC gain over the nominal of the selected model (0 when nothing was added).
+    pub delta_bic_selected: f64,
+    /// Best BIC gain of a ranked single of the true class (`None`: not ranked, or the truth is
+    /// `none`). Above `delta_bic_selected`: the selection missed a better reading; at or below
+    /// it: the recording prefers what was selected (a miss no selection rule can avoid).
+    pub delta_bic_truth: Option<f64>,
     pub seconds: f64,
     /// A diagnosis error (should not happen).
     pub error: Option<String>,
@@ -132,6 +138,8 @@ pub fn run_case_with(
         est_std_jackknife: None,
         fit_before: f64::NAN,
         fit_after: f64::NAN,
+        delta_bic_selected: f64::NAN,
+        delta_bic_truth: None,
         seconds,
         error: None,
     };
@@ -148,6 +156,18 @@ pub fn run_case_with(
             out.model_incomplete = rep.model_incomplete;
             out.fit_before = rep.fit_before.fit_percent[0].unwrap_or(f64::NAN);
             out.fit_after = rep.fit_after.fit_percent[0].unwrap_or(f64::NAN);
+            let chosen_label = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
+            out.delta_bic_selected = if rep.effects.is_empty() {
+                0.0
+            } else {
+                rep.ranking.iter().find(|r| r.label == chosen_label).map_or(f64::NAN, |r| r.delta_bic)
+            };
+            out.delta_bic_truth = rep
+                .ranking
+                .iter()
+                .filter(|r| !r.refit && r.kinds.len() == 1 && r.kinds[0] == class)
+                .map(|r| r.delta_bic)
+                .reduce(f64::max);
             if out.correct {
                 // Compare like with like: the same kind and, for forces, the same state (a force
                 // on another state is an observationally equivalent but different parameter).
