@@ -156,12 +156,7 @@ pub fn run_case_with(
             out.model_incomplete = rep.model_incomplete;
             out.fit_before = rep.fit_before.fit_percent[0].unwrap_or(f64::NAN);
             out.fit_after = rep.fit_after.fit_percent[0].unwrap_or(f64::NAN);
-            let chosen_label = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
-            out.delta_bic_selected = if rep.effects.is_empty() {
-                0.0
-            } else {
-                rep.ranking.iter().find(|r| r.label == chosen_label).map_or(f64::NAN, |r| r.delta_bic)
-            };
+            out.delta_bic_selected = selected_gain(&rep);
             out.delta_bic_truth = rep
                 .ranking
                 .iter()
@@ -240,6 +235,15 @@ pub fn run_case_with(
         }
     }
     out
+}
+
+/// The selected model's BIC gain over the nominal, from the ranking (0 when nothing was added).
+fn selected_gain(rep: &crate::Report) -> f64 {
+    if rep.effects.is_empty() {
+        return 0.0;
+    }
+    let chosen = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
+    rep.ranking.iter().find(|r| r.label == chosen).map_or(f64::NAN, |r| r.delta_bic)
 }
 
 /// Runs `cases` cases of every class (classic profile).
@@ -534,12 +538,7 @@ pub fn run_pair_case(
                 .map(|e| named_in(&identity(&e.kinds)))
                 .fold(named_in(&identity(&selected)), usize::max);
             out.equivalents = rep.equivalents.iter().map(|e| e.label.clone()).collect();
-            let chosen_label = rep.effects.iter().map(|e| e.label.clone()).collect::<Vec<_>>().join(" + ");
-            out.delta_bic_selected = if rep.effects.is_empty() {
-                0.0
-            } else {
-                rep.ranking.iter().find(|r| r.label == chosen_label).map_or(f64::NAN, |r| r.delta_bic)
-            };
+            out.delta_bic_selected = selected_gain(&rep);
             out.delta_bic_true_pair = rep
                 .ranking
                 .iter()
