@@ -274,6 +274,7 @@ fn a_misfit_whitened_by_the_colour_filter_is_still_searched() {
     let r = run(&case);
     assert_eq!(r.effects.len(), 1, "{}", r.verdict);
     assert_eq!(r.effects[0].kind, "coulomb_friction", "{}", r.verdict);
-    let searched = |h: &discovery::diagnose::Ranked| h.kinds.len() == 2 && h.kinds.iter().all(|k| k != "coulomb_friction");
+    let searched =
+        |h: &discovery::diagnose::Ranked| h.kinds.len() == 2 && h.kinds.iter().all(|k| k != "coulomb_friction");
     assert!(r.ranking.iter().any(searched), "the pair search did not run");
 }
