@@ -171,6 +171,7 @@ pub fn run_case_with(
                     | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. })
                     | (Effect::StribeckFriction { state: i, .. }, Effect::StribeckFriction { state: j, .. })
                     | (Effect::AsymmetricCoulomb { state: i, .. }, Effect::AsymmetricCoulomb { state: j, .. })
+                    | (Effect::LoadFriction { state: i, .. }, Effect::LoadFriction { state: j, .. })
                     | (Effect::Cogging { state: i, .. }, Effect::Cogging { state: j, .. }) => i == j,
                     _ => a.kind() == b.kind(),
                 };
@@ -208,6 +209,7 @@ pub fn run_case_with(
                         | Effect::ConstantForce { state, .. }
                         | Effect::StribeckFriction { state, .. }
                         | Effect::AsymmetricCoulomb { state, .. }
+                        | Effect::LoadFriction { state, .. }
                         | Effect::Cogging { state, .. } => {
                             format!("{}(x{})", t.kind(), state + 1)
                         }

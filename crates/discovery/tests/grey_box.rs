@@ -244,15 +244,18 @@ fn an_input_effect_on_one_of_two_inputs_gets_its_own_parameter() {
 }
 
 /// The shipped BAM XL330 logs with the grey-box model (`examples/real/bam-xl330-kp100-greybox.toml`:
-/// loop gain and damping freed with physical bounds): both logs refit the documented loop
-/// gain K/J = 61.05 down by about 40 % (to 36-38 1/s^2) and keep input saturation; the RMSE
-/// headline is in mrad. (Without the refit: play or Coulomb friction plus saturation, see
-/// real_data.rs.)
+/// loop gain and damping freed with physical bounds): both logs name friction that grows with
+/// the gearbox's load (`load_friction`, issue 28) with a load coefficient of the upstream
+/// identification's size (0.12 in its M3, 0.27 in its M6; here 0.43 and 0.17: `sin_time_square`
+/// also refits the loop's entries, and the load is computed from them), the validation fit
+/// improves by more than 50 points, and the RMSE headline is in mrad.
+/// (Before `load_friction`, both logs refitted the documented loop gain 40 % down and took
+/// input saturation: a stand-in that did not carry from one log to the other.)
 #[test]
-fn bam_logs_refit_the_documented_loop_gain() {
+fn bam_logs_name_the_gearbox_load_friction() {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let sys = model::load(&root.join("examples/real/bam-xl330-kp100-greybox.toml")).unwrap();
-    let mut gains = Vec::new();
+    let mut coefficients = Vec::new();
     for log in ["xl330-kp100-sin_sin.csv", "xl330-kp100-sin_time_square.csv"] {
         let rec = Recording::load(&root.join("data/bam-servo").join(log)).unwrap();
         let s = DiagnoseSettings {
@@ -262,14 +265,15 @@ fn bam_logs_refit_the_documented_loop_gain() {
         };
         let r = diagnose(&sys, &rec, &s).unwrap();
         eprintln!("{log}: {}", r.verdict);
-        assert!(r.verdict.contains("with the plant's parameters refitted"), "{log}: {}", r.verdict);
-        assert!(r.effects.iter().any(|e| e.kind == "input_saturation"), "{log}: {}", r.verdict);
+        let Some(load) = r.effects.iter().find(|e| e.label == "load_friction(x2)") else {
+            panic!("{log}: no load_friction in {}", r.verdict)
+        };
+        coefficients.push(load.params.iter().find(|p| p.0 == "load_coefficient").unwrap().1);
         assert!(r.headline.contains("mrad") && r.headline_metric == "rmse", "{}", r.headline);
-        let b = r.nominal_refit.iter().find(|v| v.name == "plant.B[1][0]").unwrap().value;
-        assert!(b < 0.8 * 61.0548, "{log}: gain {b}");
-        gains.push(b);
+        assert!(r.fit_after.fit_percent[0].unwrap() > r.fit_before.fit_percent[0].unwrap() + 50.0, "{}", r.verdict);
     }
-    assert!((gains[0] / gains[1] - 1.0).abs() < 0.2, "the two logs disagree on the gain: {gains:?}");
+    eprintln!("load coefficients {coefficients:?}");
+    assert!(coefficients.iter().all(|k| (0.05..=0.6).contains(k)), "{coefficients:?}");
 }
 
 /// Issue 14's acceptance case: a friction-dominated sampled (1 kHz) position loop whose nominal

@@ -20,6 +20,7 @@ pub mod names {
     pub const STRIBECK_FRICTION: &str = "stribeck_friction";
     pub const ASYMMETRIC_COULOMB: &str = "asymmetric_coulomb";
     pub const COGGING: &str = "cogging";
+    pub const LOAD_FRICTION: &str = "load_friction";
 }
 
 /// Where a backlash (play) effect sits.
@@ -64,6 +65,13 @@ pub enum Effect {
     /// A position-periodic (cogging, detent) force `amplitude sin(2 pi x_pos / period + phase)`
     /// on the derivative of velocity state `state`, `x_pos` being state `position_state`.
     Cogging { state: usize, position_state: usize, amplitude: f64, period: f64, phase: f64 },
+    /// Coulomb friction on velocity state `state` whose level grows with the load that a
+    /// transmission (a gearbox, a lead screw) carries: `level + load_coefficient |d - e|`,
+    /// where `d = B_j w + E_j z` is the actuator's force on `x_j'` (through the input and the
+    /// loop) and `e = sum_{i != j} A_ji x_i` the plant's own forces on it (springs, gravity),
+    /// evaluated at the start of each step (the load-dependent model M3 of the BAM actuator
+    /// models). `load_coefficient = 0` is `coulomb_friction`.
+    LoadFriction { state: usize, level: f64, load_coefficient: f64 },
 }
 
 impl Effect {
@@ -81,6 +89,7 @@ impl Effect {
             Effect::StribeckFriction { .. } => names::STRIBECK_FRICTION,
             Effect::AsymmetricCoulomb { .. } => names::ASYMMETRIC_COULOMB,
             Effect::Cogging { .. } => names::COGGING,
+            Effect::LoadFriction { .. } => names::LOAD_FRICTION,
         }
     }
 }
@@ -223,10 +232,18 @@ impl Effect {
                     phase: opt_f64(t, &prefix, "phase")?.unwrap_or(0.0),
                 }
             }
+            names::LOAD_FRICTION => {
+                check_keys(t, &prefix, "kind, state, level, load_coefficient")?;
+                Effect::LoadFriction {
+                    state: state_index(t, &prefix, n)?,
+                    level: nonneg(t, &prefix, "level")?,
+                    load_coefficient: nonneg(t, &prefix, "load_coefficient")?,
+                }
+            }
             other => {
                 return Err(ModelError::WrongType {
                     key: key(&prefix, "kind"),
-                    expected: "one of backlash, gap_width, coulomb_friction, stribeck_friction, asymmetric_coulomb, cogging, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
+                    expected: "one of backlash, gap_width, coulomb_friction, stribeck_friction, asymmetric_coulomb, load_friction, cogging, constant_force, backlash_inertia, input_delay, input_saturation, sensor_offset",
                     found: format!("{other:?}"),
                 })
             }
@@ -312,6 +329,9 @@ impl Effect {
                 ("level_positive", f(level_positive)),
                 ("level_negative", f(level_negative)),
             ],
+            Effect::LoadFriction { state, level, load_coefficient } => {
+                vec![("state", int(state)), ("level", f(level)), ("load_coefficient", f(load_coefficient))]
+            }
             Effect::Cogging { state, position_state, amplitude, period, phase } => vec![
                 ("state", int(state)),
                 ("position_state", int(position_state)),

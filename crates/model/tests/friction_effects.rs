@@ -52,6 +52,10 @@ fn new_effects_load_and_round_trip() {
             Effect::Cogging { state: 1, position_state: 0, amplitude: -0.4, period: 0.25, phase: 1.5 },
         ),
         (
+            "kind = \"load_friction\"\nstate = 1\nlevel = 0.02\nload_coefficient = 0.27",
+            Effect::LoadFriction { state: 1, level: 0.02, load_coefficient: 0.27 },
+        ),
+        (
             // `phase` is optional (default 0).
             "kind = \"cogging\"\nstate = 1\nposition_state = 0\namplitude = 0.4\nperiod = 0.25",
             Effect::Cogging { state: 1, position_state: 0, amplitude: 0.4, period: 0.25, phase: 0.0 },
@@ -110,6 +114,11 @@ fn bad_values_name_the_key_and_the_value() {
             "kind = \"cogging\"\nstate = 1\nposition_state = 5\namplitude = 0.4\nperiod = 0.25",
             &["effects[0].position_state", "5", "state index"],
         ),
+        (
+            "kind = \"load_friction\"\nstate = 1\nlevel = 0.02\nload_coefficient = -0.1",
+            &["effects[0].load_coefficient", "-0.1", "non-negative"],
+        ),
+        ("kind = \"load_friction\"\nstate = 1\nlevel = 0.02", &["effects[0].load_coefficient", "missing"]),
         ("kind = \"stiction\"\nstate = 1", &["effects[0].kind", "stribeck_friction", "\"stiction\""]),
     ];
     for (text, needles) in cases {

@@ -1,5 +1,6 @@
-//! The friction laws on a velocity state (issue 14): `coulomb_friction`, `stribeck_friction`
-//! and `asymmetric_coulomb`.
+//! The friction laws on a velocity state (issue 14): `coulomb_friction`, `stribeck_friction`,
+//! `asymmetric_coulomb` and `load_friction` (issue 28: a level that grows with the load a
+//! transmission carries, offered where an actuator drives the state: `B_j` or `E_j` nonzero).
 //!
 //! Bounds: friction levels up to the force whose static deflection of `y` equals `range(y)`,
 //! `range(y) / |C F^{-1} e_j|` (the site's force bound). `stribeck_friction` is fitted as
@@ -22,6 +23,14 @@ const STATIC_EXCESS: &str = "static_excess";
 const STRIBECK_VELOCITY: &str = "stribeck_velocity";
 const LEVEL_POSITIVE: &str = "level_positive";
 const LEVEL_NEGATIVE: &str = "level_negative";
+const LOAD_COEFFICIENT: &str = "load_coefficient";
+
+/// The largest load coefficient tried: friction equal to the transmitted load (a transmission
+/// that does not backdrive).
+pub const LOAD_COEFFICIENT_MAX: f64 = 1.0;
+
+/// Load coefficients at which `load_friction` is started.
+const LOAD_STARTS: [f64; 3] = [0.03, 0.1, 0.3];
 
 /// The friction laws (see the module documentation).
 pub struct Friction;
@@ -75,10 +84,45 @@ pub fn asymmetric(j: usize, fs: f64) -> Hypothesis {
     Hypothesis { starts, ..h }
 }
 
+/// `load_friction` on state `j`: `(level, load_coefficient)`, the level in `[0, fs]` and the
+/// coefficient in `[0, LOAD_COEFFICIENT_MAX]`, both in logarithmic coordinates; started over
+/// the level decades with coefficients [`LOAD_STARTS`].
+pub fn load(j: usize, fs: f64) -> Hypothesis {
+    let h = Hypothesis {
+        kind: Kind::LoadFriction { state: j },
+        lower: vec![0.0, 0.0],
+        upper: vec![fs, LOAD_COEFFICIENT_MAX],
+        starts: vec![],
+        names: vec![LEVEL, LOAD_COEFFICIENT],
+        log_shift: vec![Some(LEVEL_LOG_SHIFT * fs), Some(LEVEL_LOG_SHIFT * LOAD_COEFFICIENT_MAX)],
+    };
+    let mut starts = Vec::new();
+    for f in FRICTION_DECADES {
+        for k in LOAD_STARTS {
+            starts.push(vec![h.unit_of(0, f * fs), h.unit_of(1, k)]);
+        }
+    }
+    Hypothesis { starts, ..h }
+}
+
+/// Whether an actuator drives velocity state `j` (`B_j` or `E_j` nonzero): only then can a
+/// transmission carry a load to it.
+fn actuated(sys: &model::System, j: usize) -> bool {
+    sys.B.row(j).iter().chain(sys.E.row(j).iter()).any(|v| *v != 0.0)
+}
+
 impl Family for Friction {
-    fn hypotheses(&self, site: &Site, _cx: &Context) -> Vec<Hypothesis> {
+    fn hypotheses(&self, site: &Site, cx: &Context) -> Vec<Hypothesis> {
         let &Site::Velocity { state: j, force_bound: fs, velocity_scale, .. } = site else { return vec![] };
-        vec![level(Kind::CoulombFriction { state: j }, fs, LEVEL), stribeck(j, fs, velocity_scale), asymmetric(j, fs)]
+        let mut laws = vec![
+            level(Kind::CoulombFriction { state: j }, fs, LEVEL),
+            stribeck(j, fs, velocity_scale),
+            asymmetric(j, fs),
+        ];
+        if actuated(cx.sys, j) {
+            laws.push(load(j, fs));
+        }
+        laws
     }
 
     fn name(&self, kind: Kind) -> Option<&'static str> {
@@ -86,15 +130,17 @@ impl Family for Friction {
             Kind::CoulombFriction { .. } => Some(names::COULOMB_FRICTION),
             Kind::StribeckFriction { .. } => Some(names::STRIBECK_FRICTION),
             Kind::AsymmetricCoulomb { .. } => Some(names::ASYMMETRIC_COULOMB),
+            Kind::LoadFriction { .. } => Some(names::LOAD_FRICTION),
             _ => None,
         }
     }
 
     fn label(&self, kind: Kind) -> Option<String> {
         match kind {
-            Kind::CoulombFriction { state } | Kind::StribeckFriction { state } | Kind::AsymmetricCoulomb { state } => {
-                Some(format!("{}(x{})", self.name(kind)?, state + 1))
-            }
+            Kind::CoulombFriction { state }
+            | Kind::StribeckFriction { state }
+            | Kind::AsymmetricCoulomb { state }
+            | Kind::LoadFriction { state } => Some(format!("{}(x{})", self.name(kind)?, state + 1)),
             _ => None,
         }
     }
@@ -104,6 +150,7 @@ impl Family for Friction {
             Kind::CoulombFriction { state } => format!("Dry (Coulomb) friction opposes the motion of velocity state x{}: the motion sticks at rest until the driving force exceeds the friction level.", state + 1),
             Kind::StribeckFriction { state } => format!("Friction with breakaway (stiction) on velocity state x{}: at rest it holds up to a static level above the sliding friction, which falls along a Stribeck curve to the Coulomb level as the speed grows.", state + 1),
             Kind::AsymmetricCoulomb { state } => format!("Dry friction on velocity state x{} whose level depends on the direction of motion (e.g. a seal or guide that drags more one way, or a load that aids one direction).", state + 1),
+            Kind::LoadFriction { state } => format!("Dry friction on velocity state x{} that grows with the load the transmission carries (a gearbox or lead screw that holds more the harder the actuator pushes against the load, down to not backdriving at all).", state + 1),
             _ => return None,
         })
     }
@@ -126,15 +173,19 @@ impl Family for Friction {
                 level_positive: theta[0].max(0.0),
                 level_negative: theta[1].max(0.0),
             },
+            Kind::LoadFriction { state } => {
+                Effect::LoadFriction { state, level: theta[0].max(0.0), load_coefficient: theta[1].max(0.0) }
+            }
             _ => return None,
         })
     }
 
-    /// Stribeck friction (static level = sliding level) and direction-dependent friction
-    /// (equal levels) both contain Coulomb friction on the same state.
+    /// Stribeck friction (static level = sliding level), direction-dependent friction (equal
+    /// levels) and load-dependent friction (coefficient 0) all contain Coulomb friction on the
+    /// same state.
     fn simpler_form(&self, kind: Kind) -> Option<Kind> {
         match kind {
-            Kind::StribeckFriction { state } | Kind::AsymmetricCoulomb { state } => {
+            Kind::StribeckFriction { state } | Kind::AsymmetricCoulomb { state } | Kind::LoadFriction { state } => {
                 Some(Kind::CoulombFriction { state })
             }
             _ => None,
@@ -167,6 +218,13 @@ impl Family for Friction {
                     .map(|&(a, b)| unit([a * l, b * l, 0.0], 2))
                     .collect(),
             ),
+            // Part of the Coulomb reading is the load's: the level at 1, 0.6 and 0.3 `L`.
+            Kind::LoadFriction { .. } => Some(
+                [1.0, 0.6, 0.3]
+                    .iter()
+                    .flat_map(|&a| LOAD_STARTS.iter().map(move |&k| vec![h.unit_of(0, a * l), h.unit_of(1, k)]))
+                    .collect(),
+            ),
             _ => None,
         }
     }
@@ -176,6 +234,7 @@ impl Family for Friction {
             Effect::CoulombFriction { level, .. } => Some((*level, Some(LEVEL))),
             Effect::StribeckFriction { static_level, .. } => Some((*static_level, None)),
             Effect::AsymmetricCoulomb { level_positive, .. } => Some((*level_positive, Some(LEVEL_POSITIVE))),
+            Effect::LoadFriction { load_coefficient, .. } => Some((*load_coefficient, Some(LOAD_COEFFICIENT))),
             _ => None,
         }
     }
@@ -187,6 +246,9 @@ impl Family for Friction {
             }
             Effect::AsymmetricCoulomb { level_positive, level_negative, .. } => {
                 Some(vec![(LEVEL_POSITIVE, *level_positive), (LEVEL_NEGATIVE, *level_negative)])
+            }
+            Effect::LoadFriction { level, load_coefficient, .. } => {
+                Some(vec![(LOAD_COEFFICIENT, *load_coefficient), (LEVEL, *level)])
             }
             _ => None,
         }

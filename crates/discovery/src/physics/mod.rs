@@ -5,7 +5,7 @@
 //!
 //! - [`play`]: `backlash` (in the loop or at the input), `gap_width`, `backlash_inertia`;
 //! - [`friction`]: the friction laws `coulomb_friction`, `stribeck_friction`,
-//!   `asymmetric_coulomb` on a velocity state;
+//!   `asymmetric_coulomb`, `load_friction` on a velocity state;
 //! - [`cogging`]: a position-periodic force on a velocity state (period from a scan of the
 //!   nominal residual);
 //! - [`offsets`]: `constant_force` on a velocity state, `sensor_offset` on the outputs;
@@ -50,6 +50,7 @@ pub enum Kind {
     CoulombFriction { state: usize },
     StribeckFriction { state: usize },
     AsymmetricCoulomb { state: usize },
+    LoadFriction { state: usize },
     Cogging { state: usize, position_state: usize },
     ConstantForce { state: usize },
     BacklashInertia,
@@ -227,6 +228,7 @@ mod tests {
             Kind::CoulombFriction { state: 1 },
             Kind::StribeckFriction { state: 1 },
             Kind::AsymmetricCoulomb { state: 1 },
+            Kind::LoadFriction { state: 1 },
             Kind::Cogging { state: 1, position_state: 0 },
             Kind::ConstantForce { state: 1 },
             Kind::BacklashInertia,

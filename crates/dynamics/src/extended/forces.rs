@@ -3,11 +3,11 @@
 //! - a cogging force `A sin(2 pi x_pos / P + phase)` (`cogging`), evaluated at the step's
 //!   midpoint position of the force-free step and held over the step;
 //! - friction on velocity states ([`super::friction`]: `coulomb_friction`,
-//!   `asymmetric_coulomb`, `stribeck_friction`; several on one state add up), resolved
-//!   implicitly.
+//!   `asymmetric_coulomb`, `stribeck_friction`, `load_friction`; several on one state add
+//!   up), resolved implicitly, the load-dependent level taken at the step's start.
 //!
 //! Each effect is checked here as it is registered (an error names the effect and the value).
-use super::friction::Friction;
+use super::friction::{Friction, LoadRows};
 use crate::error::DynamicsError;
 
 /// A cogging force on `state`: `amplitude sin(wavenumber x_pos + phase)`.
@@ -127,6 +127,37 @@ impl Forces {
         Ok(())
     }
 
+    /// `load_friction`: level `level + load_coefficient |d - e|` on `state`, the load's rows
+    /// taken from `sys` ([`LoadRows`]).
+    pub(super) fn load_friction(
+        &mut self,
+        state: usize,
+        level: f64,
+        load_coefficient: f64,
+        sys: &model::System,
+    ) -> Result<(), DynamicsError> {
+        let bad = |reason, value| Err(DynamicsError::BadEffect { kind: "load_friction", reason, value });
+        if state >= self.n {
+            return bad("state index out of range", state as f64);
+        }
+        if !(level >= 0.0 && level.is_finite()) {
+            return bad("level must be finite and non-negative", level);
+        }
+        if !(load_coefficient >= 0.0 && load_coefficient.is_finite()) {
+            return bad("load_coefficient must be finite and non-negative", load_coefficient);
+        }
+        let fr = self.friction_on(state);
+        fr.add_coulomb(level, level);
+        if load_coefficient > 0.0 {
+            let mut a: Vec<f64> = sys.A.row(state).iter().copied().collect();
+            a[state] = 0.0;
+            let b = sys.B.row(state).iter().copied().collect();
+            let e = sys.E.row(state).iter().copied().collect();
+            fr.add_load(load_coefficient, LoadRows { a, b, e });
+        }
+        Ok(())
+    }
+
     /// `cogging` on `state` at the position `position_state`.
     pub(super) fn cogging(
         &mut self,
@@ -170,9 +201,10 @@ impl Forces {
     }
 
     /// Adds the cogging forces, then the friction forces, to the end state `xn` of a linear
-    /// step from `x` (`Psi` row-major `n x n`, the step's `int_0^h e^{sF} ds`).
+    /// step from `x` (`Psi` row-major `n x n`, the step's `int_0^h e^{sF} ds`; `w`, `z`: the
+    /// input and the loop's output at the step's start, for a load-dependent level).
     #[inline(always)]
-    pub(super) fn apply(&self, x: &[f64], xn: &mut [f64], Psi: &[f64]) {
+    pub(super) fn apply(&self, x: &[f64], xn: &mut [f64], Psi: &[f64], w: &[f64], z: &[f64]) {
         let n = self.n;
         for cg in &self.cogging {
             // Midpoint position of the force-free step.
@@ -184,7 +216,7 @@ impl Forces {
         }
         for fr in &self.friction {
             let j = fr.state;
-            let (f, stuck) = fr.force(xn[j], Psi[j * n + j]);
+            let (f, stuck) = fr.force(xn[j], Psi[j * n + j], fr.load_level(x, w, z));
             for (i, v) in xn.iter_mut().enumerate() {
                 *v += Psi[i * n + j] * f;
             }

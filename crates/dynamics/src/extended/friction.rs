@@ -12,6 +12,9 @@
 //! `[(|a| - g S_d), (|a| - g c_d)] / (1 + g viscous)` otherwise), `f = -d L_d(u)`. Static
 //! friction is thus the breakaway threshold from rest, the Stribeck curve the force while
 //! sliding, and a mass that slows down to zero is caught by the static level.
+//!
+//! A load-dependent term (`load_friction`) raises every level of the step by
+//! `k |d - e|`, the load the transmission carries at the step's start ([`LoadRows`]).
 
 /// Friction on one velocity state (see the module documentation): Coulomb levels per
 /// direction, Stribeck excess terms and a viscous increment.
@@ -26,12 +29,48 @@ pub(super) struct Friction {
     /// `sum_i (s_i - c)`: static levels are `pos + static_extra`, `neg + static_extra`.
     static_extra: f64,
     viscous: f64,
+    /// The load-dependent term: its coefficient (summed over the effects) and rows.
+    load: Option<(f64, LoadRows)>,
+}
+
+/// The rows of the load on velocity state `x_j` that a transmission carries (`load_friction`):
+/// `d - e` with `d = B_j w + E_j z` (the actuator's force on `x_j'`) and
+/// `e = sum_{i != j} A_ji x_i` (the plant's own forces on it).
+#[derive(Debug, Clone)]
+pub(super) struct LoadRows {
+    /// `A_ji` for `i != j`, 0 at `i = j` (length n).
+    pub(super) a: Vec<f64>,
+    /// `B_j` (length m).
+    pub(super) b: Vec<f64>,
+    /// `E_j` (length p).
+    pub(super) e: Vec<f64>,
+}
+
+impl LoadRows {
+    /// `|d - e|` at state `x`, held input `w` and loop output `z`.
+    #[inline]
+    fn load(&self, x: &[f64], w: &[f64], z: &[f64]) -> f64 {
+        let dot = |r: &[f64], v: &[f64]| r.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+        (dot(&self.b, w) + dot(&self.e, z) - dot(&self.a, x)).abs()
+    }
 }
 
 impl Friction {
     /// No friction yet on `state`.
     pub(super) fn new(state: usize) -> Self {
-        Self { state, pos: 0.0, neg: 0.0, excess: Vec::new(), static_extra: 0.0, viscous: 0.0 }
+        Self { state, pos: 0.0, neg: 0.0, excess: Vec::new(), static_extra: 0.0, viscous: 0.0, load: None }
+    }
+
+    /// Adds a load-dependent term `coefficient |d - e|` (rows `rows`) to every level.
+    pub(super) fn add_load(&mut self, coefficient: f64, rows: LoadRows) {
+        let k = self.load.as_ref().map_or(0.0, |(k, _)| *k);
+        self.load = Some((k + coefficient, rows));
+    }
+
+    /// The level the load adds over a step starting at `x` with input `w` and output `z`.
+    #[inline]
+    pub(super) fn load_level(&self, x: &[f64], w: &[f64], z: &[f64]) -> f64 {
+        self.load.as_ref().map_or(0.0, |(k, rows)| k * rows.load(x, w, z))
     }
 
     /// Adds sliding levels `pos` (moving up) and `neg` (moving down).
@@ -66,15 +105,17 @@ impl Friction {
     }
 
     /// The friction force over a step whose friction-free end velocity is `a`, with
-    /// `g = Psi_jj` (implicit: the end velocity is `a + g f`), and whether the state sticks.
+    /// `g = Psi_jj` (implicit: the end velocity is `a + g f`), every level raised by `extra`
+    /// (the load's, [`Friction::load_level`]), and whether the state sticks.
     #[inline]
-    pub(super) fn force(&self, a: f64, g: f64) -> (f64, bool) {
-        let (s_pos, s_neg) = (self.pos + self.static_extra, self.neg + self.static_extra);
+    pub(super) fn force(&self, a: f64, g: f64, extra: f64) -> (f64, bool) {
+        let (pos, neg) = (self.pos + extra, self.neg + extra);
+        let (s_pos, s_neg) = (pos + self.static_extra, neg + self.static_extra);
         if a <= g * s_pos && a >= -g * s_neg {
             // Sticks (the static levels hold the remaining force).
             return (-a / g, true);
         }
-        let (d, c) = if a > 0.0 { (1.0, self.pos) } else { (-1.0, self.neg) };
+        let (d, c) = if a > 0.0 { (1.0, pos) } else { (-1.0, neg) };
         if self.excess.is_empty() && self.viscous == 0.0 {
             return (-c * d, false);
         }

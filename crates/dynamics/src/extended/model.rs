@@ -12,8 +12,9 @@
 //!   `A sin(2 pi x_pos / P + phase)` (`cogging`, evaluated at the step's midpoint position
 //!   of the force-free step and held over the step) ([`super::forces`]);
 //! - `f_j` is friction on velocity state `x_j` (`coulomb_friction`, `stribeck_friction`,
-//!   `asymmetric_coulomb`; several on one state add up), a set-valued law resolved implicitly
-//!   per step (Moreau-Jean time stepping; [`super::friction`]);
+//!   `asymmetric_coulomb`, `load_friction` whose level grows with the transmitted load
+//!   `|B_j w + E_j z - sum_{i != j} A_ji x_i|`; several on one state add up), a set-valued law
+//!   resolved implicitly per step (Moreau-Jean time stepping; [`super::friction`]);
 //! - the play is the catching-up scheme `z_{k+1} = y_{k+1} + P_Theta(z_pred - y_{k+1})`, where
 //!   `z_pred = z_k` for a massless backlash output and, with `backlash_inertia`, `z` coasts
 //!   with velocity `v` decaying at rate `damping / mass` between contacts (the contact is
@@ -88,6 +89,9 @@ impl ExtendedModel {
                 }
                 Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
                     forces.stribeck(*state, *level, *static_level, *stribeck_velocity, *viscous)?
+                }
+                Effect::LoadFriction { state, level, load_coefficient } => {
+                    forces.load_friction(*state, *level, *load_coefficient, sys)?
                 }
                 Effect::Cogging { state, position_state, amplitude, period, phase } => {
                     forces.cogging(*state, *position_state, *amplitude, *period, *phase)?

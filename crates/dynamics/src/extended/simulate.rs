@@ -335,7 +335,7 @@ impl ExtendedModel {
     pub(super) fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
         let (n, m, p) = (self.n, self.m, self.p);
         let mp = pc.maps;
-        let (x, xn, q) = (&st.x[..n], &mut st.xn[..n], &st.q[..p]);
+        let (x, xn, q, z) = (&st.x[..n], &mut st.xn[..n], &st.q[..p], &st.z[..p]);
         let (w0, dw) = (&w0[..m], &dw[..m]);
         for (i, xn_i) in xn.iter_mut().enumerate() {
             let (phi, pb, p1, pe) =
@@ -355,7 +355,7 @@ impl ExtendedModel {
             }
             *xn_i = acc;
         }
-        self.forces.apply(x, xn, &mp.Psi);
+        self.forces.apply(x, xn, &mp.Psi, w0, z);
         std::mem::swap(&mut st.x, &mut st.xn);
         self.output(&st.x, &mut st.y);
     }
