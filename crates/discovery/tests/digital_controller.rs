@@ -149,7 +149,7 @@ fn digital_controller_benchmark() {
     // the stick-slip transitions): K, checked against 2K
     #[allow(non_snake_case)]
     let K = env_list("CASCADE_SUBSTEPS", "16").first().copied().unwrap_or(16) as usize;
-    println!("| seed | plant | M err % | Fv err % | Fc err % | max shift at 2K sub-steps (sigma) | multisine fit -> triangle RMSE (um) | triangle fit on triangle (um) | ratio | triangle fit: M err % | triangle fit -> multisine (um) | multisine fit on multisine (um) | ratio |");
+    println!("| seed | plant | M err % | Fv err % | Fc err % | max shift at 2K sub-steps (sigma) | multisine fit -> triangle RMSE (um) | triangle fit on triangle (um) | ratio | triangle fit: M / Fv / Fc err % (M err / its sigma) | triangle fit -> multisine (um) | multisine fit on multisine (um) | ratio |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let (mut worst_err, mut worst_ratio, mut worst_shift) = (0.0f64, 0.0f64, 0.0f64);
     for &seed in &seeds {
@@ -173,9 +173,15 @@ fn digital_controller_benchmark() {
             let (pred_tri, own_tri) = (rmse_on(fm, &tri, k), rmse_on(ft, &tri, on_tri.substeps));
             let (pred_multi, own_multi) = (rmse_on(ft, &multi, on_tri.substeps), rmse_on(fm, &multi, k));
             let (r1, r2) = (pred_tri / own_tri, pred_multi / own_multi);
-            let m_tri = 100.0 * (physical(&on_tri)[0].0 / tr.mass - 1.0);
+            let tri_errs: Vec<String> = physical(&on_tri)
+                .iter()
+                .zip([tr.mass, tr.viscous, tr.coulomb])
+                .map(|((v, _), t)| format!("{:+.2}", 100.0 * (v / t - 1.0)))
+                .collect();
+            let (m_t, m_sd) = physical(&on_tri)[0];
+            let m_tri = format!("{} ({:+.1})", tri_errs.join(" / "), (m_t - tr.mass) / m_sd);
             println!(
-                "| {seed} | {idx} | {:+.2} | {:+.2} | {:+.2} | {shift:.3} | {:.3} | {:.3} | {r1:.3} | {m_tri:+.2} | {:.3} | {:.3} | {r2:.3} |",
+                "| {seed} | {idx} | {:+.2} | {:+.2} | {:+.2} | {shift:.3} | {:.3} | {:.3} | {r1:.3} | {m_tri} | {:.3} | {:.3} | {r2:.3} |",
                 errs[0],
                 errs[1],
                 errs[2],
