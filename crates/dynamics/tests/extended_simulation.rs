@@ -65,3 +65,26 @@ fn sensor_offset_is_in_the_output_exactly() {
         assert!((ya - yb - 0.05).abs() < 1e-12, "row {i}: {ya} vs {yb}");
     }
 }
+
+#[test]
+fn a_coasting_backlash_output_converges_at_second_order() {
+    // The worked example with a massive backlash output (time constant 1.4 s), 5 s of its sine
+    // sampled at 10 ms: the output's change from K to 2K sub-steps per sample. The coasting
+    // play is second order in the step away from contact events (issue 27 item 5: the plant
+    // sees q change linearly while the output coasts, and a contact hands the output y's
+    // velocity); it was first order (a factor 2 per doubling).
+    use dynamics::extended::ExtendedModel;
+    let sys = worked("");
+    let inertia = [model::effects::Effect::BacklashInertia { mass: 1.4, damping: 1.0 }];
+    let dt = 0.01;
+    let w: Vec<f64> = (0..500).map(|k| 3.0 * (k as f64 * dt).sin()).collect();
+    let x0 = sys.x0.as_slice().to_vec();
+    let run = |k| ExtendedModel::new(&sys, &inertia, dt, k).unwrap().simulate(&w, dt, &x0).y;
+    let rms = |a: &[f64], b: &[f64]| (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len() as f64).sqrt();
+    let change: Vec<f64> = [2, 4, 8, 16].iter().map(|&k| rms(&run(k), &run(2 * k))).collect();
+    eprintln!("changes K -> 2K for K = 2, 4, 8, 16: {change:?}");
+    assert!(change.iter().all(|c| *c > 0.0), "the effect does nothing: {change:?}");
+    // Over three doublings a first-order scheme shrinks the change 8 times, a second-order one
+    // 64 times.
+    assert!(change[0] / change[3] > 25.0, "{change:?}");
+}

@@ -18,7 +18,10 @@
 //! - the play is the catching-up scheme `z_{k+1} = y_{k+1} + P_Theta(z_pred - y_{k+1})`, where
 //!   `z_pred = z_k` for a massless backlash output and, with `backlash_inertia`, `z` coasts
 //!   with velocity `v` decaying at rate `damping / mass` between contacts (the contact is
-//!   inelastic: after a projection `v = (z_{k+1} - z_k)/h`) ([`super::simulate`]).
+//!   inelastic: after a projection `z` moves with `y`, `v` the output's velocity by a
+//!   second-order backward difference; `(z_{k+1} - z_k)/h` for p > 1), and while it coasts
+//!   the plant sees `q` change linearly over the step ([`super::simulate`]). Second order in
+//!   the step away from contact events (first order before, issue 27 item 5).
 //!
 //! Compiling checks every effect (an error names the effect and the offending value); the
 //! simulation itself is [`super::simulate`].

@@ -5,8 +5,9 @@
 //! One sample interval is `substeps` sub-steps (one of them split in two at a delayed input's
 //! breakpoint, see [`super::input`]); each sub-step is, in order:
 //! 1. the input over the sub-step by the model's hold (`InputDrive::advance`);
-//! 2. the exact linear step `x+ = Phi x + Psi B w0 + Psi1 B dw + Psi E q (+ Psi b)`, then the
-//!    cogging and friction forces ([`super::forces`]) (`ExtendedModel::step_plant`);
+//! 2. the exact linear step `x+ = Phi x + Psi B w0 + Psi1 B dw + Psi E q (+ Psi1 E dq, a
+//!    coasting play's predicted change of q) (+ Psi b)`, then the cogging and friction forces
+//!    ([`super::forces`]) (`ExtendedModel::step_plant`);
 //! 3. the play: the backlash output coasts (with inertia) and is projected back into
 //!    `y + Theta` (`ExtendedModel::step_play`).
 use super::input::InputPath;
@@ -166,6 +167,17 @@ pub(super) struct RunState {
     pub(super) y: Vec<f64>,
     /// Coasting velocity of the backlash output (`backlash_inertia`).
     v: Vec<f64>,
+    /// With `backlash_inertia`: `y` at the start of the current step and of the step before,
+    /// and the length of the step before (0 before the first), for the output's velocity at
+    /// a contact ([`ExtendedModel::output_velocity`]).
+    y_start: Vec<f64>,
+    y_before: Vec<f64>,
+    h_before: f64,
+    h_last: f64,
+    /// With `backlash_inertia`: whether the play was projected (in contact) at the last step's
+    /// end, and the change of `q` predicted over the current step (coasting).
+    touching: Vec<bool>,
+    dq: Vec<f64>,
     scratch: Vec<f64>,
     /// `q` before the projection.
     qp: Vec<f64>,
@@ -313,6 +325,12 @@ impl ExtendedModel {
             v: vec![0.0; p],
             scratch: vec![0.0; p],
             qp: vec![0.0; p],
+            y_start: vec![0.0; p],
+            y_before: vec![0.0; p],
+            h_before: 0.0,
+            h_last: 0.0,
+            touching: vec![true; p],
+            dq: vec![0.0; p],
         };
         self.output(&st.x, &mut st.y);
         st.z.copy_from_slice(&st.y);
@@ -335,7 +353,8 @@ impl ExtendedModel {
     pub(super) fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
         let (n, m, p) = (self.n, self.m, self.p);
         let mp = pc.maps;
-        let (x, xn, q, z) = (&st.x[..n], &mut st.xn[..n], &st.q[..p], &st.z[..p]);
+        let coasting = self.inertia_tau > 0.0 && self.predict_coasting(st, pc);
+        let (x, xn, q, z, dq) = (&st.x[..n], &mut st.xn[..n], &st.q[..p], &st.z[..p], &st.dq[..p]);
         let (w0, dw) = (&w0[..m], &dw[..m]);
         for (i, xn_i) in xn.iter_mut().enumerate() {
             let (phi, pb, p1, pe) =
@@ -350,6 +369,11 @@ impl ExtendedModel {
             for (a, b) in pe.iter().zip(q) {
                 acc += a * b;
             }
+            if coasting {
+                for (a, b) in mp.Psi1E[i * p..][..p].iter().zip(dq) {
+                    acc += a * b;
+                }
+            }
             if self.forces.has_force {
                 acc += pc.fb[i];
             }
@@ -357,7 +381,45 @@ impl ExtendedModel {
         }
         self.forces.apply(x, xn, &mp.Psi, w0, z);
         std::mem::swap(&mut st.x, &mut st.xn);
+        if self.inertia_tau > 0.0 {
+            std::mem::swap(&mut st.y_before, &mut st.y_start);
+            st.y_start.copy_from_slice(&st.y);
+            st.h_before = st.h_last;
+            st.h_last = mp.h;
+        }
         self.output(&st.x, &mut st.y);
+    }
+
+    /// With `backlash_inertia`: the change of `q = z - y` over the coming step `pc` where the
+    /// play is not in contact (`z` coasts by `v coast`, `y` moves by its velocity times `h`),
+    /// so that the plant sees `q` change linearly over the step (`Psi1 E dq`) instead of held;
+    /// 0 in contact. Whether any output coasts.
+    #[inline(always)]
+    fn predict_coasting(&self, st: &mut RunState, pc: &Piece) -> bool {
+        let mut any = false;
+        for i in 0..self.p {
+            st.dq[i] = if st.touching[i] || st.h_last == 0.0 {
+                0.0
+            } else {
+                any = true;
+                st.v[i] * pc.coast - Self::output_velocity(st, i) * pc.maps.h
+            };
+        }
+        any
+    }
+
+    /// The output's velocity at the end of the step just taken, by the second-order backward
+    /// difference over the last two steps (first order after the first step): the velocity a
+    /// massive backlash output takes on in an inelastic contact.
+    #[inline(always)]
+    fn output_velocity(st: &RunState, i: usize) -> f64 {
+        let d2 = (st.y[i] - st.y_start[i]) / st.h_last;
+        if st.h_before > 0.0 {
+            let d1 = (st.y_start[i] - st.y_before[i]) / st.h_before;
+            d2 + st.h_last / (st.h_before + st.h_last) * (d2 - d1)
+        } else {
+            d2
+        }
     }
 
     /// The play over one piece: `z` coasts (with inertia), `q` is projected into `Theta` and
@@ -382,7 +444,16 @@ impl ExtendedModel {
         for i in 0..p {
             let znew = st.y[i] + st.q[i];
             if self.inertia_tau > 0.0 {
-                st.v[i] = if st.q[i] != st.qp[i] { (znew - st.z[i]) / pc.maps.h } else { st.v[i] * pc.decay };
+                st.touching[i] = st.q[i] != st.qp[i];
+                st.v[i] = if st.q[i] == st.qp[i] {
+                    st.v[i] * pc.decay
+                } else if p == 1 {
+                    // In contact at the step's end: dragged along with `y` (one dimension: `q`
+                    // rests on the boundary).
+                    Self::output_velocity(st, i)
+                } else {
+                    (znew - st.z[i]) / pc.maps.h
+                };
             }
             st.z[i] = znew;
         }

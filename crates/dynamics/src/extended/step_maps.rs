@@ -1,7 +1,8 @@
 //! Exact linear step maps over a step `h` for `x' = F x + B w(t) + u`:
 //! `x(h) = Phi x + Psi (B w_0 + u) + Psi1 B (w_1 - w_0)` with `Phi = e^{hF}`,
 //! `Psi = int_0^h e^{sF} ds` (= `h Psi(hF)` in the paper's notation, eq. (Psi)) and
-//! `Psi1 = int_0^h e^{(h-s)F} (s/h) ds` (linear interpolation of `w` over the step).
+//! `Psi1 = int_0^h e^{(h-s)F} (s/h) ds` (linear interpolation of `w`, or of a coasting play's
+//! `q`, over the step).
 //! All three come from the one matrix exponential of [`crate::linear::expm::exp_integrals`]
 //! (Van Loan), shared with the catching-up scheme; here they are stored row-major for the
 //! extended model's inner loop.
@@ -23,6 +24,8 @@ pub struct StepMaps {
     pub Psi1B: Vec<f64>,
     /// `Psi E` (n x p).
     pub PsiE: Vec<f64>,
+    /// `Psi1 E` (n x p): a play deviation `q` that changes linearly over the step.
+    pub Psi1E: Vec<f64>,
 }
 
 pub(super) fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
@@ -48,6 +51,7 @@ impl StepMaps {
             PsiB: row_major(&(&I.gamma1 * B)),
             Psi1B: row_major(&(&psi1 * B)),
             PsiE: row_major(&(&I.gamma1 * E)),
+            Psi1E: row_major(&(&psi1 * E)),
             Phi: row_major(&I.phi),
             Psi: row_major(&I.gamma1),
         }
