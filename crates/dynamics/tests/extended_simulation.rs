@@ -80,7 +80,8 @@ fn a_coasting_backlash_output_converges_at_second_order() {
     let w: Vec<f64> = (0..500).map(|k| 3.0 * (k as f64 * dt).sin()).collect();
     let x0 = sys.x0.as_slice().to_vec();
     let run = |k| ExtendedModel::new(&sys, &inertia, dt, k).unwrap().simulate(&w, dt, &x0).y;
-    let rms = |a: &[f64], b: &[f64]| (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len() as f64).sqrt();
+    let rms =
+        |a: &[f64], b: &[f64]| (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len() as f64).sqrt();
     let change: Vec<f64> = [2, 4, 8, 16].iter().map(|&k| rms(&run(k), &run(2 * k))).collect();
     eprintln!("changes K -> 2K for K = 2, 4, 8, 16: {change:?}");
     assert!(change.iter().all(|c| *c > 0.0), "the effect does nothing: {change:?}");
