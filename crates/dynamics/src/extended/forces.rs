@@ -136,10 +136,8 @@ impl Forces {
         load_coefficient: f64,
         sys: &model::System,
     ) -> Result<(), DynamicsError> {
+        check_state("load_friction", state, self.n)?;
         let bad = |reason, value| Err(DynamicsError::BadEffect { kind: "load_friction", reason, value });
-        if state >= self.n {
-            return bad("state index out of range", state as f64);
-        }
         if !(level >= 0.0 && level.is_finite()) {
             return bad("level must be finite and non-negative", level);
         }
