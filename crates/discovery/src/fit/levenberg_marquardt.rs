@@ -381,7 +381,28 @@ pub(crate) fn lm_from<O: Objective>(
 /// Steps: `starts` -> `best_start` (screening and a few iterations from each) -> refinement
 /// of the best on the whole estimation segment -> `conclude` (covariance and status).
 pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>, s: &FitSettings) -> FitResult {
-    fit_with(pb, x0_init, x_scale, warm, s, true)
+    fit_with(pb, x0_init, x_scale, Starts::Warm(warm), s, true)
+}
+
+/// One group of starts of [`fit_groups`]: for each part of the problem (in order), its
+/// parameters in physical units, or `None` for the part's own start grid.
+pub type PartStarts = Vec<Option<Vec<f64>>>;
+
+/// [`fit`] from several groups of starts, each group as [`fit`] treats its starts (screened,
+/// [`FitSettings::max_iter_start`] iterations from each kept one): the best end point over
+/// every group is refined, once. The cost of one multi-start fit, where one fit per group and
+/// the best of their ends costs a refinement and a covariance per group.
+pub fn fit_groups(pb: &Problem, x0_init: &[f64], x_scale: &[f64], groups: &[PartStarts], s: &FitSettings) -> FitResult {
+    fit_with(pb, x0_init, x_scale, Starts::Groups(groups), s, true)
+}
+
+/// Where [`fit_with`] starts from.
+#[derive(Clone, Copy)]
+enum Starts<'w> {
+    /// The parts' start grids, the leading parameters given where warm ([`starts`]).
+    Warm(Option<&'w [f64]>),
+    /// Groups of starts ([`fit_groups`]).
+    Groups(&'w [PartStarts]),
 }
 
 /// [`fit`]'s estimate alone: the same parameters, initial state and SSE, without the
@@ -396,7 +417,7 @@ pub fn fit_estimate(
     warm: Option<&[f64]>,
     s: &FitSettings,
 ) -> FitResult {
-    fit_with(pb, x0_init, x_scale, warm, s, false)
+    fit_with(pb, x0_init, x_scale, Starts::Warm(warm), s, false)
 }
 
 /// [`fit`] (`covariance`) or [`fit_estimate`].
@@ -404,7 +425,7 @@ fn fit_with(
     pb: &Problem,
     x0_init: &[f64],
     x_scale: &[f64],
-    warm: Option<&[f64]>,
+    from: Starts,
     s: &FitSettings,
     covariance: bool,
 ) -> FitResult {
@@ -427,19 +448,22 @@ fn fit_with(
         return nothing_to_fit(&vars, x0_init, &mut evals);
     }
     let x0v: Vec<f64> = if xs.is_empty() { vec![] } else { x0_init.iter().zip(&xs).map(|(a, b)| a / b).collect() };
-    let starts = starts(pb, k, warm, &nomv, &x0v);
+    let groups: Vec<Vec<Vec<f64>>> = match from {
+        Starts::Warm(warm) => vec![starts(pb, k, warm, &nomv, &x0v)],
+        Starts::Groups(g) => g.iter().map(|g| group_starts(pb, g, &nomv, &x0v)).collect(),
+    };
     // Long records: screening and the start iterations see a leading part of the estimation
     // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
     // see all of it, from the best start. Several starts only: a single (warm) start goes
     // straight to the whole segment.
     let short;
-    let start_vars = if starts.len() > 1 && pb.k_est >= s.long_record {
+    let start_vars = if groups.iter().map(Vec::len).sum::<usize>() > 1 && pb.k_est >= s.long_record {
         short = Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() };
         &short
     } else {
         &vars
     };
-    let best = best_start(start_vars, starts, s, &mut evals);
+    let best = best_of_groups(start_vars, groups, s, &mut evals);
     let failed = |evals: usize| FitResult {
         theta: lo.clone(),
         std: vec![f64::NAN; k],
@@ -545,6 +569,60 @@ fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64
         }
     }
     starts
+}
+
+/// The starts of one group of [`fit_groups`] in solver units: the given parts' parameters,
+/// the others at start `i` of their grids (as many starts as the longest grid among them; one
+/// where every part is given), then `nomv` and `x0v`. Given parameters of the wrong length
+/// count as not given.
+fn group_starts(pb: &Problem, group: &PartStarts, nomv: &[f64], x0v: &[f64]) -> Vec<Vec<f64>> {
+    let given = |j: usize| group.get(j).and_then(|g| g.as_ref()).filter(|w| w.len() == pb.parts[j].k());
+    let nstart = pb
+        .parts
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| given(j).is_none())
+        .map(|(_, h)| h.starts.len())
+        .max()
+        .unwrap_or(1);
+    (0..nstart.max(1))
+        .map(|i| {
+            let mut v: Vec<f64> = Vec::new();
+            for (j, h) in pb.parts.iter().enumerate() {
+                match given(j) {
+                    Some(w) => v.extend(w.iter().enumerate().map(|(c, x)| h.unit_of(c, *x))),
+                    None => v.extend(h.starts[i % h.starts.len()].iter()),
+                }
+            }
+            v.extend(nomv.iter());
+            v.extend(x0v.iter());
+            v
+        })
+        .collect()
+}
+
+/// [`best_start`] of each group (side by side where the settings say so), and the best of
+/// their end points (the first of equals).
+fn best_of_groups(vars: &Vars, mut groups: Vec<Vec<Vec<f64>>>, s: &FitSettings, evals: &mut usize) -> Option<LmEnd> {
+    if groups.len() == 1 {
+        return best_start(vars, groups.pop().expect("one group"), s, evals);
+    }
+    let run = |g: Vec<Vec<f64>>| {
+        let mut e = 0;
+        (best_start(vars, g, s, &mut e), e)
+    };
+    let done: Vec<(Option<LmEnd>, usize)> =
+        if s.parallel { groups.into_par_iter().map(run).collect() } else { groups.into_iter().map(run).collect() };
+    let mut best: Option<LmEnd> = None;
+    for (res, e) in done {
+        *evals += e;
+        if let Some(res) = res {
+            if best.as_ref().is_none_or(|b| res.2 < b.2) {
+                best = Some(res);
+            }
+        }
+    }
+    best
 }
 
 /// Where [`lm`] ends: `(v, r, cost, converged)`.

@@ -14,6 +14,8 @@ pub mod missing_input;
 pub mod nominal;
 pub mod problem;
 
-pub use levenberg_marquardt::{fit, fit_estimate, EffectCovariance, FitResult, FitSettings, FitStatus, LONG_RECORD};
+pub use levenberg_marquardt::{
+    fit, fit_estimate, fit_groups, EffectCovariance, FitResult, FitSettings, FitStatus, PartStarts, LONG_RECORD,
+};
 pub use nominal::{FreeNominal, Refit};
 pub use problem::Problem;

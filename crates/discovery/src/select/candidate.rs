@@ -106,9 +106,38 @@ pub(crate) fn fit_hypothesis(
     bic_nom: f64,
     val_sse_nom: f64,
 ) -> Ranked {
-    let (p, n_samp, k_est, nx) = (ctx.p, ctx.n, ctx.k_est, ctx.x_scale.len());
     let pb = ctx.problem_r(parts.clone(), refit.as_deref());
     let r: FitResult = fit::fit(&pb, x0, &ctx.x_scale, warm.as_deref(), plan.fit);
+    scored(ctx, &pb, parts, r, bic_nom, val_sse_nom)
+}
+
+/// [`fit_hypothesis`] (no refit of the nominal parameters) from several groups of starts, one
+/// multi-start fit ([`fit::fit_groups`]): the best end of every group's start phase refined.
+pub(crate) fn fit_hypothesis_from(
+    ctx: &FitContext,
+    plan: &Plan,
+    parts: Vec<Hypothesis>,
+    groups: &[fit::PartStarts],
+    x0: &[f64],
+    bic_nom: f64,
+    val_sse_nom: f64,
+) -> Ranked {
+    let pb = ctx.problem_r(parts.clone(), None);
+    let r = fit::fit_groups(&pb, x0, &ctx.x_scale, groups, plan.fit);
+    scored(ctx, &pb, parts, r, bic_nom, val_sse_nom)
+}
+
+/// Fit `r` of hypothesis `parts` (problem `pb`) scored: BIC against the nominal's `bic_nom`,
+/// validation fit and SSE against the nominal's `val_sse_nom`.
+fn scored(
+    ctx: &FitContext,
+    pb: &Problem,
+    parts: Vec<Hypothesis>,
+    r: FitResult,
+    bic_nom: f64,
+    val_sse_nom: f64,
+) -> Ranked {
+    let (p, n_samp, k_est, nx) = (ctx.p, ctx.n, ctx.k_est, ctx.x_scale.len());
     let (val, val_sse) = match pb.simulate_with(&r.theta, &r.nominal, &r.x0, None) {
         Some(sim) => (metrics::fit(&ctx.y, &sim.y, p, k_est, n_samp, ctx.dt), ctx.weighted_sse(&sim.y, k_est, n_samp)),
         None => (failed_fit(p), f64::INFINITY),

@@ -8,7 +8,7 @@
 //! selected model gives way to a simpler reading that fits as well, and the readings that fit
 //! as well as the selected one are named beside it ([`Equivalent`]). Every fit ends in the
 //! ranking with its evidence.
-use super::candidate::{failed_fit, fit_hypothesis, nominal_scores, Ranked};
+use super::candidate::{failed_fit, fit_hypothesis, fit_hypothesis_from, nominal_scores, Ranked};
 use super::context::FitContext;
 use super::cross_validation::{cross_validate, cv_sse_of};
 use super::Plan;
@@ -416,16 +416,13 @@ impl Selector<'_, '_> {
         // Each single's estimate has absorbed part of the other effect: started from both
         // estimates and from both scaled down (PAIR_START_SCALES), and from each effect's own
         // estimate (its single's, and its part of every composite fitted on the way) with the
-        // other effect at its start grid (pair_starts); the best fit kept.
+        // other effect at its start grid (pair_starts); one multi-start fit, whose best start
+        // is refined.
         let fitted: Vec<&Ranked> = tried.iter().chain(std::iter::once(cur)).filter(|t| !t.refit).collect();
         let f = |(a, b): &(&Ranked, &Ranked)| {
-            pair_starts(a, b, &fitted)
-                .into_iter()
-                .map(|(parts, warm)| {
-                    fit_hypothesis(ctx, plan, parts, None, Some(warm), &a.x0, self.bic_nom, self.val_sse_nom)
-                })
-                .min_by(|x, y| x.bic.total_cmp(&y.bic))
-                .expect("at least one start")
+            let parts = vec![a.parts[0].clone(), b.parts[0].clone()];
+            let starts = pair_starts(a, b, &fitted);
+            fit_hypothesis_from(ctx, plan, parts, &starts, &a.x0, self.bic_nom, self.val_sse_nom)
         };
         let mut pairs: Vec<Ranked> =
             if plan.parallel { todo.par_iter().map(f).collect() } else { todo.iter().map(f).collect() };
@@ -817,21 +814,17 @@ pub const SWAP_WINDOW: f64 = 0.25;
 /// The pair search's starts: both singles' estimates times each of these.
 pub const PAIR_START_SCALES: [f64; 3] = [1.0, 0.6, 0.3];
 
-/// The starts of the joint fit of singles `a` and `b` (issue 27 item 4): `(parts, leading
-/// parameters)`, the parts not covered by the leading parameters at their own start grid.
+/// The starts of the joint fit of singles `a` and `b` (issue 27 item 4), in the order `a`, `b`:
 /// - both singles' estimates, times each of [`PAIR_START_SCALES`];
 /// - each effect's own estimate, the other effect at its start grid: from its single, and from
 ///   every composite in `fitted` that contains its kind (a gap width fitted beside Stribeck
 ///   friction is a better start for the gap beside Coulomb friction than the gap's single,
-///   which has absorbed the friction). Such a start puts that effect first (the pair's label
-///   then lists it first).
-fn pair_starts(a: &Ranked, b: &Ranked, fitted: &[&Ranked]) -> Vec<(Vec<Hypothesis>, Vec<f64>)> {
-    let (ha, hb) = (a.parts[0].clone(), b.parts[0].clone());
-    let mut out: Vec<(Vec<Hypothesis>, Vec<f64>)> = PAIR_START_SCALES
-        .iter()
-        .map(|&c| (vec![ha.clone(), hb.clone()], a.params.iter().chain(&b.params).map(|v| c * v).collect()))
-        .collect();
-    for (h, other, single) in [(&ha, &hb, a), (&hb, &ha, b)] {
+///   which has absorbed the friction).
+fn pair_starts(a: &Ranked, b: &Ranked, fitted: &[&Ranked]) -> Vec<fit::PartStarts> {
+    let scale = |r: &Ranked, c: f64| Some(r.params.iter().map(|v| c * v).collect::<Vec<f64>>());
+    let mut out: Vec<fit::PartStarts> = PAIR_START_SCALES.iter().map(|&c| vec![scale(a, c), scale(b, c)]).collect();
+    for (at, single) in [(0, a), (1, b)] {
+        let h = &single.parts[0];
         let mut seen: Vec<Vec<f64>> = Vec::new();
         let own = std::iter::once(single.params.clone())
             .chain(fitted.iter().filter(|t| t.parts.len() > 1).filter_map(|t| part_params(t, h.kind)));
@@ -840,7 +833,9 @@ fn pair_starts(a: &Ranked, b: &Ranked, fitted: &[&Ranked]) -> Vec<(Vec<Hypothesi
                 continue;
             }
             seen.push(w.clone());
-            out.push((vec![h.clone(), other.clone()], w));
+            let mut group: fit::PartStarts = vec![None, None];
+            group[at] = Some(w);
+            out.push(group);
         }
     }
     out

@@ -1,0 +1,73 @@
+//! A fit from several groups of starts (`fit::fit_groups`, the pair search's joint fits, issue
+//! 27 item 5): one group reads as `fit` from the same starts, bit for bit; several groups end at
+//! the best group's point, refined once, at less cost than one fit per group.
+mod common;
+use discovery::fit::{self, FitSettings, FitStatus, PartStarts};
+use discovery::hypothesis::{self, Kind};
+use dynamics::extended::ExtendedModel;
+use model::effects::Effect;
+
+fn mass() -> model::System {
+    let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -1.2]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+    model::parse_str(text).unwrap()
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+#[test]
+fn groups_of_starts_end_at_the_best_group_refined_once() {
+    let sys = mass();
+    let (dt, level, n) = (0.02, 0.25, 2000);
+    let w: Vec<f64> = (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.5 * (2.3 * k as f64 * dt + 1.0).sin()).collect();
+    let truth = [Effect::CoulombFriction { state: 1, level }];
+    let y0 = ExtendedModel::new(&sys, &truth, dt, 2).unwrap().simulate(&w, dt, &[0.1, 0.0]).y;
+    let yr = y0.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y0.iter().copied().fold(f64::INFINITY, f64::min);
+    let y: Vec<f64> =
+        y0.iter().enumerate().map(|(k, v)| v + 0.01 * yr * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)).collect();
+    let scales = common::test_scales(yr, n, dt);
+    let h = hypothesis::candidates(&sys, &scales)
+        .into_iter()
+        .find(|h| h.kind == Kind::CoulombFriction { state: 1 })
+        .expect("Coulomb friction on the velocity state is a candidate");
+    let pb = common::scalar_problem(&sys, &h, &scales, &w, &y, 7 * n / 10, 1.0 / yr, 2);
+    let (x0, xs) = ([0.0, 0.0], [0.2, 0.2]);
+    let s = FitSettings::default();
+    let same = |a: &fit::FitResult, b: &fit::FitResult| {
+        bits(&a.theta) == bits(&b.theta) && bits(&a.x0) == bits(&b.x0) && a.sse.to_bits() == b.sse.to_bits()
+    };
+
+    // One group: `fit` from the same starts (the part's grid; a warm start).
+    let grid = fit::fit(&pb, &x0, &xs, None, &s);
+    assert!(same(&fit::fit_groups(&pb, &x0, &xs, &[vec![None]], &s), &grid));
+    let near = [1.1 * level];
+    let warm = fit::fit(&pb, &x0, &xs, Some(&near), &s);
+    assert!(same(&fit::fit_groups(&pb, &x0, &xs, &[vec![Some(near.to_vec())]], &s), &warm));
+    assert!((warm.theta[0] - level).abs() < 0.05 * level, "estimate {} vs truth {level}", warm.theta[0]);
+
+    // Two groups, a far start and a near one, with a start phase too short to bring the far
+    // start in: the fit ends where the near group leads, whichever comes first.
+    let short = FitSettings { max_iter_start: 1, ..s.clone() };
+    let far = [20.0 * level];
+    let groups: Vec<PartStarts> = vec![vec![Some(far.to_vec())], vec![Some(near.to_vec())]];
+    let both = fit::fit_groups(&pb, &x0, &xs, &groups, &short);
+    let swapped = fit::fit_groups(&pb, &x0, &xs, &[groups[1].clone(), groups[0].clone()], &short);
+    let near_alone = fit::fit(&pb, &x0, &xs, Some(&near), &short);
+    let far_alone = fit::fit(&pb, &x0, &xs, Some(&far), &short);
+    assert!(both.status == FitStatus::Converged || both.status == FitStatus::MaxIterations, "{:?}", both.status);
+    assert!(same(&both, &near_alone) && same(&swapped, &near_alone));
+    // the groups run side by side or one after the other: the same point
+    let serial = fit::fit_groups(&pb, &x0, &xs, &groups, &FitSettings { parallel: false, ..short.clone() });
+    assert!(same(&serial, &both));
+    // refined once: fewer simulations than the two fits it replaces
+    assert!(
+        both.evaluations < near_alone.evaluations + far_alone.evaluations,
+        "{} evaluations against {} + {}",
+        both.evaluations,
+        near_alone.evaluations,
+        far_alone.evaluations
+    );
+    // control: the comparison sees another end point (the far start refined alone)
+    assert!(!same(&far_alone, &near_alone), "the far start must end elsewhere for this test to tell");
+}
