@@ -1,6 +1,7 @@
 //! A fit from several groups of starts (`fit::fit_groups`, the pair search's joint fits, issue
-//! 27 item 5): one group reads as `fit` from the same starts, bit for bit; several groups end at
-//! the best group's point, refined once, at less cost than one fit per group.
+//! 27 item 5): one group reads as `fit` from the same starts, bit for bit; several groups are
+//! pooled, screened and end at the best start's point, refined once, at less cost than one fit
+//! per group.
 mod common;
 use discovery::fit::{self, FitSettings, FitStatus, PartStarts};
 use discovery::hypothesis::{self, Kind};
@@ -70,4 +71,13 @@ fn groups_of_starts_end_at_the_best_group_refined_once() {
     );
     // control: the comparison sees another end point (the far start refined alone)
     assert!(!same(&far_alone, &near_alone), "the far start must end elsewhere for this test to tell");
+
+    // More starts than are kept: the part's grid beside the far start, pooled and screened by
+    // their first cost; the fit still finds the level.
+    let pooled: Vec<PartStarts> = vec![vec![None], vec![Some(far.to_vec())]];
+    let n_grid = h.starts.len() + 1;
+    assert!(n_grid > fit::levenberg_marquardt::POOLED_KEPT_STARTS, "{n_grid} starts");
+    let p = fit::fit_groups(&pb, &x0, &xs, &pooled, &s);
+    assert!((p.theta[0] - level).abs() < 0.05 * level, "estimate {} vs truth {level}", p.theta[0]);
+    assert!(p.sse <= 1.0001 * grid.sse, "pooled {} against the grid's {}", p.sse, grid.sse);
 }

@@ -388,10 +388,11 @@ pub fn fit(pb: &Problem, x0_init: &[f64], x_scale: &[f64], warm: Option<&[f64]>,
 /// parameters in physical units, or `None` for the part's own start grid.
 pub type PartStarts = Vec<Option<Vec<f64>>>;
 
-/// [`fit`] from several groups of starts, each group as [`fit`] treats its starts (screened,
-/// [`FitSettings::max_iter_start`] iterations from each kept one): the best end point over
-/// every group is refined, once. The cost of one multi-start fit, where one fit per group and
-/// the best of their ends costs a refinement and a covariance per group.
+/// [`fit`] from several groups of starts, pooled: every start of every group is evaluated once,
+/// the best [`POOLED_KEPT_STARTS`] by that first cost are iterated
+/// ([`FitSettings::max_iter_start`] iterations each) and the best end point is refined, once.
+/// The cost of one multi-start fit, where one fit per group costs a start phase, a refinement
+/// and a covariance per group.
 pub fn fit_groups(pb: &Problem, x0_init: &[f64], x_scale: &[f64], groups: &[PartStarts], s: &FitSettings) -> FitResult {
     fit_with(pb, x0_init, x_scale, Starts::Groups(groups), s, true)
 }
@@ -463,7 +464,8 @@ fn fit_with(
     } else {
         &vars
     };
-    let best = best_of_groups(start_vars, groups, s, &mut evals);
+    let keep = if groups.len() > 1 { POOLED_KEPT_STARTS } else { SCREENED_STARTS };
+    let best = best_start(start_vars, groups.concat(), keep, s, &mut evals);
     let failed = |evals: usize| FitResult {
         theta: lo.clone(),
         std: vec![f64::NAN; k],
@@ -601,30 +603,6 @@ fn group_starts(pb: &Problem, group: &PartStarts, nomv: &[f64], x0v: &[f64]) -> 
         .collect()
 }
 
-/// [`best_start`] of each group (side by side where the settings say so), and the best of
-/// their end points (the first of equals).
-fn best_of_groups(vars: &Vars, mut groups: Vec<Vec<Vec<f64>>>, s: &FitSettings, evals: &mut usize) -> Option<LmEnd> {
-    if groups.len() == 1 {
-        return best_start(vars, groups.pop().expect("one group"), s, evals);
-    }
-    let run = |g: Vec<Vec<f64>>| {
-        let mut e = 0;
-        (best_start(vars, g, s, &mut e), e)
-    };
-    let done: Vec<(Option<LmEnd>, usize)> =
-        if s.parallel { groups.into_par_iter().map(run).collect() } else { groups.into_iter().map(run).collect() };
-    let mut best: Option<LmEnd> = None;
-    for (res, e) in done {
-        *evals += e;
-        if let Some(res) = res {
-            if best.as_ref().is_none_or(|b| res.2 < b.2) {
-                best = Some(res);
-            }
-        }
-    }
-    best
-}
-
 /// Where [`lm`] ends: `(v, r, cost, converged)`.
 type LmEnd = (Vec<f64>, Vec<f64>, f64, bool);
 
@@ -632,18 +610,19 @@ type LmEnd = (Vec<f64>, Vec<f64>, f64, bool);
 /// simulation failed (in the screening).
 type KeptStart = (Vec<f64>, Option<Option<Vec<f64>>>);
 
-/// Screens the starts (more than [`SCREENED_STARTS`]: the best by their first cost), runs
+/// Screens the starts (more than `keep`: the best `keep` by their first cost), runs
 /// `max_iter_start` iterations from each kept one and returns the best end point (the first
 /// of equals). The kept starts are iterated in parallel where the settings say so (the same
 /// result either way).
 fn best_start(
     vars: &Vars,
     starts: Vec<Vec<f64>>,
+    keep: usize,
     s: &FitSettings,
     evals: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>, f64, bool)> {
     // Each start with its residual where already evaluated (by the screening).
-    let kept: Vec<KeptStart> = if starts.len() > SCREENED_STARTS {
+    let kept: Vec<KeptStart> = if starts.len() > keep {
         let mut scored: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = starts
             .into_iter()
             .map(|v| {
@@ -652,7 +631,7 @@ fn best_start(
             })
             .collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-        scored.into_iter().take(SCREENED_STARTS).map(|(_, v, r)| (v, Some(r))).collect()
+        scored.into_iter().take(keep).map(|(_, v, r)| (v, Some(r))).collect()
     } else {
         starts.into_iter().map(|v| (v, None)).collect()
     };
@@ -774,6 +753,13 @@ pub fn correlation_block(cov: &DMatrix<f64>, from: usize, n: usize) -> Vec<Vec<f
 
 /// Starts iterated after screening (see [`fit`]).
 pub const SCREENED_STARTS: usize = 3;
+
+/// Starts iterated after the pooled screening of [`fit_groups`]: twice [`SCREENED_STARTS`], as
+/// the groups' starts come from different readings (the pair search's scaled and own estimates,
+/// each with the other effect's start grid). On the slowest pair case (fresh seed 9862,
+/// `backlash_inertia + input_delay` #1) 3 kept starts ended 5-164 worse in BIC than one fit per
+/// group on 3 of 10 pairs, 6 ended as well or better on all but one (at a bound before).
+pub const POOLED_KEPT_STARTS: usize = 6;
 
 /// Estimation segments of at least this many samples run the start phase of [`fit`] on a
 /// leading part (at least half of this and a third of the segment), the final iterations on the
