@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates docs/figures: one PNG (plotters) and one PDF (the pgfplots code compiled with
 # pdflatex on a 14 cm x 11 cm page) of each figure kind of `moreau figure`. Needs pdflatex and
-# pgfplots (Debian: texlive-latex-base texlive-pictures). The bam-xl330-* PNGs come from
-# `moreau diagnose` (docs/guide/diagnose.md) and are left alone.
+# pgfplots (Debian: texlive-latex-base texlive-pictures). The bam-xl330-* PNGs are `moreau
+# diagnose` figures of the shipped BAM servo logs (docs/guide/diagnose.md), regenerated too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet -p moreau
@@ -29,4 +29,10 @@ TEX
     (cd "$tmp" && pdflatex -interaction=nonstopmode -halt-on-error "doc-$stem.tex" >/dev/null)
     cp "$tmp/doc-$stem.pdf" "docs/figures/$stem.pdf"
 done
+for log in sin_sin sin_time_square; do
+    $bin diagnose --model examples/real/bam-xl330-kp100.toml --data "data/bam-servo/xl330-kp100-$log.csv" \
+        --out "$tmp/bam-$log" >/dev/null
+    cp "$tmp/bam-$log/fit.png" "docs/figures/bam-xl330-kp100-$log-fit.png"
+done
+cp "$tmp/bam-sin_time_square/zoom-1.png" docs/figures/bam-xl330-kp100-sin_time_square-zoom-1.png
 echo "docs/figures regenerated"
