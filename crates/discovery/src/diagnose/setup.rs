@@ -189,11 +189,11 @@ impl<'a> Setup<'a> {
 
     /// Sub-step convergence of a fitted model (`sys_c` with `effects`, from `x0`) under
     /// `hold`, doubling from `k_from` up to `max_substeps` until the change is within the
-    /// tolerance; where that leaves a remaining stepping error above the noise level (a cap
-    /// reached, or a tolerance set above half the noise), on up to [`BEYOND_MAX_SUBSTEPS`]
-    /// times `max_substeps` (at least [`MIN_SUBSTEPS_CAP`], within [`SUBSTEP_BUDGET`]) with
-    /// the change held to half the noise (a stated error above the noise is not accepted
-    /// while more sub-steps can bring it down).
+    /// tolerance; where it is not, on up to [`BEYOND_MAX_SUBSTEPS`] times `max_substeps` (at
+    /// least [`MIN_SUBSTEPS_CAP`], within [`SUBSTEP_BUDGET`]), with the change held to half
+    /// the noise where the error is above the noise (a stated error above the noise is not
+    /// accepted while more sub-steps can bring it down, and one within it still buys an
+    /// allowance on the selection margin).
     pub(super) fn converge_model(
         &self,
         sys_c: &System,
@@ -209,10 +209,15 @@ impl<'a> Setup<'a> {
             o.finite.then_some(o.y)
         };
         let chk = discretisation::converge(&sim, k_from, self.max_sub, &self.weights, self.tol);
-        if chk.error_rms <= self.noise_w {
+        if chk.converged && chk.error_rms <= self.noise_w {
             return chk;
         }
-        // The error is twice the last change: a change of half the noise level at most.
+        // Not converged within `max_substeps` (or to a tolerance set above half the noise): on,
+        // to the tolerance. Stopping where the error
+        // is within the noise left up to ~100 in BIC of allowance on the selection margin
+        // (fresh seed 9893, a backlash inertia case at 64 sub-steps: its +85 was not accepted;
+        // at 128 it was, 2.1 % off, within its sigma). Above the noise, the change is held to
+        // half the noise level at most (the error is twice the last change).
         let tol = self.tol.min(0.5 * self.noise_w);
         let cap = (BEYOND_MAX_SUBSTEPS * self.max_sub).max(MIN_SUBSTEPS_CAP).min(SUBSTEP_BUDGET / self.n_samp.max(1));
         if cap <= chk.substeps {
