@@ -355,3 +355,21 @@ fn a_held_recording_with_nothing_missing_keeps_its_hold() {
         assert_eq!(r.hold_used, "zoh", "{r:?}");
     }
 }
+
+#[test]
+fn a_generalisation_at_another_minimum_is_refitted_from_its_simpler_form() {
+    // Fresh mixed-profile seed 9893 case 3 (Stribeck friction, 19.7 ms sampling, truth: level
+    // 0.61, static level 1.78, Stribeck velocity 0.78). The law's own starts converged to a
+    // spike (Stribeck velocity 0.007, static level 5.9) that failed the held-out folds against
+    // Coulomb friction (ratio 1.25): Coulomb friction was selected. Refitted from around the
+    // Coulomb level too, the law reads the breakaway and passes.
+    let case = bench_gen::generate_profile("stribeck_friction", 9893, 3, Profile::Mixed);
+    let s = with_known_state(&case);
+    let rep = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    assert_eq!(rep.selected(), "stribeck_friction", "{}", rep.verdict);
+    let stribeck = rep.ranking.iter().find(|r| r.label == "stribeck_friction(x2)").expect("fitted");
+    // parameters: level, static excess, Stribeck velocity (not the spike)
+    assert!(stribeck.params[2] > 0.1 && stribeck.params[2] < 3.0, "{:?}", stribeck.params);
+    let coulomb = rep.ranking.iter().find(|r| r.label == "coulomb_friction(x2)").expect("fitted");
+    assert!(stribeck.sse_estimation < coulomb.sse_estimation, "{stribeck:?} {coulomb:?}");
+}
