@@ -4,14 +4,6 @@
 //! per group.
 mod common;
 use discovery::fit::{self, FitSettings, FitStatus, PartStarts};
-use discovery::hypothesis::{self, Kind};
-use dynamics::extended::ExtendedModel;
-use model::effects::Effect;
-
-fn mass() -> model::System {
-    let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -1.2]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
-    model::parse_str(text).unwrap()
-}
 
 fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
@@ -19,20 +11,10 @@ fn bits(v: &[f64]) -> Vec<u64> {
 
 #[test]
 fn groups_of_starts_end_at_the_best_group_refined_once() {
-    let sys = mass();
-    let (dt, level, n) = (0.02, 0.25, 2000);
-    let w: Vec<f64> = (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.5 * (2.3 * k as f64 * dt + 1.0).sin()).collect();
-    let truth = [Effect::CoulombFriction { state: 1, level }];
-    let y0 = ExtendedModel::new(&sys, &truth, dt, 2).unwrap().simulate(&w, dt, &[0.1, 0.0]).y;
-    let yr = y0.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y0.iter().copied().fold(f64::INFINITY, f64::min);
-    let y: Vec<f64> =
-        y0.iter().enumerate().map(|(k, v)| v + 0.01 * yr * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)).collect();
-    let scales = common::test_scales(yr, n, dt);
-    let h = hypothesis::candidates(&sys, &scales)
-        .into_iter()
-        .find(|h| h.kind == Kind::CoulombFriction { state: 1 })
-        .expect("Coulomb friction on the velocity state is a candidate");
-    let pb = common::scalar_problem(&sys, &h, &scales, &w, &y, 7 * n / 10, 1.0 / yr, 2);
+    let level = 0.25;
+    let data = common::CoulombMass::new(level, 2000);
+    let h = &data.hypothesis;
+    let pb = data.problem();
     let (x0, xs) = ([0.0, 0.0], [0.2, 0.2]);
     let s = FitSettings::default();
     let same = |a: &fit::FitResult, b: &fit::FitResult| {

@@ -157,38 +157,66 @@ fn the_header_states_the_hold_used_after_a_switch() {
     assert!(!kept.header().contains("switched") && kept.header().contains("than with foh"), "{}", kept.header());
 }
 
+/// The stepping tests' wide play in the loop (the catching-up projection is first order in the
+/// step), driven by two sines over 600 samples of 50 ms.
+struct WidePlay {
+    sys: model::System,
+    w: Vec<f64>,
+    dt: f64,
+}
+
+impl WidePlay {
+    fn new() -> Self {
+        let text = "name = \"play\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [4.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [-4.0]]\n[theta]\nshape = \"interval\"\nhalf_width = 0.3\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+        let dt = 0.05;
+        let w = (0..600).map(|k| (0.9 * k as f64 * dt).sin() + 0.4 * (2.7 * k as f64 * dt).sin()).collect();
+        Self { sys: model::parse_str(text).unwrap(), w, dt }
+    }
+
+    /// Its output at `k` sub-steps per sample.
+    fn y(&self, k: usize) -> Vec<f64> {
+        ExtendedModel::new(&self.sys, &[], self.dt, k).unwrap().simulate(&self.w, self.dt, &[0.0, 0.0]).y
+    }
+
+    /// Standard deviation of `y` over the record.
+    fn sd(y: &[f64]) -> f64 {
+        let m = y.iter().sum::<f64>() / y.len() as f64;
+        (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / y.len() as f64).sqrt()
+    }
+
+    /// The output at 256 sub-steps with uniform noise of standard deviation `noise` output
+    /// standard deviations, diagnosed at a cap of one sub-step per sample (first-order hold,
+    /// known state): the report and the noise level in output standard deviations (the fit's
+    /// units).
+    fn diagnose_at_one_substep(&self, noise: f64) -> (discovery::Report, f64) {
+        let clean = self.y(256);
+        let sd = Self::sd(&clean);
+        let y: Vec<Vec<f64>> = clean
+            .iter()
+            .enumerate()
+            .map(|(k, v)| vec![v + noise * sd * 3f64.sqrt() * 2.0 * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)])
+            .collect();
+        let t: Vec<f64> = (0..y.len()).map(|k| k as f64 * self.dt).collect();
+        let u = self.w.iter().map(|v| vec![*v]).collect();
+        let rec = discovery::Recording::from_samples("play", &t, u, y, None);
+        let s = DiagnoseSettings {
+            initial_state: Some(InitialState { x0: vec![0.0, 0.0], z0: Some(vec![0.0]) }),
+            input_hold: HoldChoice::Fixed(InputHold::Foh),
+            max_substeps: 1,
+            ..Default::default()
+        };
+        let r = diagnose(&self.sys, &rec, &s).unwrap();
+        let y_sd = Self::sd(&rec.y.iter().map(|v| v[0]).collect::<Vec<f64>>());
+        let noise_w = r.noise_level[0] / y_sd;
+        (r, noise_w)
+    }
+}
+
 #[test]
 fn a_stepping_error_above_the_noise_is_not_accepted() {
-    // A wide play in the loop (the catching-up projection is first order in the step),
-    // recorded with noise at 0.1 % of the output's spread, and a cap of one sub-step per
-    // sample. Before: the cap stood, with a stated stepping error several times the noise.
-    let text = "name = \"play\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [4.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [-4.0]]\n[theta]\nshape = \"interval\"\nhalf_width = 0.3\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
-    let sys = model::parse_str(text).unwrap();
-    let (dt, n) = (0.05, 600);
-    let w: Vec<f64> = (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.4 * (2.7 * k as f64 * dt).sin()).collect();
-    let clean = ExtendedModel::new(&sys, &[], dt, 256).unwrap().simulate(&w, dt, &[0.0, 0.0]).y;
-    let m = clean.iter().sum::<f64>() / n as f64;
-    let sd = (clean.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n as f64).sqrt();
-    let y: Vec<Vec<f64>> = clean
-        .iter()
-        .enumerate()
-        .map(|(k, v)| vec![v + 1e-3 * sd * 3f64.sqrt() * 2.0 * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)])
-        .collect();
-    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-    let rec = discovery::Recording::from_samples("play", &t, w.iter().map(|v| vec![*v]).collect(), y, None);
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState { x0: vec![0.0, 0.0], z0: Some(vec![0.0]) }),
-        input_hold: HoldChoice::Fixed(InputHold::Foh),
-        max_substeps: 1,
-        ..Default::default()
-    };
-    let r = diagnose(&sys, &rec, &s).unwrap();
-    // The weighted noise level (the fit's units: output standard deviations).
-    let y_sd = {
-        let m = rec.y.iter().map(|v| v[0]).sum::<f64>() / n as f64;
-        (rec.y.iter().map(|v| (v[0] - m).powi(2)).sum::<f64>() / n as f64).sqrt()
-    };
-    let noise_w = r.noise_level[0] / y_sd;
+    // Noise at 0.1 % of the output's spread and a cap of one sub-step per sample. Before: the
+    // cap stood, with a stated stepping error several times the noise.
+    let (r, noise_w) = WidePlay::new().diagnose_at_one_substep(1e-3);
     let d = &r.discretisation;
     assert!(d.ladder[0].1 > noise_w, "negative control: one sub-step is already within the noise: {d:?}");
     assert!(
@@ -200,39 +228,15 @@ fn a_stepping_error_above_the_noise_is_not_accepted() {
 
 #[test]
 fn a_stepping_error_within_the_noise_is_still_converged_to_the_tolerance() {
-    // The play of the test above with noise four times the one-sub-step change: its stepping
-    // error (twice the change) is within the noise but the change is above the tolerance (a
-    // tenth of the noise). Before: the cap of one sub-step stood (not converged), and the error
-    // bought up to ~100 in BIC of allowance on the selection margin.
-    let text = "name = \"play\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -0.4]]\nB = [[0.0], [4.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [-4.0]]\n[theta]\nshape = \"interval\"\nhalf_width = 0.3\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
-    let sys = model::parse_str(text).unwrap();
-    let (dt, n) = (0.05, 600);
-    let w: Vec<f64> = (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.4 * (2.7 * k as f64 * dt).sin()).collect();
-    let sim = |k: usize| ExtendedModel::new(&sys, &[], dt, k).unwrap().simulate(&w, dt, &[0.0, 0.0]).y;
-    let clean = sim(256);
-    let m = clean.iter().sum::<f64>() / n as f64;
-    let sd = (clean.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n as f64).sqrt();
-    let change = (sim(1).iter().zip(sim(2)).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / n as f64).sqrt() / sd;
-    // uniform noise of standard deviation 4 x change (output standard deviations)
-    let y: Vec<Vec<f64>> = clean
-        .iter()
-        .enumerate()
-        .map(|(k, v)| vec![v + 4.0 * change * sd * 3f64.sqrt() * 2.0 * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5)])
-        .collect();
-    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-    let rec = discovery::Recording::from_samples("play", &t, w.iter().map(|v| vec![*v]).collect(), y, None);
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState { x0: vec![0.0, 0.0], z0: Some(vec![0.0]) }),
-        input_hold: HoldChoice::Fixed(InputHold::Foh),
-        max_substeps: 1,
-        ..Default::default()
-    };
-    let r = diagnose(&sys, &rec, &s).unwrap();
-    let y_sd = {
-        let m = rec.y.iter().map(|v| v[0]).sum::<f64>() / n as f64;
-        (rec.y.iter().map(|v| (v[0] - m).powi(2)).sum::<f64>() / n as f64).sqrt()
-    };
-    let noise_w = r.noise_level[0] / y_sd;
+    // Noise four times the one-sub-step change: the stepping error (twice the change) is
+    // within the noise but the change is above the tolerance (a tenth of the noise). Before:
+    // the cap of one sub-step stood (not converged), and the error bought up to ~100 in BIC of
+    // allowance on the selection margin.
+    let play = WidePlay::new();
+    let (y1, y2) = (play.y(1), play.y(2));
+    let rms = (y1.iter().zip(&y2).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / y1.len() as f64).sqrt();
+    let change = rms / WidePlay::sd(&play.y(256));
+    let (r, noise_w) = play.diagnose_at_one_substep(4.0 * change);
     let d = &r.discretisation;
     // Negative control: at one sub-step the error is within the noise and the change above
     // the tolerance (the case the old rule let stand).

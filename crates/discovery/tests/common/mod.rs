@@ -53,3 +53,46 @@ pub fn test_scales(y_range: f64, n: usize, dt: f64) -> Scales {
         ..Default::default()
     }
 }
+
+/// A damped mass on a spring driven by two sines, recorded with Coulomb friction of `level` on
+/// its velocity (2 sub-steps, from `x0 = [0.1, 0]`) and deterministic pseudo-noise of 1 % of
+/// the output's range, `n` samples of `dt = 0.02`: the nominal model (no friction), the input,
+/// the recorded output, its range, and the Coulomb friction hypothesis with its scales.
+#[allow(dead_code)]
+pub struct CoulombMass {
+    pub sys: model::System,
+    pub w: Vec<f64>,
+    pub y: Vec<f64>,
+    pub y_range: f64,
+    pub scales: Scales,
+    pub hypothesis: Hypothesis,
+}
+
+#[allow(dead_code)]
+impl CoulombMass {
+    pub fn new(level: f64, n: usize) -> Self {
+        use dynamics::extended::ExtendedModel;
+        let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -1.2]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+        let sys = model::parse_str(text).unwrap();
+        let dt = 0.02;
+        let w: Vec<f64> =
+            (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.5 * (2.3 * k as f64 * dt + 1.0).sin()).collect();
+        let truth = [model::effects::Effect::CoulombFriction { state: 1, level }];
+        let y0 = ExtendedModel::new(&sys, &truth, dt, 2).unwrap().simulate(&w, dt, &[0.1, 0.0]).y;
+        let hi = y0.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let y_range = hi - y0.iter().copied().fold(f64::INFINITY, f64::min);
+        let y = y0.iter().enumerate().map(|(k, v)| v + 0.01 * y_range * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5));
+        let scales = test_scales(y_range, n, dt);
+        let hypothesis = discovery::hypothesis::candidates(&sys, &scales)
+            .into_iter()
+            .find(|h| h.kind == discovery::hypothesis::Kind::CoulombFriction { state: 1 })
+            .expect("Coulomb friction on the velocity state is a candidate");
+        Self { sys, w, y: y.collect(), y_range, scales, hypothesis }
+    }
+
+    /// Its least-squares problem: estimation segment the first 70 %, 2 sub-steps.
+    pub fn problem(&self) -> Problem<'_> {
+        let k_est = 7 * self.w.len() / 10;
+        scalar_problem(&self.sys, &self.hypothesis, &self.scales, &self.w, &self.y, k_est, 1.0 / self.y_range, 2)
+    }
+}
