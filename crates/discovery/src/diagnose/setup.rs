@@ -213,11 +213,11 @@ impl<'a> Setup<'a> {
             return chk;
         }
         // Not converged within `max_substeps` (or to a tolerance set above half the noise): on,
-        // to the tolerance. Stopping where the error
-        // is within the noise left up to ~100 in BIC of allowance on the selection margin
-        // (fresh seed 9893, a backlash inertia case at 64 sub-steps: its +85 was not accepted;
-        // at 128 it was, 2.1 % off, within its sigma). Above the noise, the change is held to
-        // half the noise level at most (the error is twice the last change).
+        // to the tolerance. Stopping where the error is within the noise left up to ~100 in BIC
+        // of allowance on the selection margin (fresh seed 9893, a backlash inertia case at 64
+        // sub-steps: its +85 was not accepted; at 128 it was, 2.1 % off, within its sigma).
+        // Above the noise, the change is held to half the noise level at most (the error is
+        // twice the last change).
         let tol = self.tol.min(0.5 * self.noise_w);
         let cap = (BEYOND_MAX_SUBSTEPS * self.max_sub).max(MIN_SUBSTEPS_CAP).min(SUBSTEP_BUDGET / self.n_samp.max(1));
         if cap <= chk.substeps {

@@ -545,32 +545,19 @@ fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64
     } else {
         pb.parts.iter().map(|h| h.starts.len()).max().unwrap_or(1).max(1)
     };
-    let mut starts: Vec<Vec<f64>> = Vec::new();
-    if let Some(w) = warm {
-        // Warm start: the given leading parameters, then the new part's starts.
-        let nw = w.len();
-        for i in 0..nstart {
-            let mut v: Vec<f64> = pb.units_of(w);
-            let mut off = 0;
-            for h in &pb.parts {
-                if off >= nw {
-                    v.extend(h.starts[i % h.starts.len()].iter());
-                }
-                off += h.k();
-            }
-            v.extend(nomv.iter());
-            v.extend(x0v.iter());
-            starts.push(v);
-        }
-    } else {
-        for i in 0..nstart {
-            let mut v: Vec<f64> = pb.parts.iter().flat_map(|h| h.starts[i % h.starts.len()].clone()).collect();
-            v.extend(nomv.iter());
-            v.extend(x0v.iter());
-            starts.push(v);
-        }
-    }
-    starts
+    // The parts the warm start's leading parameters cover.
+    let w = warm.unwrap_or(&[]);
+    let mut off = 0;
+    let given: Vec<Option<&[f64]>> = pb
+        .parts
+        .iter()
+        .map(|h| {
+            let part = (off < w.len()).then(|| &w[off..(off + h.k()).min(w.len())]);
+            off += h.k();
+            part
+        })
+        .collect();
+    expand_starts(pb, &given, nstart, nomv, x0v)
 }
 
 /// The starts of one group of [`fit_groups`] in solver units: the given parts' parameters,
@@ -578,20 +565,21 @@ fn starts(pb: &Problem, k: usize, warm: Option<&[f64]>, nomv: &[f64], x0v: &[f64
 /// where every part is given), then `nomv` and `x0v`. Given parameters of the wrong length
 /// count as not given.
 fn group_starts(pb: &Problem, group: &PartStarts, nomv: &[f64], x0v: &[f64]) -> Vec<Vec<f64>> {
-    let given = |j: usize| group.get(j).and_then(|g| g.as_ref()).filter(|w| w.len() == pb.parts[j].k());
-    let nstart = pb
-        .parts
-        .iter()
-        .enumerate()
-        .filter(|&(j, _)| given(j).is_none())
-        .map(|(_, h)| h.starts.len())
-        .max()
-        .unwrap_or(1);
-    (0..nstart.max(1))
+    let given: Vec<Option<&[f64]>> = (0..pb.parts.len())
+        .map(|j| group.get(j).and_then(|g| g.as_deref()).filter(|w| w.len() == pb.parts[j].k()))
+        .collect();
+    let grids = pb.parts.iter().zip(&given).filter(|(_, g)| g.is_none()).map(|(h, _)| h.starts.len());
+    expand_starts(pb, &given, grids.max().unwrap_or(1).max(1), nomv, x0v)
+}
+
+/// `nstart` starts in solver units: for start `i`, each part's `given` parameters (physical
+/// units, mapped to unit coordinates) or else start `i` of its grid, then `nomv` and `x0v`.
+fn expand_starts(pb: &Problem, given: &[Option<&[f64]>], nstart: usize, nomv: &[f64], x0v: &[f64]) -> Vec<Vec<f64>> {
+    (0..nstart)
         .map(|i| {
             let mut v: Vec<f64> = Vec::new();
-            for (j, h) in pb.parts.iter().enumerate() {
-                match given(j) {
+            for (h, g) in pb.parts.iter().zip(given) {
+                match g {
                     Some(w) => v.extend(w.iter().enumerate().map(|(c, x)| h.unit_of(c, *x))),
                     None => v.extend(h.starts[i % h.starts.len()].iter()),
                 }

@@ -112,7 +112,7 @@ pub(crate) fn fit_hypothesis(
 }
 
 /// [`fit_hypothesis`] (no refit of the nominal parameters) from several groups of starts, one
-/// multi-start fit ([`fit::fit_groups`]): the best end of every group's start phase refined.
+/// multi-start fit ([`fit::fit_groups`]: every start screened together, the best refined once).
 pub(crate) fn fit_hypothesis_from(
     ctx: &FitContext,
     plan: &Plan,
