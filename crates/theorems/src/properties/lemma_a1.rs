@@ -6,7 +6,8 @@
 //! `r` comes from `ConvexSet::dist_to_boundary` (closed forms / bisection).
 //! Negative control: `-4 r` instead of `-2 r`; on a ball with boundary points at half-angle
 //! `phi` the claim reads `sin^2 phi >= 1 - cos phi` and the control `1 + cos phi >= 2`, false.
-//! Tolerance: [`fp_tol`] of `(|u| + |v|) (|x| + |y| + |x - y| + r)`.
+//! Tolerance: [`fp_tol`] of `(|u| + |v|) (|x| + |y| + |x - y| + r)`, plus `2 (|u| + |v|)` times
+//! the allowance on `r` ([`r_tol`]).
 use super::sets_prelude::*;
 
 pub fn info() -> PropertyInfo {
@@ -37,7 +38,21 @@ pub fn eval_pair(pr: &Pair, variant: Variant) -> Eval {
     };
     let rhs = -k * r * nu;
     let scale = nu * (norm(&pr.x) + norm(&pr.y) + norm(&dxy) + r);
-    Eval::new(lhs, rhs, fp_tol(scale, p))
+    Eval::new(lhs, rhs, fp_tol(scale, p) + 2.0 * nu * r_tol(&c, r, p))
+}
+
+/// Allowance on `r` (`dist_to_boundary` of the midpoint `c`): `4096 (p + 1) eps (|c| + r)`,
+/// about `1e-12 (p + 1)` relative. On an ellipsoid `r` comes from a bisection in the secular
+/// equation's parameter, and its error is not bounded in closed form here. The claim is an
+/// equality where one point is on the boundary and the other on the segment to its nearest
+/// boundary point (every one-dimensional case), so that error decides. Two CI failures on
+/// 2026-11-28 had `lhs - rhs` = 3.8e-12 (shrunk case `ea7a654e`, a one-dimensional
+/// ellipsoid, replayed from `proptest-regressions/geometric.txt`) and 1.6e-10 at `|lhs|` = 542,
+/// against [`fp_tol`]'s 2.1e-12 and 1.5e-10. With this allowance, 400,000 random cases
+/// passed (8 runs of `PROPTEST_CASES=50000`), and the negative control (`4 r`) is still
+/// caught.
+fn r_tol(c: &[f64], r: f64, p: usize) -> f64 {
+    4096.0 * (p as f64 + 1.0) * f64::EPSILON * (norm(c) + r)
 }
 
 pub fn eval(case: &PairCase, variant: Variant) -> Eval {
