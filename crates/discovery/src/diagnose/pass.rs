@@ -59,25 +59,19 @@ pub(super) struct FinerFit {
 pub(super) const FINER_STEPPING: usize = 4;
 
 /// The finer stepping's warm refit must move an effect parameter by more than this many of
-/// its sigmas at the pass's stepping for [`needs_cold_refit`].
+/// its sigmas at the pass's stepping for [`moved_beyond_sigma`].
 pub(super) const COLD_REFIT_SIGMAS: f64 = 1.0;
 
-/// Whether the selected model `c` is refitted at the finer stepping from its hypotheses' own
-/// starts as well as warm (`warm`, its refit from `c`'s estimate): where the warm refit moved
-/// an effect parameter by more than [`COLD_REFIT_SIGMAS`] of its sigma, or its sigma is not
-/// finite. Where the finer stepping moves the estimate by less, the cost surface there is the
+/// Whether the selected model is refitted at the finer stepping from its hypotheses' own
+/// starts as well as warm: where the warm refit (`fine`) moved an effect parameter from the
+/// pass's estimate (`coarse`) by more than [`COLD_REFIT_SIGMAS`] of its sigma (`std`), or a
+/// sigma is not finite. Where the finer stepping moves the estimate by less, the cost surface there is the
 /// one whose minimum the pass found from those starts, and the refit from them ends where the
 /// warm one does. Development seeds 10211-10212 (88 selected models checked): the warm refit
 /// moved less than 1 sigma in 84, and there the refit from the starts ended at most 0.33 sigma
 /// from it; of the 4 that moved more, one (cogging, 1.3 sigma) ended 76 sigma away, at a
 /// higher cost. On a long record the refit from the starts was half the check's cost (1.3 of
 /// 2.2 CPU s on the 50,000-sample record).
-fn needs_cold_refit(c: &Ranked, warm: &fit::FitResult) -> bool {
-    moved_beyond_sigma(&c.params, &c.std, &warm.theta)
-}
-
-/// Whether `fine` lies more than [`COLD_REFIT_SIGMAS`] sigmas (`std`) from `coarse` in any
-/// parameter, or a sigma is not finite.
 fn moved_beyond_sigma(coarse: &[f64], std: &[f64], fine: &[f64]) -> bool {
     fine.iter().zip(coarse).zip(std).any(|((a, b), sd)| !((a - b).abs() <= COLD_REFIT_SIGMAS * sd))
 }
@@ -290,10 +284,10 @@ impl<'a> Pass<'a> {
             // costs less. The warm start alone can stay in the coarse stepping's local minimum
             // (backlash inertia 7 % low at 2 sub-steps: the warm refit at 8 moved 2 %, the one
             // from the starts found the optimum 9 % away at a far lower cost), but only where
-            // the finer stepping moves the estimate (`needs_cold_refit`). The gain check above
+            // the finer stepping moves the estimate (`moved_beyond_sigma`). The gain check above
             // keeps the warm refit.
-            let cold =
-                needs_cold_refit(c, &c_f).then(|| fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, None, &s.fit));
+            let cold = moved_beyond_sigma(&c.params, &c.std, &c_f.theta)
+                .then(|| fit::fit(&c.problem(&ctx_f), &c.x0, &ctx_f.x_scale, None, &s.fit));
             let best = std::iter::once(c_f)
                 .chain(cold)
                 .filter(|f| f.status != fit::FitStatus::Failed && f.sse.is_finite())

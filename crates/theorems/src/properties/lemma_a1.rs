@@ -45,8 +45,8 @@ pub fn eval_pair(pr: &Pair, variant: Variant) -> Eval {
 /// about `1e-12 (p + 1)` relative. On an ellipsoid `r` comes from a bisection in the secular
 /// equation's parameter, and its error is not bounded in closed form here. The claim is an
 /// equality where one point is on the boundary and the other on the segment to its nearest
-/// boundary point (every one-dimensional case), so that error decides. Two CI failures on
-/// 2026-11-28 had `lhs - rhs` = 3.8e-12 (shrunk case `ea7a654e`, a one-dimensional
+/// boundary point (every one-dimensional case), so that error decides. A CI run and a rerun on
+/// 2026-11-28 failed with `lhs - rhs` = 3.8e-12 (shrunk case `ea7a654e`, a one-dimensional
 /// ellipsoid, replayed from `proptest-regressions/geometric.txt`) and 1.6e-10 at `|lhs|` = 542,
 /// against [`fp_tol`]'s 2.1e-12 and 1.5e-10. With this allowance, 400,000 random cases
 /// passed (8 runs of `PROPTEST_CASES=50000`), and the negative control (`4 r`) is still
