@@ -31,6 +31,11 @@ pub struct FitSettings {
     /// Estimation segments of at least this many samples run the multi-start phase on a
     /// leading part (see [`LONG_RECORD`]); `usize::MAX` never. Default [`LONG_RECORD`].
     pub long_record: usize,
+    /// The multi-start phase (screening and the start iterations) steps the simulation this
+    /// many times more coarsely where that leaves at least [`MIN_START_SUBSTEPS`] sub-steps per
+    /// sample; the refinement of the best start runs at the problem's own stepping (see
+    /// [`START_COARSENING`]). 1: never. Default [`START_COARSENING`].
+    pub start_coarsening: usize,
     /// Evaluate the columns of the finite-difference Jacobian and the starts in parallel
     /// (rayon; the result is the same either way). Default true.
     pub parallel: bool,
@@ -38,7 +43,15 @@ pub struct FitSettings {
 
 impl Default for FitSettings {
     fn default() -> Self {
-        Self { max_iter_start: 6, max_iter: 40, tol_fd: 1e-3, tol_cost: 1e-7, long_record: LONG_RECORD, parallel: true }
+        Self {
+            max_iter_start: 6,
+            max_iter: 40,
+            tol_fd: 1e-3,
+            tol_cost: 1e-7,
+            long_record: LONG_RECORD,
+            start_coarsening: START_COARSENING,
+            parallel: true,
+        }
     }
 }
 
@@ -453,19 +466,17 @@ fn fit_with(
         Starts::Warm(warm) => vec![starts(pb, k, warm, &nomv, &x0v)],
         Starts::Groups(g) => g.iter().map(|g| group_starts(pb, g, &nomv, &x0v)).collect(),
     };
-    // Long records: screening and the start iterations see a leading part of the estimation
-    // segment (at least LONG_RECORD / 2 samples and a third of it); the final iterations below
-    // see all of it, from the best start. Several starts only: a single (warm) start goes
-    // straight to the whole segment.
-    let short;
-    let start_vars = if groups.iter().map(Vec::len).sum::<usize>() > 1 && pb.k_est >= s.long_record {
-        short = Vars { k_end: (s.long_record / 2).max(pb.k_est / 3), ..vars.clone() };
-        &short
-    } else {
-        &vars
-    };
+    // Several starts only (a single warm start goes straight to the refinement): screening and
+    // the start iterations see a leading part of a long estimation segment (at least
+    // LONG_RECORD / 2 samples and a third of it) and a finely stepped problem at a coarser
+    // stepping; the refinement below sees the whole segment at the problem's stepping, from
+    // the best start.
+    let several = groups.iter().map(Vec::len).sum::<usize>() > 1;
+    let coarse = several.then(|| start_phase_problem(pb, s)).flatten();
+    let k_end = if several && pb.k_est >= s.long_record { (s.long_record / 2).max(pb.k_est / 3) } else { pb.k_est };
+    let start_vars = Vars { pb: coarse.as_ref().unwrap_or(pb), k_end, ..vars.clone() };
     let keep = if groups.len() > 1 { POOLED_KEPT_STARTS } else { SCREENED_STARTS };
-    let best = best_start(start_vars, groups.concat(), keep, s, &mut evals);
+    let best = best_start(&start_vars, groups.concat(), keep, s, &mut evals);
     let failed = |evals: usize| FitResult {
         theta: lo.clone(),
         std: vec![f64::NAN; k],
@@ -480,13 +491,13 @@ fn fit_with(
         evaluations: evals,
     };
     let Some(b) = best else { return failed(evals) };
-    let refined = match start_vars.k_end == vars.k_end {
+    let refined = match start_vars.k_end == vars.k_end && coarse.is_none() {
         // the best start's residual is that of the whole segment already
         true => Some(lm_from(&vars, b.0, b.1, s.max_iter, s, &mut evals)),
         false => match lm(&vars, b.0.clone(), s.max_iter, s, &mut evals) {
             Some(done) => Some(done),
-            // the best start's residual is of the leading part after a short start phase: the
-            // fallback is evaluated on the whole segment
+            // the best start's residual is of the leading part or the coarser stepping of the
+            // start phase: the fallback is evaluated on the whole segment at the problem's
             None => vars.res(&b.0, &mut evals).map(|r| {
                 let c = sse(&r);
                 (b.0, r, c, false)
@@ -512,6 +523,14 @@ fn fit_with(
         status: if conv { FitStatus::Converged } else { FitStatus::MaxIterations },
         evaluations: evals,
     }
+}
+
+/// The problem of the start phase where it is stepped more coarsely than `pb`:
+/// [`FitSettings::start_coarsening`] times fewer sub-steps, where that leaves at least
+/// [`MIN_START_SUBSTEPS`].
+fn start_phase_problem<'a>(pb: &Problem<'a>, s: &FitSettings) -> Option<Problem<'a>> {
+    let k = pb.substeps / s.start_coarsening.max(1);
+    (k >= MIN_START_SUBSTEPS && k < pb.substeps).then(|| pb.with_substeps(k)).flatten()
 }
 
 /// Nothing to fit: the nominal model from a known initial state.
@@ -753,6 +772,19 @@ pub const POOLED_KEPT_STARTS: usize = 6;
 /// leading part (at least half of this and a third of the segment), the final iterations on the
 /// whole: the cost of the multi-start phase stops growing with the record.
 pub const LONG_RECORD: usize = 24_000;
+
+/// How many times more coarsely the start phase of a multi-start fit steps the simulation
+/// ([`FitSettings::start_coarsening`]). The start phase only ranks the starts' basins and
+/// iterates [`FitSettings::max_iter_start`] times from the best few; the refinement and the
+/// covariance run at the stepping the recording needs. A lightly damped plant or a stiff play
+/// needs 32-64 sub-steps per sample, where most of a pair search's cost was its start phase.
+pub const START_COARSENING: usize = 4;
+
+/// The fewest sub-steps per sample the start phase is coarsened to (a problem stepped at fewer
+/// than `START_COARSENING * MIN_START_SUBSTEPS` keeps its own stepping there): below 4 the
+/// stepping moves a backlash inertia's optimum by several per cent (BENCHMARKS, "The stepping
+/// check refits from the starts only where the estimate moved").
+pub const MIN_START_SUBSTEPS: usize = 4;
 
 #[cfg(test)]
 mod tests {

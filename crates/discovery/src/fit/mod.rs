@@ -16,6 +16,7 @@ pub mod problem;
 
 pub use levenberg_marquardt::{
     fit, fit_estimate, fit_groups, EffectCovariance, FitResult, FitSettings, FitStatus, PartStarts, LONG_RECORD,
+    MIN_START_SUBSTEPS, START_COARSENING,
 };
 pub use nominal::{FreeNominal, Refit};
 pub use problem::Problem;

@@ -150,13 +150,7 @@ impl<'a> Problem<'a> {
         let sys = refitted.as_ref().unwrap_or(self.sys);
         let maps = match &refitted {
             None => self.maps.clone(),
-            Some(s) => {
-                let maps = StepMaps::new(&s.F(), &s.B, &s.E, self.dt / self.substeps.max(1) as f64);
-                if !maps.Phi.iter().chain(&maps.PsiB).chain(&maps.PsiE).all(|x| x.is_finite()) {
-                    return None;
-                }
-                maps
-            }
+            Some(s) => step_maps(s, self.dt, self.substeps)?,
         };
         let len = len.unwrap_or(self.w.len() / self.m);
         let ops = self.input_ops(theta);
@@ -197,6 +191,33 @@ impl<'a> Problem<'a> {
         self.residual_to(theta, nom, x0, self.k_est)
     }
 
+    /// The same problem stepped at `substeps` sub-steps per sample (its step maps recomputed):
+    /// the solver's start phase at a coarser stepping ([`crate::fit::FitSettings::start_coarsening`]).
+    /// `None` where the step maps are not finite.
+    pub fn with_substeps(&self, substeps: usize) -> Option<Problem<'a>> {
+        let sub = substeps.max(1);
+        let maps = step_maps(self.sys, self.dt, sub)?;
+        Some(Problem {
+            sys: self.sys,
+            fixed: self.fixed.clone(),
+            parts: self.parts.clone(),
+            scales: self.scales,
+            w: self.w,
+            y: self.y,
+            m: self.m,
+            p: self.p,
+            dt: self.dt,
+            k_est: self.k_est,
+            weights: self.weights.clone(),
+            maps,
+            substeps: sub,
+            hold: self.hold,
+            z0: self.z0.clone(),
+            exclude: self.exclude,
+            refit: self.refit.clone(),
+        })
+    }
+
     /// The residual on the first `k_end <= k_est` samples only (the solver's start phase on
     /// long records, see [`crate::fit::levenberg_marquardt`]).
     pub fn residual_to(&self, theta: &[f64], nom: &[f64], x0: &[f64], k_end: usize) -> Option<Vec<f64>> {
@@ -211,4 +232,10 @@ impl<'a> Problem<'a> {
                 .collect(),
         )
     }
+}
+
+/// The step maps of `sys` at `substeps` sub-steps per sample of `dt`; `None` where not finite.
+fn step_maps(sys: &System, dt: f64, substeps: usize) -> Option<StepMaps> {
+    let maps = StepMaps::new(&sys.F(), &sys.B, &sys.E, dt / substeps.max(1) as f64);
+    maps.Phi.iter().chain(&maps.PsiB).chain(&maps.PsiE).all(|x| x.is_finite()).then_some(maps)
 }

@@ -55,9 +55,9 @@ pub fn test_scales(y_range: f64, n: usize, dt: f64) -> Scales {
 }
 
 /// A damped mass on a spring driven by two sines, recorded with Coulomb friction of `level` on
-/// its velocity (2 sub-steps, from `x0 = [0.1, 0]`) and deterministic pseudo-noise of 1 % of
-/// the output's range, `n` samples of `dt = 0.02`: the nominal model (no friction), the input,
-/// the recorded output, its range, and the Coulomb friction hypothesis with its scales.
+/// its velocity (from `x0 = [0.1, 0]`) and deterministic pseudo-noise of 1 % of the output's
+/// range: the nominal model (no friction), the input, the recorded output, its range, and the
+/// Coulomb friction hypothesis with its scales.
 #[allow(dead_code)]
 pub struct CoulombMass {
     pub sys: model::System,
@@ -70,15 +70,21 @@ pub struct CoulombMass {
 
 #[allow(dead_code)]
 impl CoulombMass {
+    /// `n` samples of `dt = 0.02`, damping 1.2, the truth stepped at 2 sub-steps.
     pub fn new(level: f64, n: usize) -> Self {
+        Self::stepped(level, n, 1.2, 0.02, 2)
+    }
+
+    /// `n` samples of `dt`, damping `damping` (`x'' = -4 x - damping x' + w`), the truth stepped
+    /// at `truth_substeps` sub-steps per sample.
+    pub fn stepped(level: f64, n: usize, damping: f64, dt: f64, truth_substeps: usize) -> Self {
         use dynamics::extended::ExtendedModel;
-        let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -1.2]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
-        let sys = model::parse_str(text).unwrap();
-        let dt = 0.02;
+        let text = "name = \"mass\"\n[plant]\nA = [[0.0, 1.0], [-4.0, -DAMPING]]\nB = [[0.0], [1.0]]\nC = [[1.0, 0.0]]\nE = [[0.0], [0.0]]\n[input]\nkind = \"sine\"\namplitudes = [1.0]\nomega = 1.0\n[initial]\nx0 = [0.0, 0.0]\nz0 = [0.0]\n";
+        let sys = model::parse_str(&text.replace("DAMPING", &format!("{damping:?}"))).unwrap();
         let w: Vec<f64> =
             (0..n).map(|k| (0.9 * k as f64 * dt).sin() + 0.5 * (2.3 * k as f64 * dt + 1.0).sin()).collect();
         let truth = [model::effects::Effect::CoulombFriction { state: 1, level }];
-        let y0 = ExtendedModel::new(&sys, &truth, dt, 2).unwrap().simulate(&w, dt, &[0.1, 0.0]).y;
+        let y0 = ExtendedModel::new(&sys, &truth, dt, truth_substeps).unwrap().simulate(&w, dt, &[0.1, 0.0]).y;
         let hi = y0.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let y_range = hi - y0.iter().copied().fold(f64::INFINITY, f64::min);
         let y = y0.iter().enumerate().map(|(k, v)| v + 0.01 * y_range * (((k * 7919) % 1000) as f64 / 1000.0 - 0.5));
@@ -92,7 +98,12 @@ impl CoulombMass {
 
     /// Its least-squares problem: estimation segment the first 70 %, 2 sub-steps.
     pub fn problem(&self) -> Problem<'_> {
+        self.problem_at(2)
+    }
+
+    /// Its least-squares problem at `substeps` sub-steps per sample.
+    pub fn problem_at(&self, substeps: usize) -> Problem<'_> {
         let k_est = 7 * self.w.len() / 10;
-        scalar_problem(&self.sys, &self.hypothesis, &self.scales, &self.w, &self.y, k_est, 1.0 / self.y_range, 2)
+        scalar_problem(&self.sys, &self.hypothesis, &self.scales, &self.w, &self.y, k_est, 1.0 / self.y_range, substeps)
     }
 }
