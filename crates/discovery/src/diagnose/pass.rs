@@ -89,13 +89,6 @@ pub(super) struct NominalFindings {
     pub delta_bic_disc: f64,
 }
 
-/// An effect that cuts the nominal's held-out (validation) error to at most this share
-/// overrules residual tests that pass: they see the residual averaged over blocks of a tenth of
-/// the slowest time constant, where a fast structured residual (a cogging force at a lightly
-/// damped plant's frequency) averages out. On a recording without missing physics no effect
-/// predicts the held-out noise, so none comes near this share.
-pub(super) const OVERRULE_VALIDATION_RATIO: f64 = 0.5;
-
 /// How a pass ended.
 enum Step {
     Done(Box<(NominalFindings, Selection)>),
@@ -127,14 +120,14 @@ impl<'a> Pass<'a> {
     }
 
     /// Whether a single effect clears the BIC `margin` and cuts the held-out error to at most
-    /// [`OVERRULE_VALIDATION_RATIO`] of the nominal's although the nominal residual passed its
+    /// [`select::DECISIVE_HELD_OUT_RATIO`] of the nominal's although the nominal residual passed its
     /// tests (a note says which and by how much).
     fn tests_overruled(&mut self, data: &Setup, singles: &[select::Ranked], margin: f64) -> bool {
         let Some(best) = singles
             .iter()
             .filter(|r| r.delta_bic >= margin && r.status.conclusive())
             .min_by(|a, b| a.validation_ratio.total_cmp(&b.validation_ratio))
-            .filter(|r| r.validation_ratio <= OVERRULE_VALIDATION_RATIO)
+            .filter(|r| r.validation_ratio <= select::DECISIVE_HELD_OUT_RATIO)
         else {
             return false;
         };

@@ -158,7 +158,7 @@ pub(super) fn unconfirmed_extension(ranking: &[Ranked], chosen: Option<&Ranked>,
 }
 
 /// The fitted candidate (not the selected model, conclusive fit) that cuts the held-out
-/// (validation) error the most, to at most [`super::pass::OVERRULE_VALIDATION_RATIO`] of the
+/// (validation) error the most, to at most [`crate::select::DECISIVE_HELD_OUT_RATIO`] of the
 /// selected model's (the nominal's where nothing is selected): label and share. Such a
 /// candidate was not accepted, its estimation-segment gain being short of the margin.
 pub(super) fn held_out_extension(ranking: &[Ranked], chosen: Option<&Ranked>) -> Option<(String, f64)> {
@@ -167,7 +167,7 @@ pub(super) fn held_out_extension(ranking: &[Ranked], chosen: Option<&Ranked>) ->
         .iter()
         .filter(|r| chosen.is_none_or(|c| c.label != r.label) && r.status.conclusive())
         .map(|r| (r.label.clone(), r.validation_ratio / base.max(1e-300)))
-        .filter(|(_, share)| *share <= super::pass::OVERRULE_VALIDATION_RATIO)
+        .filter(|(_, share)| *share <= crate::select::DECISIVE_HELD_OUT_RATIO)
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
