@@ -121,6 +121,26 @@ fn a_delay_under_an_unknown_hold_is_covered_by_its_interval() {
 }
 
 #[test]
+fn a_delay_whose_holds_differ_only_by_the_noise_colour_covers_both_readings() {
+    // Seed 10601 case 1 of the mixed profile: a continuous command sampled at 1.07 ms, delayed
+    // by 0.74 ms, AR(1) 0.68 noise. The delay model fits the zero-order hold better by 7.4 in
+    // BIC, above the tie margin 6 counted as if every residual were independent, but 1.7 once
+    // counted for the residual's colour. Before, the zero-order reading 0.19 ms +- 0.03 ms was
+    // reported alone, 20 sigma from the continuous command's delay (the first-order reading,
+    // 0.73 ms, matched it).
+    let r = bench::run_case_with("input_delay", 10601, 1, Profile::Mixed, &DiagnoseSettings::default());
+    assert_eq!(r.predicted, "input_delay", "{r:?}");
+    let (e, t, sd) = (r.est_param.unwrap(), r.true_param.unwrap(), r.est_std.unwrap());
+    assert!((e - t).abs() <= 2.0 * sd, "delay {e:.4e} +- {sd:.2e} against the truth {t:.4e}");
+    let case = bench_gen::generate_profile("input_delay", 10601, 1, Profile::Mixed);
+    let rep = diagnose(&case.nominal, &case.recording, &with_known_state(&case)).unwrap();
+    let d = rep.hold.delay_delta_bic.expect("the delay is refitted under the other hold");
+    // control: the raw BIC difference alone would call the holds apart
+    assert!(d.abs() > DiagnoseSettings::default().select.tie_bic, "raw difference {d}");
+    assert!(rep.hold.delay_ambiguous, "{:?}", rep.hold);
+}
+
+#[test]
 fn a_delay_under_half_a_sample_is_found_under_the_other_hold() {
     // Seed 9302 case 3 of the mixed profile: a linearly interpolated (first-order-held)
     // command sampled at 1.85 ms, delayed by 0.66 ms (a third of a sample). The nominal prefers
