@@ -139,6 +139,7 @@ pub struct FitResult {
 
 #[derive(Clone)]
 struct Vars<'p, 'a> {
+    /// The problem (in the start phase of a finely stepped fit, its coarser-stepped copy).
     pb: &'p Problem<'a>,
     /// Scales of the free initial state (empty: the initial state is fixed at `x0_fixed`).
     xs: Vec<f64>,
@@ -498,6 +499,7 @@ fn fit_with(
             Some(done) => Some(done),
             // the best start's residual is of the leading part or the coarser stepping of the
             // start phase: the fallback is evaluated on the whole segment at the problem's
+            // own stepping
             None => vars.res(&b.0, &mut evals).map(|r| {
                 let c = sse(&r);
                 (b.0, r, c, false)
