@@ -201,6 +201,9 @@ impl<'a> Pass<'a> {
         if let Some(note) = self.gain_at_finer_stepping(data, &mut selection) {
             self.notes.push(note);
         }
+        if let Some(note) = held_out_waiver(&selection, s.select.margin_bic, margin) {
+            self.notes.push(note);
+        }
         let nominal = NominalFindings { nom_sim, e_nom, residual_nominal, nominal_adequate, loc, delta_bic_disc };
         Ok(Step::Done(Box::new((nominal, selection))))
     }
@@ -312,6 +315,24 @@ impl<'a> Pass<'a> {
         self.nom = data.fit_nominal(&self.ctx);
         self.prev_singles = Some(prev);
     }
+}
+
+/// The note where a single accepted against the nominal model fell short of `margin` (with the
+/// stepping allowance) and was judged at the settings' `margin_bic` alone, for cutting the
+/// held-out error to at most [`select::DECISIVE_HELD_OUT_RATIO`] (`select::forward`
+/// `single_margin`): the validation fit it reports took part in its choice.
+fn held_out_waiver(selection: &Selection, margin_bic: f64, margin: f64) -> Option<String> {
+    let r = selection.ranking.iter().find(|r| {
+        r.beats_nominal
+            && r.parts.len() == 1
+            && r.delta_bic < margin
+            && r.delta_bic >= margin_bic
+            && r.validation_ratio <= select::DECISIVE_HELD_OUT_RATIO
+    })?;
+    Some(format!(
+        "{} gained {:.1} in BIC over the nominal, short of the margin {margin:.1} that includes the stepping allowance, but cut the held-out error to {:.3} of the nominal's: it was judged at the settings' margin {margin_bic:.1} (stepping error cannot remove most of the held-out error; the refit at finer stepping still judged it). Its validation fit took part in that choice and is not an independent check.",
+        r.label, r.delta_bic, r.validation_ratio
+    ))
 }
 
 #[cfg(test)]
