@@ -304,8 +304,7 @@ pub(super) fn delay_under_both_holds(
     // zero-order hold better by 7.4 in BIC, 1.4 independent-sample units, and its zero-order
     // reading (0.19 ms +- 0.03) lay 20 sigma from the delay of the continuous input (0.74 ms),
     // which the first-order reading (0.73 ms) matched.
-    let rho = c.problem(ctx).estimation_residual_rho(&c.params, &c.nominal, &c.x0).unwrap_or(0.0);
-    let d_counted = d * crate::residual::independent_share(rho);
+    let d_counted = d * crate::residual::independent_share(c.residual_rho(ctx));
     if !(d_counted.is_finite() && d_counted.abs() < s.select.tie_bic) {
         return None;
     }

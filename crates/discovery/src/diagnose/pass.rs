@@ -326,8 +326,7 @@ fn held_out_waiver(selection: &Selection, margin_bic: f64, margin: f64) -> Optio
         r.beats_nominal
             && r.parts.len() == 1
             && r.delta_bic < margin
-            && r.delta_bic >= margin_bic
-            && r.validation_ratio <= select::DECISIVE_HELD_OUT_RATIO
+            && r.delta_bic >= select::forward::single_margin(r.validation_ratio, margin_bic, margin)
     })?;
     Some(format!(
         "{} gained {:.1} in BIC over the nominal, short of the margin {margin:.1} that includes the stepping allowance, but cut the held-out error to {:.3} of the nominal's: it was judged at the settings' margin {margin_bic:.1} (stepping error cannot remove most of the held-out error; the refit at finer stepping still judged it). Its validation fit took part in that choice and is not an independent check.",

@@ -16,6 +16,7 @@ use model::effects::Effect;
 use model::System;
 
 /// Data and structure shared by every evaluation.
+#[derive(Clone)]
 pub struct Problem<'a> {
     pub sys: &'a System,
     /// Effects fixed at given values (none in the single-effect round).
@@ -197,25 +198,7 @@ impl<'a> Problem<'a> {
     pub fn with_substeps(&self, substeps: usize) -> Option<Problem<'a>> {
         let sub = substeps.max(1);
         let maps = step_maps(self.sys, self.dt, sub)?;
-        Some(Problem {
-            sys: self.sys,
-            fixed: self.fixed.clone(),
-            parts: self.parts.clone(),
-            scales: self.scales,
-            w: self.w,
-            y: self.y,
-            m: self.m,
-            p: self.p,
-            dt: self.dt,
-            k_est: self.k_est,
-            weights: self.weights.clone(),
-            maps,
-            substeps: sub,
-            hold: self.hold,
-            z0: self.z0.clone(),
-            exclude: self.exclude,
-            refit: self.refit.clone(),
-        })
+        Some(Problem { maps, substeps: sub, ..self.clone() })
     }
 
     /// The residual on the first `k_end <= k_est` samples only (the solver's start phase on

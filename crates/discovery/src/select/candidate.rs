@@ -60,6 +60,12 @@ impl Ranked {
     pub fn problem<'a>(&self, ctx: &'a FitContext<'a>) -> Problem<'a> {
         ctx.problem_r(self.parts.clone(), self.refit.then_some(&self.nominal[..]))
     }
+
+    /// Lag-one autocorrelation of this fit's residual on the estimation segment in `ctx` (the
+    /// largest over the outputs; 0 where it cannot be simulated).
+    pub fn residual_rho(&self, ctx: &FitContext) -> f64 {
+        self.problem(ctx).estimation_residual_rho(&self.params, &self.nominal, &self.x0).unwrap_or(0.0)
+    }
 }
 
 /// The blocked cross-validation of one hypothesis against the model it would extend (see

@@ -90,18 +90,18 @@ pub(crate) fn select_all(
                     cur = b;
                 }
                 if cur.parts.len() < plan.max_effects && sel.something_left(&cur) {
-                    let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| base_sse.clone());
-                    let (better, combos) = sel.extend_by_every_single(&singles, &extra, &cur, &cur_sse);
+                    let (better, combos) = sel.extend_by_every_single(&singles, &extra, &cur, &base_sse);
                     extra.extend(combos);
                     if let Some(b) = better {
                         cur = b;
                     }
                 }
             }
-            // A full model: each effect beside every other partner.
-            if cur.parts.len() >= 2 && cur.parts.len() >= plan.max_effects {
-                let cur_sse = cur.cv.as_ref().map(|c| c.sse.clone()).unwrap_or_else(|| base_sse.clone());
-                let (better, combos) = sel.swap_partner(&singles, &extra, &cur, &cur_sse);
+            // A full model: each effect beside every other partner (`swap_partner` passes
+            // over a single effect and the refit; the combinations are judged against `cur`'s
+            // own held-out SSE, `base_sse` only where it has none).
+            if cur.parts.len() >= plan.max_effects {
+                let (better, combos) = sel.swap_partner(&singles, &extra, &cur, &base_sse);
                 extra.extend(combos);
                 if let Some(b) = better {
                     cur = b;
@@ -178,15 +178,9 @@ impl Selector<'_, '_> {
     fn supported(&self, c: &Ranked, cv: &super::CvResult, gain: f64) -> bool {
         match cv.status {
             "failed" => false,
-            "not_testable" => super::untestable_gain_clears(gain, self.margin, self.residual_rho(c)),
+            "not_testable" => super::untestable_gain_clears(gain, self.margin, c.residual_rho(self.ctx)),
             _ => true,
         }
-    }
-
-    /// Lag-one autocorrelation of `c`'s residual on the estimation segment (the largest over
-    /// the outputs; 0 where it cannot be simulated).
-    fn residual_rho(&self, c: &Ranked) -> f64 {
-        c.problem(self.ctx).estimation_residual_rho(&c.params, &c.nominal, &c.x0).unwrap_or(0.0)
     }
 
     /// Singles: cross-validates the best few (`max_cv`) that clear the BIC margin against the
