@@ -2,9 +2,10 @@
 //! position state is known (a pair `x_pos' = a x_vel`).
 //!
 //! Fitted as `(a_sin, a_cos, period)`: the force `a_sin sin(2 pi x/P) + a_cos cos(2 pi x/P)`
-//! is linear in the amplitudes (`+-` the site's force bound) and the period lies in a narrow
-//! log box about the best period of a scan of the nominal residual ([`cogging_scan`],
-//! [`COGGING_PERIODS`] over the recorded position range). Offered only with a nominal run
+//! is linear in the amplitudes (`+-` the site's force bound) and the period lies in a log box
+//! about the peaks of a scan of the nominal residual ([`cogging_scan`], [`COGGING_PERIODS`]
+//! over the recorded position range, one peak per [`COGGING_SCAN_BANDS`] band), each peak a
+//! start of the fit. Offered only with a nominal run
 //! ([`super::Scales::nominal`]).
 use super::scales::NominalRun;
 use super::{Context, Family, Hypothesis, Kind, Scales, Site};
@@ -31,25 +32,54 @@ fn position_signal(sys: &System, run: &NominalRun, pos: usize) -> Vec<f64> {
     }
 }
 
+/// Log-period bands of the scan whose best peak each becomes a start of the cogging fit
+/// ([`cogging_scan`]). The scan's regressor is held over each sample, so a period shorter than
+/// the position travelled in a sample or two aliases into a pseudo-random regressor that fits
+/// the residual's noise better than the true period does (development seed 10211 `cogging`
+/// #0: the scan's best peak 0.177 against a true 1.64, whose own gain was a third of it); the
+/// fit, which steps the force between samples, decides among the bands' peaks.
+pub const COGGING_SCAN_BANDS: usize = 3;
+
+/// A peak of the cogging scan: the period and the least-squares amplitudes of its sine and
+/// cosine regressors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanPeak {
+    pub period: f64,
+    pub amplitude_sin: f64,
+    pub amplitude_cos: f64,
+}
+
 /// Scan for a cogging period: for periods `P` from `range / 40` to `range / 2.5` of the
 /// position (log grid, step `P / (6 range)`, so the phase at the ends of the range is off
 /// by at most `pi / 6` between neighbours), the linearised response of the output to the two
 /// force regressors `sin(2 pi x_pos / P)`, `cos(2 pi x_pos / P)` on velocity state `vel`
 /// (the contact dynamics `F = A + E C`, the regressor held over each sample) is fitted to
-/// the nominal residual by least squares. Returns the period with the largest reduction of
-/// the residual and its two amplitudes, or `None` without a nominal run.
-pub fn cogging_scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Option<(f64, f64, f64)> {
-    let run = s.nominal.as_ref()?;
-    let (n, p) = (sys.n(), sys.p());
-    let ke = run.k_est;
-    if ke < 10 || s.dt <= 0.0 {
-        return None;
+/// the nominal residual by least squares. Returns the best local maximum of the residual's
+/// reduction in each of [`COGGING_SCAN_BANDS`] equal log-period bands (the scan's ends count
+/// as maxima), the largest reduction first; empty without a nominal run.
+pub fn cogging_scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Vec<ScanPeak> {
+    let Some(run) = s.nominal.as_ref() else { return vec![] };
+    if run.k_est < 10 || s.dt <= 0.0 {
+        return vec![];
     }
     let xp = position_signal(sys, run, pos);
-    let range = xp.iter().copied().fold(f64::NEG_INFINITY, f64::max) - xp.iter().copied().fold(f64::INFINITY, f64::min);
+    let range = position_range(&xp);
     if !(range > 0.0 && range.is_finite()) {
-        return None;
+        return vec![];
     }
+    let gains = scan_gains(sys, s, run, &xp, range, vel);
+    band_peaks(&gains, range / COGGING_PERIODS.1, range / COGGING_PERIODS.0)
+}
+
+fn position_range(xp: &[f64]) -> f64 {
+    xp.iter().copied().fold(f64::NEG_INFINITY, f64::max) - xp.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+/// The scan itself: `(gain, peak)` at every period of the grid, the force on velocity state
+/// `vel` (see [`cogging_scan`]).
+fn scan_gains(sys: &System, s: &Scales, run: &NominalRun, xp: &[f64], range: f64, vel: usize) -> Vec<(f64, ScanPeak)> {
+    let (n, p) = (sys.n(), sys.p());
+    let ke = run.k_est;
     // Weighted residual (outputs weigh alike).
     let wts: Vec<f64> = (0..p)
         .map(|i| {
@@ -77,7 +107,7 @@ pub fn cogging_scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Option<
         }
     };
     let (pmin, pmax) = (range / COGGING_PERIODS.1, range / COGGING_PERIODS.0);
-    let mut best: Option<(f64, f64, f64, f64)> = None;
+    let mut gains = vec![];
     let (mut rs, mut rc) = (Vec::with_capacity(ke * p), Vec::with_capacity(ke * p));
     let mut per = pmin;
     while per <= pmax {
@@ -92,36 +122,60 @@ pub fn cogging_scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Option<
         let det = hss * hcc - hsc * hsc;
         if det > 1e-12 * (hss * hcc).max(1e-300) {
             let (a_s, a_c) = ((hcc * gs - hsc * gc) / det, (hss * gc - hsc * gs) / det);
-            let gain = a_s * gs + a_c * gc;
-            if best.is_none_or(|b| gain > b.0) {
-                best = Some((gain, per, a_s, a_c));
-            }
+            gains.push((a_s * gs + a_c * gc, ScanPeak { period: per, amplitude_sin: a_s, amplitude_cos: a_c }));
         }
         per *= 1.0 + per / (6.0 * range);
     }
-    best.map(|(_, per, a_s, a_c)| (per, a_s, a_c))
+    gains
+}
+
+/// The best local maximum of `gains` (periods increasing; the ends count as maxima) in each of
+/// [`COGGING_SCAN_BANDS`] equal log-period bands of `[pmin, pmax]`, the largest gain first.
+fn band_peaks(gains: &[(f64, ScanPeak)], pmin: f64, pmax: f64) -> Vec<ScanPeak> {
+    let g = |i: usize| gains[i].0;
+    let is_peak = |i: usize| (i == 0 || g(i) > g(i - 1)) && (i + 1 == gains.len() || g(i) >= g(i + 1));
+    let band = |per: f64| {
+        let b = ((per / pmin).ln() / (pmax / pmin).ln() * COGGING_SCAN_BANDS as f64).floor();
+        (b.max(0.0) as usize).min(COGGING_SCAN_BANDS - 1)
+    };
+    let mut best: Vec<Option<(f64, ScanPeak)>> = vec![None; COGGING_SCAN_BANDS];
+    for i in (0..gains.len()).filter(|&i| is_peak(i)) {
+        let slot = &mut best[band(gains[i].1.period)];
+        if slot.is_none_or(|(b, _)| g(i) > b) {
+            *slot = Some(gains[i]);
+        }
+    }
+    let mut peaks: Vec<(f64, ScanPeak)> = best.into_iter().flatten().collect();
+    peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    peaks.into_iter().map(|(_, peak)| peak).collect()
 }
 
 /// `cogging` on velocity state `vel` with position state `pos`: amplitudes of the sine and
-/// cosine parts in `[-fs, fs]` (linear: the force is linear in them) and the period in a
-/// log box of `+- 3` scan steps about the scan's best period ([`cogging_scan`]), started at
-/// the scan's amplitudes, half and 1.5 times them. `None` without a scan.
+/// cosine parts in `[-fs, fs]` (linear: the force is linear in them) and the period in a log
+/// box from `3` scan steps below the lowest of the scan's band peaks ([`cogging_scan`]) to `3`
+/// above the highest. Started at the best peak's amplitudes, half and 1.5 times them, and at
+/// each other peak's amplitudes. `None` without a scan.
 fn cogging(sys: &System, s: &Scales, pos: usize, vel: usize, fs: f64) -> Option<Hypothesis> {
-    let (per, a_s, a_c) = cogging_scan(sys, s, pos, vel)?;
+    let peaks = cogging_scan(sys, s, pos, vel);
+    let best = *peaks.first()?;
     let run = s.nominal.as_ref()?;
-    let xp = position_signal(sys, run, pos);
-    let range = xp.iter().copied().fold(f64::NEG_INFINITY, f64::max) - xp.iter().copied().fold(f64::INFINITY, f64::min);
-    let step = per / (6.0 * range);
+    let range = position_range(&position_signal(sys, run, pos));
+    let step = |per: f64| per / (6.0 * range);
+    let lo = peaks.iter().map(|q| q.period).fold(f64::INFINITY, f64::min);
+    let hi = peaks.iter().map(|q| q.period).fold(0.0, f64::max);
     let h = Hypothesis {
         kind: Kind::Cogging { state: vel, position_state: pos },
-        lower: vec![-fs, -fs, per * (1.0 - 3.0 * step)],
-        upper: vec![fs, fs, per * (1.0 + 3.0 * step)],
+        lower: vec![-fs, -fs, lo * (1.0 - 3.0 * step(lo))],
+        upper: vec![fs, fs, hi * (1.0 + 3.0 * step(hi))],
         starts: vec![],
         names: vec!["amplitude_sin", "amplitude_cos", "period"],
         log_shift: vec![None, None, Some(0.0)],
     };
+    let start = |f: f64, q: &ScanPeak| {
+        vec![h.unit_of(0, f * q.amplitude_sin), h.unit_of(1, f * q.amplitude_cos), h.unit_of(2, q.period)]
+    };
     let starts =
-        [1.0, 0.5, 1.5].iter().map(|f| vec![h.unit_of(0, f * a_s), h.unit_of(1, f * a_c), h.unit_of(2, per)]).collect();
+        [1.0, 0.5, 1.5].iter().map(|&f| start(f, &best)).chain(peaks[1..].iter().map(|q| start(1.0, q))).collect();
     Some(Hypothesis { starts, ..h })
 }
 
@@ -207,5 +261,28 @@ mod tests {
             let a = 0.3 * f64::sin(t) - 0.4 * f64::cos(t);
             assert!((amplitude * (t + phase).sin() - a).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn each_band_offers_its_best_peak_best_first() {
+        // Gains over periods 0.1-1.6 (3 bands of a factor 16^(1/3) = 2.52 each: 0.1-0.252,
+        // 0.252-0.635, 0.635-1.6): a tall
+        // aliased peak at 0.15, a smaller one at 0.18 in the same band, nothing but a slope in
+        // the middle band, and a scan that still rises at its upper end (1.6).
+        let pers: Vec<f64> = (0..=40).map(|i| 0.1 * 16f64.powf(i as f64 / 40.0)).collect();
+        let gain =
+            |p: f64| 18.0 * (-((p - 0.15) / 0.01).powi(2)).exp() + 9.0 * (-((p - 0.18) / 0.01).powi(2)).exp() + 4.0 * p;
+        let gains: Vec<(f64, ScanPeak)> =
+            pers.iter().map(|&p| (gain(p), ScanPeak { period: p, amplitude_sin: p, amplitude_cos: -p })).collect();
+        let peaks = band_peaks(&gains, 0.1, 1.6);
+        let got: Vec<f64> = peaks.iter().map(|q| q.period).collect();
+        // The alias first (the largest gain), then the scan's upper end; the second peak of the
+        // first band and the slope of the middle band offer nothing.
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert!((got[0] - 0.15).abs() < 0.01, "{got:?}");
+        assert_eq!(got[1], *pers.last().unwrap());
+        assert_eq!((peaks[1].amplitude_sin, peaks[1].amplitude_cos), (got[1], -got[1]));
+        // Empty scan, no peaks.
+        assert!(band_peaks(&[], 0.1, 1.6).is_empty());
     }
 }
