@@ -278,3 +278,27 @@ fn a_misfit_whitened_by_the_colour_filter_is_still_searched() {
         |h: &discovery::diagnose::Ranked| h.kinds.len() == 2 && h.kinds.iter().all(|k| k != "coulomb_friction");
     assert!(r.ranking.iter().any(searched), "the pair search did not run");
 }
+
+#[test]
+fn the_pair_pool_is_not_filled_by_one_physics() {
+    // Mixed-profile seed 10711 case 0, a gap width and Coulomb friction on a 4-state plant: the
+    // six best singles were Stribeck friction on x4 and x2, an input delay, and
+    // direction-dependent, Coulomb and load-dependent friction on x2. Rivals are never paired,
+    // so the pair search fitted friction + delay only, and Stribeck friction + an input
+    // backlash was selected, 1473 worse in BIC than the true pair. The pool now takes at most
+    // two singles that stand for the same physics (`select::forward::POOL_RIVALS`).
+    let case = bench_gen::generate_pair(["gap_width", "coulomb_friction"], 10711, 0, Profile::Mixed).unwrap();
+    let r = run(&case);
+    // Control: the gap width's single is not among the six best singles, so a pool of the
+    // six best would not hold it.
+    let mut singles: Vec<(&str, f64)> = r
+        .ranking
+        .iter()
+        .filter(|x| x.kinds.len() == 1 && x.status.conclusive())
+        .map(|x| (x.label.as_str(), x.delta_bic))
+        .collect();
+    singles.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let gap = singles.iter().position(|s| s.0 == "gap_width").expect("the gap width's single");
+    assert!(gap >= discovery::select::forward::PAIR_POOL, "gap width single ranked {gap}: {singles:?}");
+    assert_eq!(named(&case, &r), 2, "{}", r.verdict);
+}
