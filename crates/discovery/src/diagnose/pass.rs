@@ -33,6 +33,9 @@ pub(super) struct Pass<'a> {
     pub notes: Vec<String>,
     /// Passes rerun for the selected model's sub-steps (at most one).
     substep_reruns: usize,
+    /// Whether a hold switched by the effects was checked against the selected model
+    /// ([`hold::switch_undone`], once).
+    switch_checked: bool,
     /// Singles of the previous pass, or of a long record's screening (warm starts).
     prev_singles: Option<Vec<Ranked>>,
     /// The selected model's gain checked at a finer stepping: `(sub-steps, gain at the
@@ -112,6 +115,7 @@ impl<'a> Pass<'a> {
             nom,
             notes: Vec::new(),
             substep_reruns: 0,
+            switch_checked: false,
             // a long record's screening warm-starts the whole record's singles
             prev_singles: data.s.screened_singles.clone(),
             finer_check: None,
@@ -197,6 +201,18 @@ impl<'a> Pass<'a> {
         let mut selection = select::forward::select_all(&self.ctx, &plan, singles, &self.nom, nominal_adequate, margin);
         if self.needs_more_substeps(data, &selection) {
             return Ok(Step::Restart);
+        }
+        if self.hold_report.switched && !self.switch_checked {
+            self.switch_checked = true;
+            let undone =
+                hold::switch_undone(data, &self.ctx, selection.chosen.as_ref(), self.hold, &mut self.hold_report);
+            if let Some((other, note)) = undone {
+                self.notes.push(note);
+                self.hold = other;
+                self.disc_final = None;
+                self.restart(data, self.ctx.substeps, selection.ranking.clone());
+                return Ok(Step::Restart);
+            }
         }
         if let Some(note) = self.gain_at_finer_stepping(data, &mut selection) {
             self.notes.push(note);
