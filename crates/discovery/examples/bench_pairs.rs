@@ -38,6 +38,7 @@ fn main() {
             .collect(),
     };
     let (mut n, mut both, mut both_eq, mut missed, mut flagged, mut missed_eq, mut flagged_eq) = (0, 0, 0, 0, 0, 0, 0);
+    let truth = std::env::var("BENCH_PAIRS_TRUTH").ok();
     for i in 0..cases {
         for &p in &pairs {
             let Some(r) = discovery::bench::run_pair_case(p, seed, i, profile, &Default::default()) else { continue };
@@ -57,8 +58,12 @@ fn main() {
                 r.equivalents,
                 r.error
             );
-            let truth = std::env::var("BENCH_PAIRS_TRUTH").ok();
-            if r.named < 2 && (!r.model_incomplete || truth.as_deref() == Some("all")) && truth.is_some() {
+            let again = match truth.as_deref() {
+                Some("all") => true,
+                Some(_) => !r.model_incomplete,
+                None => false,
+            };
+            if r.named < 2 && again {
                 print_truth_ceiling(p, seed, i, profile, r.delta_bic_selected);
             }
             if std::env::var_os("BENCH_PAIRS_RANKING").is_some() {

@@ -157,10 +157,8 @@ pub(super) fn overturned_by_effects(
     }
     let other = other_hold(hold);
     for (i, c) in leading.into_iter().enumerate() {
-        let ctx_o = data.context(other, ctx.substeps, data.x_scale.clone());
         let fo = fit::FitSettings { max_iter: 10, ..s.fit.clone() };
-        let start = delay_shifted_start(c, hold, data.dt);
-        let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&start), &fo);
+        let (ctx_o, r_o) = refit_under_other_hold(data, c, hold, ctx.substeps, data.x_scale.clone(), &fo);
         let d = select::bic(c.sse_estimation, n_res, 0) - select::bic(r_o.sse, n_res, 0) - (c.bic - best_bic);
         if i == 0 {
             report.effect_delta_bic = Some(d);
@@ -227,8 +225,7 @@ pub(super) fn switch_undone(
     let c = chosen?;
     let s = data.s;
     let other = other_hold(hold);
-    let ctx_o = data.context(other, ctx.substeps, data.x_scale.clone());
-    let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&delay_shifted_start(c, hold, data.dt)), &s.fit);
+    let (_, r_o) = refit_under_other_hold(data, c, hold, ctx.substeps, data.x_scale.clone(), &s.fit);
     // `BIC(this hold) - BIC(the nominal's hold)`, the same parameters
     let d = select::bic(c.sse_estimation, data.n_res, 0) - select::bic(r_o.sse, data.n_res, 0);
     if !(d > s.select.tie_bic) {
@@ -286,6 +283,22 @@ fn other_hold(hold: InputHold) -> InputHold {
     }
 }
 
+/// Fitted model `c` (of `hold`) refitted under the other hold at `substeps` sub-steps, from
+/// its estimate with its delays shifted by the half sample the holds differ by
+/// ([`delay_shifted_start`]): the other hold's fit context and the fit.
+fn refit_under_other_hold<'d>(
+    data: &'d Setup,
+    c: &Ranked,
+    hold: InputHold,
+    substeps: usize,
+    x_scale: Vec<f64>,
+    fs: &fit::FitSettings,
+) -> (FitContext<'d>, FitResult) {
+    let ctx_o = data.context(other_hold(hold), substeps, x_scale);
+    let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&delay_shifted_start(c, hold, data.dt)), fs);
+    (ctx_o, r_o)
+}
+
 /// The parameters of `c` (fitted under `hold`) as a start under the other hold: its delays
 /// moved by the h/2 that a zero-order hold adds to a first-order one (`+h/2` from zoh to foh),
 /// not below 0.
@@ -337,9 +350,7 @@ pub(super) fn delay_under_both_holds(
         return None;
     }
     let other = other_hold(hold);
-    let ctx_o = data.context(other, ctx.substeps, ctx.x_scale.clone());
-    let start = delay_shifted_start(c, hold, data.dt);
-    let r_o = fit::fit(&c.problem(&ctx_o), &c.x0, &ctx_o.x_scale, Some(&start), &s.fit);
+    let (_, r_o) = refit_under_other_hold(data, c, hold, ctx.substeps, ctx.x_scale.clone(), &s.fit);
     let d = select::bic(r_o.sse, data.n_res, 0) - select::bic(c.sse_estimation, data.n_res, 0);
     report.delay_delta_bic = Some(d);
     report.delay_other_hold = at.iter().map(|&i| r_o.theta.get(i).copied().unwrap_or(f64::NAN)).collect();

@@ -58,21 +58,23 @@ pub struct ScanPeak {
 /// reduction in each of [`COGGING_SCAN_BANDS`] equal log-period bands (the scan's ends count
 /// as maxima), the largest reduction first; empty without a nominal run.
 pub fn cogging_scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Vec<ScanPeak> {
-    let Some(run) = s.nominal.as_ref() else { return vec![] };
-    if run.k_est < 10 || s.dt <= 0.0 {
-        return vec![];
-    }
-    let xp = position_signal(sys, run, pos);
-    let range = position_range(&xp);
-    if !(range > 0.0 && range.is_finite()) {
-        return vec![];
-    }
-    let gains = scan_gains(sys, s, run, &xp, range, vel);
-    band_peaks(&gains, range / COGGING_PERIODS.1, range / COGGING_PERIODS.0)
+    scan(sys, s, pos, vel).map_or(vec![], |(_, peaks)| peaks)
 }
 
-fn position_range(xp: &[f64]) -> f64 {
-    xp.iter().copied().fold(f64::NEG_INFINITY, f64::max) - xp.iter().copied().fold(f64::INFINITY, f64::min)
+/// [`cogging_scan`] with the recorded position range it scanned over; `None` without a
+/// nominal run or a position range.
+fn scan(sys: &System, s: &Scales, pos: usize, vel: usize) -> Option<(f64, Vec<ScanPeak>)> {
+    let run = s.nominal.as_ref()?;
+    if run.k_est < 10 || s.dt <= 0.0 {
+        return None;
+    }
+    let xp = position_signal(sys, run, pos);
+    let range = xp.iter().copied().fold(f64::NEG_INFINITY, f64::max) - xp.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(range > 0.0 && range.is_finite()) {
+        return None;
+    }
+    let gains = scan_gains(sys, s, run, &xp, range, vel);
+    Some((range, band_peaks(&gains, range / COGGING_PERIODS.1, range / COGGING_PERIODS.0)))
 }
 
 /// The scan itself: `(gain, peak)` at every period of the grid, the force on velocity state
@@ -156,10 +158,8 @@ fn band_peaks(gains: &[(f64, ScanPeak)], pmin: f64, pmax: f64) -> Vec<ScanPeak> 
 /// above the highest. Started at the best peak's amplitudes, half and 1.5 times them, and at
 /// each other peak's amplitudes. `None` without a scan.
 fn cogging(sys: &System, s: &Scales, pos: usize, vel: usize, fs: f64) -> Option<Hypothesis> {
-    let peaks = cogging_scan(sys, s, pos, vel);
+    let (range, peaks) = scan(sys, s, pos, vel)?;
     let best = *peaks.first()?;
-    let run = s.nominal.as_ref()?;
-    let range = position_range(&position_signal(sys, run, pos));
     let step = |per: f64| per / (6.0 * range);
     let lo = peaks.iter().map(|q| q.period).fold(f64::INFINITY, f64::min);
     let hi = peaks.iter().map(|q| q.period).fold(0.0, f64::max);
