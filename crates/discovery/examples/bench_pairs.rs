@@ -124,4 +124,13 @@ fn print_ranking(p: [&'static str; 2], seed: u64, i: usize, profile: discovery::
         println!("    {:<50} dBIC {:>9.1} {:?} {}", r.label, r.delta_bic, r.status, r.evidence);
     }
     println!("    verdict: {}", rep.verdict);
+    println!("    hold {:?}, {} sub-steps", rep.hold, rep.substeps);
+    println!(
+        "    ladder {:?} final {:?}",
+        rep.discretisation.ladder,
+        rep.discretisation_final.as_ref().map(|d| d.ladder.clone())
+    );
+    for n in &rep.notes {
+        println!("    note: {n}");
+    }
 }

@@ -138,22 +138,24 @@ fn a_delay_whose_holds_differ_only_by_the_noise_colour_covers_both_readings() {
     // control: the raw BIC difference alone would call the holds apart
     assert!(d.abs() > DiagnoseSettings::default().select.tie_bic, "raw difference {d}");
     assert!(rep.hold.delay_ambiguous, "{:?}", rep.hold);
-    // control for the test below: a selection that cleared the margin with the stepping
-    // allowance carries no note of the waiver
+    // a selection that cleared the margin with the stepping allowance carries no note of the
+    // waiver (`diagnose/pass.rs` tests the note where it is due)
     assert!(!rep.notes.iter().any(|n| n.contains("took part in that choice")), "{:?}", rep.notes);
 }
 
 #[test]
-fn an_effect_that_removes_most_of_the_held_out_error_is_judged_without_the_stepping_allowance() {
+fn a_saturation_reached_mostly_after_the_estimation_segment_is_named() {
     // Seed 10603 case 1 of the digital profile: an input saturation reached mostly after the
-    // estimation segment. The single gains 13.6 in BIC against a margin of 17.6 (10 plus 7.6 of
-    // stepping allowance) and cuts the held-out error to 0.081 of the nominal's. Before, the
-    // recording was read as nothing.
+    // estimation segment. With the simulator's first-order play step (until 2026-11-28) the
+    // single gained 13.6 in BIC against a margin of 17.6 (10 plus 7.6 of stepping allowance)
+    // and cut the held-out error to 0.081 of the nominal's; before the waiver the recording was
+    // read as nothing. The second-order step leaves an allowance of 0.1 here, and the single
+    // clears the margin itself; the waiver's note is tested in `diagnose/pass.rs` (no recording
+    // of the seeds 10601-10603 needs it now).
     let case = bench_gen::generate_profile("input_saturation", 10603, 1, Profile::Digital);
     let rep = diagnose(&case.nominal, &case.recording, &with_known_state(&case)).unwrap();
     assert_eq!(rep.selected(), "input_saturation", "{}", rep.verdict);
-    // the report says the validation fit took part in the choice
-    assert!(rep.notes.iter().any(|n| n.contains("took part in that choice")), "{:?}", rep.notes);
+    assert!(rep.delta_bic_discretisation < 1.0, "allowance {}", rep.delta_bic_discretisation);
 }
 
 #[test]

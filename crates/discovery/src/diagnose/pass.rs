@@ -192,9 +192,10 @@ impl<'a> Pass<'a> {
         );
         if let Some((other, note)) = overturned {
             self.notes.push(note);
+            let warm = hold::carried_to_other_hold(singles, self.hold, data.dt);
             self.hold = other;
             self.disc_final = None;
-            self.restart(data, self.ctx.substeps, singles);
+            self.restart(data, self.ctx.substeps, warm);
             return Ok(Step::Restart);
         }
         // Selection and cross-validation.
@@ -208,9 +209,10 @@ impl<'a> Pass<'a> {
                 hold::switch_undone(data, &self.ctx, selection.chosen.as_ref(), self.hold, &mut self.hold_report);
             if let Some((other, note)) = undone {
                 self.notes.push(note);
+                let warm = hold::carried_to_other_hold(selection.ranking.clone(), self.hold, data.dt);
                 self.hold = other;
                 self.disc_final = None;
-                self.restart(data, self.ctx.substeps, selection.ranking.clone());
+                self.restart(data, self.ctx.substeps, warm);
                 return Ok(Step::Restart);
             }
         }
@@ -353,6 +355,50 @@ fn held_out_waiver(selection: &Selection, margin_bic: f64, margin: f64) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A selection whose ranking holds one single effect, accepted or not, with its gain over
+    /// the nominal model and its held-out ratio.
+    fn one_single(delta_bic: f64, validation_ratio: f64, beats_nominal: bool) -> Selection {
+        let sys = model::parse_str(include_str!("../../../../examples/worked-example.toml")).unwrap();
+        let h = crate::hypothesis::candidates(&sys, &Default::default()).remove(0);
+        let r = Ranked {
+            label: h.kind.label(),
+            kinds: vec![],
+            params: vec![],
+            std: vec![],
+            sse_estimation: 1.0,
+            bic: -delta_bic,
+            delta_bic,
+            validation: select::candidate::failed_fit(1),
+            validation_ratio,
+            beats_nominal,
+            status: fit::FitStatus::Converged,
+            evidence: String::new(),
+            cv: None,
+            refit: false,
+            nominal: vec![],
+            nominal_std: vec![],
+            nominal_correlation: vec![],
+            effect_covariance: None,
+            x0: vec![],
+            val_sse: 1.0,
+            parts: vec![h],
+        };
+        Selection { ranking: vec![r], chosen: None, ties: vec![], cv_rejected: vec![], equivalents: vec![] }
+    }
+
+    #[test]
+    fn a_single_accepted_below_the_stepping_allowance_for_its_held_out_cut_is_noted() {
+        // fresh 10603 input_saturation #1 (digital) under the first-order play step: +13.6
+        // against the margin 10 + 7.6 of allowance, held-out error cut to 0.081
+        let note = held_out_waiver(&one_single(13.6, 0.081, true), 10.0, 17.6).expect("the waiver is noted");
+        assert!(note.contains("took part in that choice"), "{note}");
+        // negative controls: a gain that clears the full margin, a held-out cut short of
+        // decisive, a single not accepted
+        assert!(held_out_waiver(&one_single(18.0, 0.081, true), 10.0, 17.6).is_none());
+        assert!(held_out_waiver(&one_single(13.6, 0.6, true), 10.0, 17.6).is_none());
+        assert!(held_out_waiver(&one_single(13.6, 0.081, false), 10.0, 17.6).is_none());
+    }
 
     #[test]
     fn the_refit_from_the_starts_runs_only_where_the_finer_stepping_moved_the_estimate() {

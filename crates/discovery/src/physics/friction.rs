@@ -255,6 +255,18 @@ impl Family for Friction {
     }
 }
 
+/// The static over the sliding level as the Stribeck note words it: a ratio, or, where the
+/// sliding level is zero (or the ratio beyond a million), that the friction acts only near
+/// rest (a ratio of 2.8e302 was printed for a sliding level fitted at 0).
+fn level_ratio(static_level: f64, level: f64) -> String {
+    let r = static_level / level;
+    if level > 0.0 && r.is_finite() && r < 1e6 {
+        format!("ratio {r:.2}")
+    } else {
+        "no sliding friction: it acts near rest only".into()
+    }
+}
+
 /// Notes on observational equivalences among the friction effects of a fitted model
 /// (`effects`) and on ties (`ties`, hypothesis labels) that involve them: a Stribeck law
 /// whose static level equals its sliding level is Coulomb friction, and direction-dependent
@@ -270,9 +282,9 @@ pub fn notes(effects: &[Effect], ties: &[String]) -> Vec<String> {
                 -0.5 * (a - b)
             )),
             Effect::StribeckFriction { state, level, static_level, stribeck_velocity, .. } => out.push(format!(
-                "stribeck_friction(x{}): static (breakaway) level {static_level:.4e} against the sliding (Coulomb) level {level:.4e} (ratio {:.2}), Stribeck velocity {stribeck_velocity:.3e}: the recording shows breakaway; with equal levels it would be coulomb_friction, which BIC prefers when the data do not show it.",
+                "stribeck_friction(x{}): static (breakaway) level {static_level:.4e} against the sliding (Coulomb) level {level:.4e} ({}), Stribeck velocity {stribeck_velocity:.3e}: the recording shows breakaway; with equal levels it would be coulomb_friction, which BIC prefers when the data do not show it.",
                 state + 1,
-                static_level / level.max(1e-300)
+                level_ratio(*static_level, *level)
             )),
             _ => {}
         }
@@ -313,6 +325,14 @@ pub fn notes(effects: &[Effect], ties: &[String]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_stribeck_note_words_a_zero_sliding_level() {
+        assert_eq!(level_ratio(3.0, 2.0), "ratio 1.50");
+        // negative controls: a zero sliding level, a ratio past a million
+        assert!(level_ratio(281.0, 0.0).contains("near rest only"));
+        assert!(level_ratio(281.0, 1e-10).contains("near rest only"));
+    }
     use crate::physics::Scales;
 
     #[test]

@@ -179,7 +179,8 @@ fn scored(
 /// Fits every single hypothesis on the estimation segment (sorted by BIC).
 ///
 /// `prev`: the singles of an earlier pass of the same diagnosis (after a change of input hold or
-/// of sub-steps, which moves each optimum a little): a hypothesis whose earlier fit converged
+/// of sub-steps, which moves each optimum a little; a change of hold moves a delay by h/2, and
+/// the pass shifts its start by that much): a hypothesis whose earlier fit converged
 /// (or ran out of iterations) starts from that estimate alone instead of all its starts; a stuck
 /// or failed earlier fit gets all its starts again.
 pub(crate) fn fit_singles(

@@ -19,9 +19,11 @@
 //!   `z_pred = z_k` for a massless backlash output and, with `backlash_inertia`, `z` coasts
 //!   with velocity `v` decaying at rate `damping / mass` between contacts (the contact is
 //!   inelastic: after a projection `z` moves with `y`, `v` the output's velocity by a
-//!   second-order backward difference; `(z_{k+1} - z_k)/h` for p > 1), and while it coasts
-//!   the plant sees `q` change linearly over the step ([`super::simulate`]). Second order in
-//!   the step away from contact events (first order before, issue 27 item 5).
+//!   second-order backward difference; `(z_{k+1} - z_k)/h` for p > 1). Between contacts, with
+//!   or without inertia, the plant sees `q` change linearly over the step: `z` coasts (or
+//!   stays) while `y` moves at its velocity ([`super::simulate`]). Second order in the step
+//!   away from contact events; the catching-up scheme of the paper, which holds `q` over the
+//!   step, is first order (issue 27 item 5; `tests/extended_simulation.rs`).
 //!
 //! Compiling checks every effect (an error names the effect and the offending value); the
 //! simulation itself is [`super::simulate`].

@@ -6,7 +6,7 @@
 //! breakpoint, see [`super::input`]); each sub-step is, in order:
 //! 1. the input over the sub-step by the model's hold (`InputDrive::advance`);
 //! 2. the exact linear step `x+ = Phi x + Psi B w0 + Psi1 B dw + Psi E q (+ Psi1 E dq, a
-//!    coasting play's predicted change of q) (+ Psi b)`, then the cogging and friction forces
+//!    free play's predicted change of q) (+ Psi b)`, then the cogging and friction forces
 //!    ([`super::forces`]) (`ExtendedModel::step_plant`);
 //! 3. the play: the backlash output coasts (with inertia) and is projected back into
 //!    `y + Theta` (`ExtendedModel::step_play`).
@@ -167,15 +167,15 @@ pub(super) struct RunState {
     pub(super) y: Vec<f64>,
     /// Coasting velocity of the backlash output (`backlash_inertia`).
     v: Vec<f64>,
-    /// With `backlash_inertia`: `y` at the start of the current step and of the step before,
-    /// and the length of the step before (0 before the first), for the output's velocity at
-    /// a contact ([`ExtendedModel::output_velocity`]).
+    /// With a play: `y` at the start of the current step and of the step before,
+    /// and the length of the step before (0 before the first), for the output's velocity
+    /// ([`ExtendedModel::output_velocity`]).
     y_start: Vec<f64>,
     y_before: Vec<f64>,
     h_before: f64,
     h_last: f64,
-    /// With `backlash_inertia`: whether the play was projected (in contact) at the last step's
-    /// end, and the change of `q` predicted over the current step (coasting).
+    /// With a play: whether it was projected (in contact) at the last step's end, and the
+    /// change of `q` predicted over the current step (free: `z` coasts or stays).
     touching: Vec<bool>,
     dq: Vec<f64>,
     scratch: Vec<f64>,
@@ -353,7 +353,7 @@ impl ExtendedModel {
     pub(super) fn step_plant(&self, st: &mut RunState, pc: &Piece, w0: &[f64], dw: &[f64]) {
         let (n, m, p) = (self.n, self.m, self.p);
         let mp = pc.maps;
-        let coasting = self.inertia_tau > 0.0 && self.predict_coasting(st, pc);
+        let free = self.has_play() && self.predict_free_play(st, pc);
         let (x, xn, q, z, dq) = (&st.x[..n], &mut st.xn[..n], &st.q[..p], &st.z[..p], &st.dq[..p]);
         let (w0, dw) = (&w0[..m], &dw[..m]);
         for (i, xn_i) in xn.iter_mut().enumerate() {
@@ -369,7 +369,7 @@ impl ExtendedModel {
             for (a, b) in pe.iter().zip(q) {
                 acc += a * b;
             }
-            if coasting {
+            if free {
                 for (a, b) in mp.Psi1E[i * p..][..p].iter().zip(dq) {
                     acc += a * b;
                 }
@@ -381,7 +381,7 @@ impl ExtendedModel {
         }
         self.forces.apply(x, xn, &mp.Psi, w0, z);
         std::mem::swap(&mut st.x, &mut st.xn);
-        if self.inertia_tau > 0.0 {
+        if self.has_play() {
             std::mem::swap(&mut st.y_before, &mut st.y_start);
             st.y_start.copy_from_slice(&st.y);
             st.h_before = st.h_last;
@@ -390,12 +390,13 @@ impl ExtendedModel {
         self.output(&st.x, &mut st.y);
     }
 
-    /// With `backlash_inertia`: the change of `q = z - y` over the coming step `pc` where the
-    /// play is not in contact (`z` coasts by `v coast`, `y` moves by its velocity times `h`),
-    /// so that the plant sees `q` change linearly over the step (`Psi1 E dq`) instead of held;
-    /// 0 in contact. Whether any output coasts.
+    /// With a play: the change of `q = z - y` over the coming step `pc` where the play is not
+    /// in contact (`z` coasts by `v coast`, 0 for a massless output; `y` moves by its velocity
+    /// times `h`), so that the plant sees `q` change linearly over the step (`Psi1 E dq`)
+    /// instead of held (second order in the step where the play is free); 0 in contact and on
+    /// the first step. Whether any output is free.
     #[inline(always)]
-    fn predict_coasting(&self, st: &mut RunState, pc: &Piece) -> bool {
+    fn predict_free_play(&self, st: &mut RunState, pc: &Piece) -> bool {
         let mut any = false;
         for i in 0..self.p {
             st.dq[i] = if st.touching[i] || st.h_last == 0.0 {
@@ -410,7 +411,8 @@ impl ExtendedModel {
 
     /// The output's velocity at the end of the step just taken, by the second-order backward
     /// difference over the last two steps (first order after the first step): the velocity a
-    /// massive backlash output takes on in an inelastic contact.
+    /// massive backlash output takes on in an inelastic contact, and the rate at which `q`
+    /// changes where the play is free.
     #[inline(always)]
     fn output_velocity(st: &RunState, i: usize) -> f64 {
         let d2 = (st.y[i] - st.y_start[i]) / st.h_last;
@@ -443,8 +445,8 @@ impl ExtendedModel {
         let hit = self.play.project_q(&mut st.q, &mut st.scratch);
         for i in 0..p {
             let znew = st.y[i] + st.q[i];
+            st.touching[i] = st.q[i] != st.qp[i];
             if self.inertia_tau > 0.0 {
-                st.touching[i] = st.q[i] != st.qp[i];
                 st.v[i] = if st.q[i] == st.qp[i] {
                     st.v[i] * pc.decay
                 } else if p == 1 {
