@@ -415,3 +415,22 @@ fn a_generalisation_at_another_minimum_is_refitted_from_its_simpler_form() {
     let coulomb = rep.ranking.iter().find(|r| r.label == "coulomb_friction(x2)").expect("fitted");
     assert!(stribeck.sse_estimation < coulomb.sse_estimation, "{stribeck:?} {coulomb:?}");
 }
+
+#[test]
+fn a_saturation_no_command_reaches_before_the_validation_segment_is_named_as_what_is_left() {
+    // Seed 10808 case 3 of the digital profile: no command of the estimation segment reaches
+    // the limit, so the saturation's fit is stuck at its start (zero gradient, nothing to fit),
+    // where it cuts the held-out error to 0.113 of the nominal's. The verdict said "the
+    // mismatch is outside the library"; it now names the saturation as what the held-out
+    // segment shows.
+    let case = bench_gen::generate_profile("input_saturation", 10808, 3, Profile::Digital);
+    let rep = diagnose(&case.nominal, &case.recording, &with_known_state(&case)).unwrap();
+    let sat = rep.ranking.iter().find(|r| r.label == "input_saturation").unwrap();
+    // Control: the fit is stuck, and it is not accepted on the estimation segment.
+    assert_eq!(sat.status, discovery::fit::FitStatus::ZeroGradient, "{sat:?}");
+    assert_eq!(rep.selected(), "none", "{}", rep.verdict);
+    assert!(rep.model_incomplete, "{}", rep.verdict);
+    assert!(rep.verdict.contains("but input_saturation improves the held-out segment"), "{}", rep.verdict);
+    assert!(rep.verdict.contains("input_saturation cuts the held-out error to"), "{}", rep.verdict);
+    assert!(!rep.verdict.contains("outside the library"), "{}", rep.verdict);
+}

@@ -131,6 +131,7 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
     }
     // Report: headline, verdict, notes.
     let headline = verdict::headline(&data, &outcome.fit_before, &fitted.fit_after, &mut notes);
+    let held_out = verdict::held_out_extension(&outcome.ranking, outcome.chosen.as_ref());
     let mut verdict = verdict::verdict(
         nominal.nominal_adequate,
         &outcome.missing_inputs,
@@ -138,10 +139,11 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
         &outcome.equivalents,
         &fitted.nominal_refit,
         &outcome.cv_rejected,
+        held_out.as_ref(),
         &headline.text,
     );
     // What the final model leaves: something still missing, and where.
-    let remaining = remaining(&data, &pass, &nominal, &outcome, &fitted);
+    let remaining = remaining(&data, &pass, &nominal, &outcome, &fitted, held_out);
     if let Some(r) = &remaining {
         verdict += &format!("; {}", verdict::still_missing(r, outcome.chosen.as_ref(), s.max_effects));
     }
@@ -183,7 +185,7 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 ///   line at 1 is thin (a noise level from 1000-2000 samples is uncertain by about 2 %).
 ///
 /// Neither exempts a model that a fitted candidate beats on the held-out segment by half
-/// ([`verdict::held_out_extension`]): the effect acts where the estimation data do not reach.
+/// ([`verdict::held_out_extension`], `held_out`): the effect acts where the estimation data do not reach.
 ///
 /// With the localisation of that residual.
 fn remaining(
@@ -192,6 +194,7 @@ fn remaining(
     nominal: &NominalFindings,
     outcome: &Outcome,
     fitted: &Fitted,
+    held_out: Option<(String, f64)>,
 ) -> Option<Remaining> {
     let t = &fitted.residual_fitted;
     if nominal.nominal_adequate || outcome.missing_inputs.iter().any(|c| c.missing) {
@@ -216,7 +219,6 @@ fn remaining(
     let unconfirmed = verdict::unconfirmed_extension(&outcome.ranking, outcome.chosen.as_ref(), margin);
     let within_noise = rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO);
     let above_noise = rms_over_noise.iter().any(|&r| r > 1.0);
-    let held_out = verdict::held_out_extension(&outcome.ranking, outcome.chosen.as_ref());
     let exempt =
         !mean_off_zero && (t_w.white || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)));
     if exempt && held_out.is_none() {

@@ -59,6 +59,7 @@ pub(super) fn verdict(
     equivalents: &[Equivalent],
     nominal_refit: &[NominalValue],
     cv_rejected: &[(String, f64, String)],
+    held_out: Option<&(String, f64)>,
     headline: &str,
 ) -> String {
     let missing: Vec<&MissingInput> = missing_inputs.iter().filter(|c| c.missing).collect();
@@ -106,6 +107,8 @@ pub(super) fn verdict(
             "the nominal residual is not white; {} improve(s) the estimation fit but not the held-out folds of the blocked cross-validation, so nothing is added (see the ranking)",
             cv_rejected.iter().map(|c| c.0.clone()).collect::<Vec<_>>().join(", ")
         )
+    } else if let Some((label, _)) = held_out {
+        format!("the nominal residual is not white; no effect of the library improves the estimation fit by the required margin, but {label} improves the held-out segment")
     } else {
         "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library".to_string()
     }
@@ -157,15 +160,21 @@ pub(super) fn unconfirmed_extension(ranking: &[Ranked], chosen: Option<&Ranked>,
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The fitted candidate (not the selected model, conclusive fit) that cuts the held-out
-/// (validation) error the most, to at most [`crate::select::DECISIVE_HELD_OUT_RATIO`] of the
-/// selected model's (the nominal's where nothing is selected): label and share. Such a
-/// candidate was not accepted, its estimation-segment gain being short of the margin.
+/// The fitted candidate (not the selected model; a conclusive fit, or one stuck with a zero
+/// gradient) that cuts the held-out (validation) error the most, to at most
+/// [`crate::select::DECISIVE_HELD_OUT_RATIO`] of the selected model's (the nominal's where
+/// nothing is selected): label and share. Such a candidate was not accepted, its
+/// estimation-segment gain being short of the margin. A fit stuck with a zero gradient is an
+/// effect that does not act on the estimation segment at all: fresh seed 10808 (digital)
+/// `input_saturation` #3, a limit no command reaches before the validation segment, stuck at
+/// its start and cutting the held-out error to 0.113 of the nominal's, was read as "outside the
+/// library".
 pub(super) fn held_out_extension(ranking: &[Ranked], chosen: Option<&Ranked>) -> Option<(String, f64)> {
     let base = chosen.map_or(1.0, |c| c.validation_ratio);
+    let judged = |r: &Ranked| r.status.conclusive() || r.status == crate::fit::FitStatus::ZeroGradient;
     ranking
         .iter()
-        .filter(|r| chosen.is_none_or(|c| c.label != r.label) && r.status.conclusive())
+        .filter(|r| chosen.is_none_or(|c| c.label != r.label) && judged(r))
         .map(|r| (r.label.clone(), r.validation_ratio / base.max(1e-300)))
         .filter(|(_, share)| *share <= crate::select::DECISIVE_HELD_OUT_RATIO)
         .min_by(|a, b| a.1.total_cmp(&b.1))
