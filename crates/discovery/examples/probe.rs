@@ -1,6 +1,7 @@
 //! Development aid: one benchmark case, its ranking, and a profile of the estimation cost
 //! along the true effect's main parameter (initial state refitted at each point).
-//! Usage: `[HOLD=zoh|foh] [SUB=N] cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`.
+//! Usage: `[HOLD=zoh|foh] [SUB=N] cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`
+//! (`CLASS` may be a pair `a+b` of the pair benchmark).
 use discovery::bench_gen;
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
@@ -19,8 +20,15 @@ fn main() {
     let seed: u64 = a[2].parse().unwrap();
     let idx: usize = a[3].parse().unwrap();
     let profile = a.get(4).and_then(|s| bench_gen::Profile::parse(s)).unwrap_or(bench_gen::Profile::Classic);
-    let case = bench_gen::generate_profile(class, seed, idx, profile);
-    println!("{} truth {:?}", case.description, case.truth);
+    // `a+b`: a case of the pair benchmark (`bench_gen::generate_pair`)
+    let case = match class.split_once('+') {
+        Some((a, b)) => {
+            let pair = [&*Box::leak(a.to_string().into_boxed_str()), &*Box::leak(b.to_string().into_boxed_str())];
+            bench_gen::generate_pair(pair, seed, idx, profile).expect("a pair that can co-occur")
+        }
+        None => bench_gen::generate_profile(class, seed, idx, profile),
+    };
+    println!("{} truth {:?}", case.description, case.truths);
     let s = discovery::DiagnoseSettings {
         initial_state: Some(discovery::InitialState {
             x0: case.nominal.x0.iter().copied().collect(),

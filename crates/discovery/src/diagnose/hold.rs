@@ -9,8 +9,9 @@
 //! an artefact of the missing effect, so the best few single effects are refitted under the
 //! other hold; where one beats the best effect of this hold by the tie margin (an input
 //! delay too), the hold is switched and the diagnosis is redone. Once the selection has
-//! settled under the switched hold ([`switch_undone`]), its model is refitted under the
-//! nominal's hold; where it fits better there, the switch is undone and the diagnosis redone.
+//! settled ([`selected_model_prefers_other`], once), its model is refitted under the other
+//! hold; where it fits better there, the hold is switched (a switch by the effects undone) and
+//! the diagnosis redone.
 //!
 //! Delay under an unknown hold ([`delay_under_both_holds`], `auto` only): a selected input
 //! delay is refitted under the other hold; where the two fits differ by less than the tie
@@ -205,17 +206,26 @@ pub(super) fn overturned_by_effects(
     None
 }
 
-/// After a switch by the effects ([`overturned_by_effects`]), once: the model the selection
-/// settled on under the switched `hold`, refitted under the hold the nominal preferred. A
-/// single effect that misses a second one can prefer the wrong hold: fresh pairs seed 10721
-/// (digital) `coulomb_friction + backlash_inertia` #1, a zero-order-held recording, was
-/// switched to the first-order hold by a single that fitted 315.9 better there. Under it the
-/// selection settled on backlash inertia + load-dependent friction, 355 in BIC worse than the
-/// true pair under the zero-order hold. Where the selected model fits better under the
-/// nominal's hold by more than the tie margin, the switch is undone (`report.switched` false,
-/// `report.effect_delta_bic` that model's preference) and the diagnosis redone under it, the
-/// effects not asked again. Returns that hold and the note that says why.
-pub(super) fn switch_undone(
+/// Auto hold, once the selection has settled (once per diagnosis): the selected model refitted
+/// under the other hold. Where it fits better there by more than the tie margin, the hold is
+/// switched to it and the diagnosis redone, the effects not asked again. Returns that hold and
+/// the note that says why.
+///
+/// - After a switch by the effects ([`overturned_by_effects`]) this undoes it: a single effect
+///   that misses a second one can prefer the wrong hold. Fresh pairs seed 10721 (digital)
+///   `coulomb_friction + backlash_inertia` #1, a zero-order-held recording, was switched to
+///   the first-order hold by a single that fitted 315.9 better there; under it the selection
+///   settled on backlash inertia + load-dependent friction, 355 in BIC worse than the true pair
+///   under the zero-order hold.
+/// - Without a switch the nominal's choice can be the missing effects' artefact that no single
+///   overturns: development pairs seed 10726 (digital) `constant_force + backlash_inertia` #0,
+///   zero-order held; the nominal preferred the first-order hold by 89.2, no single fitted
+///   better under the other, and the pair selected under it left a residual Q of 2684
+///   (30 under the zero-order hold).
+///
+/// A model with an input delay is left to [`delay_under_both_holds`]: delay and hold trade off
+/// (its interval covers both readings where they tie once the residual's colour is counted).
+pub(super) fn selected_model_prefers_other(
     data: &Setup,
     ctx: &FitContext,
     chosen: Option<&Ranked>,
@@ -224,25 +234,39 @@ pub(super) fn switch_undone(
 ) -> Option<(InputHold, String)> {
     let c = chosen?;
     let s = data.s;
+    if s.input_hold != HoldChoice::Auto || (!report.switched && !delay_offsets(c).is_empty()) {
+        return None;
+    }
     let other = other_hold(hold);
     let (_, r_o) = refit_under_other_hold(data, c, hold, ctx.substeps, data.x_scale.clone(), &s.fit);
-    // `BIC(this hold) - BIC(the nominal's hold)`, the same parameters
+    // `BIC(this hold) - BIC(the other hold)`, the same parameters
     let d = select::bic(c.sse_estimation, data.n_res, 0) - select::bic(r_o.sse, data.n_res, 0);
     if !(d > s.select.tie_bic) {
         return None;
     }
-    let note = format!(
-        "Input hold: the effects had switched it to {} (one fitted better there by {:.1} in BIC), but the model selected under {} ({}) fits better with {} by {d:.1}: the switch was undone and the diagnosis redone with {}.",
-        hold.name(),
-        report.effect_delta_bic.unwrap_or(f64::NAN),
-        hold.name(),
-        c.label,
-        other.name(),
-        other.name()
-    );
+    let note = if report.switched {
+        format!(
+            "Input hold: the effects had switched it to {} (one fitted better there by {:.1} in BIC), but the model selected under {} ({}) fits better with {} by {d:.1}: the switch was undone and the diagnosis redone with {}.",
+            hold.name(),
+            report.effect_delta_bic.unwrap_or(f64::NAN),
+            hold.name(),
+            c.label,
+            other.name(),
+            other.name()
+        )
+    } else {
+        format!(
+            "Input hold: the nominal model preferred {} (by {:.1} in BIC), but the model selected under it ({}) fits better with {} by {d:.1}: the missing effects had biased the nominal's choice; the diagnosis was redone with {}.",
+            hold.name(),
+            report.delta_bic.unwrap_or(f64::NAN),
+            c.label,
+            other.name(),
+            other.name()
+        )
+    };
     report.effect_delta_bic = Some(-d);
     report.chosen = other.name();
-    report.switched = false;
+    report.switched = !report.switched;
     Some((other, note))
 }
 

@@ -2,7 +2,9 @@
 //! localisation -> hypotheses -> selection and cross-validation ([`Pass::once`]).
 //!
 //! A pass ends in a restart (the next pass starts from the singles of this one) where
-//! - the best effects overturn an `auto` hold ([`super::hold::overturned_by_effects`], once), or
+//! - the best effects overturn an `auto` hold ([`super::hold::overturned_by_effects`], once),
+//! - the selected model fits better under the other hold
+//!   ([`super::hold::selected_model_prefers_other`], once), or
 //! - the selected model needs more sub-steps than the nominal (once): the whole selection is
 //!   rerun at the sub-steps it needs.
 //!
@@ -33,9 +35,12 @@ pub(super) struct Pass<'a> {
     pub notes: Vec<String>,
     /// Passes rerun for the selected model's sub-steps (at most one).
     substep_reruns: usize,
-    /// Whether a hold switched by the effects was checked against the selected model
-    /// ([`hold::switch_undone`], once).
+    /// Whether the hold was checked against the selected model
+    /// ([`hold::selected_model_prefers_other`], once).
     switch_checked: bool,
+    /// The model selected before that check switched the hold (the next pass adopts it where
+    /// its own selection ends worse: [`select::forward::adopt_carried`]).
+    carried: Option<Ranked>,
     /// Singles of the previous pass, or of a long record's screening (warm starts).
     prev_singles: Option<Vec<Ranked>>,
     /// The selected model's gain checked at a finer stepping: `(sub-steps, gain at the
@@ -116,6 +121,7 @@ impl<'a> Pass<'a> {
             notes: Vec::new(),
             substep_reruns: 0,
             switch_checked: false,
+            carried: None,
             // a long record's screening warm-starts the whole record's singles
             prev_singles: data.s.screened_singles.clone(),
             finer_check: None,
@@ -200,15 +206,30 @@ impl<'a> Pass<'a> {
         }
         // Selection and cross-validation.
         let mut selection = select::forward::select_all(&self.ctx, &plan, singles, &self.nom, nominal_adequate, margin);
+        if let Some(c) = self.carried.take() {
+            if select::forward::adopt_carried(&self.ctx, &plan, &mut selection, &self.nom, &c, margin) {
+                self.notes.push(format!(
+                    "The selection redone under the new hold ended worse than the model that asked for it ({}), refitted there: that model stands.",
+                    c.label
+                ));
+            }
+        }
         if self.needs_more_substeps(data, &selection) {
             return Ok(Step::Restart);
         }
-        if self.hold_report.switched && !self.switch_checked {
+        if !self.switch_checked {
             self.switch_checked = true;
-            let undone =
-                hold::switch_undone(data, &self.ctx, selection.chosen.as_ref(), self.hold, &mut self.hold_report);
+            let undone = hold::selected_model_prefers_other(
+                data,
+                &self.ctx,
+                selection.chosen.as_ref(),
+                self.hold,
+                &mut self.hold_report,
+            );
             if let Some((other, note)) = undone {
                 self.notes.push(note);
+                let carried = selection.chosen.clone().into_iter().collect();
+                self.carried = hold::carried_to_other_hold(carried, self.hold, data.dt).pop();
                 let warm = hold::carried_to_other_hold(selection.ranking.clone(), self.hold, data.dt);
                 self.hold = other;
                 self.disc_final = None;

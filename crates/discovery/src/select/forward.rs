@@ -139,6 +139,61 @@ pub(crate) fn select_all(
     Selection { ranking, chosen, ties, cv_rejected, equivalents }
 }
 
+/// The model selected before a change of hold that it asked for (`carried`, its effects and
+/// estimate), fitted again here from that estimate, where the selection under the new hold
+/// ended worse than it by the margin (or selected nothing): it replaces the selected model if it
+/// passes its cross-validation against the nominal model (the selection redone under the new
+/// hold need not find it again: fresh pairs seed 10814 (classic) `gap_width +
+/// coulomb_friction` #0, the pair 737 in BIC better under the first-order hold, and the
+/// selection redone there read an input backlash). Returns whether it did.
+pub(crate) fn adopt_carried(
+    ctx: &FitContext,
+    plan: &Plan,
+    selection: &mut Selection,
+    nom: &FitResult,
+    carried: &Ranked,
+    margin: f64,
+) -> bool {
+    let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
+    let sel = Selector { ctx, plan, bic_nom, val_sse_nom, margin };
+    let refit = carried.refit.then(|| carried.nominal.clone());
+    let mut c = fit_hypothesis(
+        ctx,
+        plan,
+        carried.parts.clone(),
+        refit,
+        Some(carried.params.clone()),
+        &carried.x0,
+        bic_nom,
+        val_sse_nom,
+    );
+    let beaten = selection.chosen.as_ref().map_or(bic_nom, |r| r.bic);
+    if !c.status.conclusive() || beaten - c.bic < margin {
+        return false;
+    }
+    let nominal_ranked = sel.nominal_ranked(nom);
+    let base_sse = cv_sse_of(ctx, plan, &nominal_ranked);
+    let cv = cross_validate(ctx, plan, &c, &nominal_ranked, &base_sse);
+    if !sel.supported(&c, &cv, bic_nom - c.bic) {
+        return false;
+    }
+    c.beats_nominal = true;
+    c.cv = Some(cv);
+    c.evidence = evidence_of(&c);
+    for r in selection.ranking.iter_mut().filter(|r| r.beats_nominal) {
+        r.beats_nominal = false;
+        r.evidence = evidence_of(r);
+    }
+    let labels = label_list(&c);
+    selection.ranking.retain(|r| r.refit != c.refit || !same_label_set(&label_list(r), &labels));
+    selection.ranking.insert(0, c.clone());
+    selection.ranking = rank(std::mem::take(&mut selection.ranking));
+    selection.chosen = Some(c);
+    selection.ties.clear();
+    selection.equivalents.clear();
+    true
+}
+
 /// What every step of the selection shares.
 struct Selector<'c, 'a> {
     ctx: &'c FitContext<'a>,
