@@ -16,6 +16,18 @@ fn scalar_sys() -> model::System {
     model::parse_str(text).unwrap()
 }
 
+/// A benchmark case diagnosed with its true initial state handed over, as the benchmark does.
+fn diagnose_known_state(case: &bench_gen::Case) -> discovery::Report {
+    let s = DiagnoseSettings {
+        initial_state: Some(InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        }),
+        ..Default::default()
+    };
+    diagnose(&case.nominal, &case.recording, &s).unwrap()
+}
+
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
@@ -264,14 +276,7 @@ fn a_hold_switched_by_one_effect_is_undone_by_the_selected_model() {
     // `a_delay_under_half_a_sample_is_found_under_the_other_hold` in
     // `hold_delay_and_stepping.rs`, read under the first-order hold.)
     let case = bench_gen::generate_pair(["coulomb_friction", "backlash_inertia"], 10721, 1, Profile::Digital).unwrap();
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        ..Default::default()
-    };
-    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    let r = diagnose_known_state(&case);
     // Control: the effects did switch the hold first.
     assert!(r.notes.iter().any(|n| n.contains("the diagnosis was redone with foh")), "{:?}", r.notes);
     assert!(r.notes.iter().any(|n| n.contains("the switch was undone")), "{:?}", r.notes);
@@ -288,14 +293,7 @@ fn a_delay_carried_to_the_other_hold_starts_half_a_sample_away() {
     // from its fit of the pass before, the delay from 0, where its fit did not move (+-6.5 in
     // BIC, nothing selected). A change of hold moves a delay by h/2, and its start is moved so.
     let case = bench_gen::generate_profile("input_delay", 10801, 1, Profile::Mixed);
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        ..Default::default()
-    };
-    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    let r = diagnose_known_state(&case);
     // Control: the effects switched the hold, so the second pass started from the first one's fits.
     assert!(r.notes.iter().any(|n| n.contains("the diagnosis was redone with foh")), "{:?}", r.notes);
     assert_eq!(r.selected(), "input_delay", "{}", r.verdict);
@@ -312,14 +310,7 @@ fn the_selected_model_overturns_a_hold_that_no_single_effect_did() {
     // residual Q of 2684; refitted under the zero-order hold it fits 761 better, and the
     // diagnosis is redone there.
     let case = bench_gen::generate_pair(["constant_force", "backlash_inertia"], 10726, 0, Profile::Digital).unwrap();
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        ..Default::default()
-    };
-    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    let r = diagnose_known_state(&case);
     // Control: the nominal model did prefer the first-order hold.
     assert!(r.hold.sse_foh.unwrap() < r.hold.sse_zoh.unwrap(), "{:?}", r.hold);
     assert!(r.notes.iter().any(|n| n.contains("the model selected under it")), "{:?}", r.notes);
@@ -337,14 +328,7 @@ fn the_model_that_switched_the_hold_stands_where_the_redone_selection_ends_worse
     // there read an input backlash (residual Q 2015). The pair refitted under the new hold
     // stands: it fits better than what the redone selection found.
     let case = bench_gen::generate_pair(["gap_width", "coulomb_friction"], 10814, 0, Profile::Classic).unwrap();
-    let s = DiagnoseSettings {
-        initial_state: Some(InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        ..Default::default()
-    };
-    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    let r = diagnose_known_state(&case);
     // Control: the selected model switched the hold.
     assert!(r.notes.iter().any(|n| n.contains("the model selected under it")), "{:?}", r.notes);
     assert!(r.notes.iter().any(|n| n.contains("that model stands")), "{:?}", r.notes);
