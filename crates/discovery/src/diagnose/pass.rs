@@ -197,11 +197,7 @@ impl<'a> Pass<'a> {
             &mut self.hold_report,
         );
         if let Some((other, note)) = overturned {
-            self.notes.push(note);
-            let warm = hold::carried_to_other_hold(singles, self.hold, data.dt);
-            self.hold = other;
-            self.disc_final = None;
-            self.restart(data, self.ctx.substeps, warm);
+            self.switch_hold(data, other, note, singles);
             return Ok(Step::Restart);
         }
         // Selection and cross-validation.
@@ -227,13 +223,9 @@ impl<'a> Pass<'a> {
                 &mut self.hold_report,
             );
             if let Some((other, note)) = undone {
-                self.notes.push(note);
                 let carried = selection.chosen.clone().into_iter().collect();
                 self.carried = hold::carried_to_other_hold(carried, self.hold, data.dt).pop();
-                let warm = hold::carried_to_other_hold(selection.ranking.clone(), self.hold, data.dt);
-                self.hold = other;
-                self.disc_final = None;
-                self.restart(data, self.ctx.substeps, warm);
+                self.switch_hold(data, other, note, selection.ranking);
                 return Ok(Step::Restart);
             }
         }
@@ -344,6 +336,16 @@ impl<'a> Pass<'a> {
         Some(format!(
             "{label} gained {g:.1} in BIC over the nominal at {k} sub-steps per sample, but {g_f:.1} with both refitted at {kf} (of which up to {owed:.1} may still be stepping error): its gain is within the simulator's stepping error, not evidence of physics; it is not reported."
         ))
+    }
+
+    /// The next pass under the hold `other` (the `note` says why), warm-started from `fits`
+    /// of this one with their delays moved by the h/2 the holds differ by.
+    fn switch_hold(&mut self, data: &'a Setup<'a>, other: InputHold, note: String, fits: Vec<Ranked>) {
+        self.notes.push(note);
+        let warm = hold::carried_to_other_hold(fits, self.hold, data.dt);
+        self.hold = other;
+        self.disc_final = None;
+        self.restart(data, self.ctx.substeps, warm);
     }
 
     /// The next pass: sub-steps converged from `k_from` under the current hold, the nominal
