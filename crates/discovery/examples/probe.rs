@@ -22,10 +22,7 @@ fn main() {
     let profile = a.get(4).and_then(|s| bench_gen::Profile::parse(s)).unwrap_or(bench_gen::Profile::Classic);
     // `a+b`: a case of the pair benchmark (`bench_gen::generate_pair`)
     let case = match class.split_once('+') {
-        Some((a, b)) => {
-            let pair = [&*Box::leak(a.to_string().into_boxed_str()), &*Box::leak(b.to_string().into_boxed_str())];
-            bench_gen::generate_pair(pair, seed, idx, profile).expect("a pair that can co-occur")
-        }
+        Some((a, b)) => bench_gen::generate_pair([a, b], seed, idx, profile).expect("a pair that can co-occur"),
         None => bench_gen::generate_profile(class, seed, idx, profile),
     };
     println!("{} truth {:?}", case.description, case.truths);

@@ -340,14 +340,14 @@ fn delay_shifted_start(c: &Ranked, hold: InputHold, dt: f64) -> Vec<f64> {
     start
 }
 
-/// The fits of one pass (under `hold`) as the warm starts of the next pass under the other
-/// hold: each delay moved by the half sample the holds differ by ([`delay_shifted_start`]).
-/// A hold change moves every other optimum a little, but a delay by h/2: carried over as it
-/// was, a first-order-held delay read as 0 under the zero-order hold (clipped there) starts the
-/// next pass at 0, where its fit does not move (fresh seed 10801 `input_delay` #1, mixed: the
-/// delay 1.4 ms, read as 0 under the first-order hold, and nothing selected).
-pub(super) fn carried_to_other_hold(fits: Vec<Ranked>, hold: InputHold, dt: f64) -> Vec<Ranked> {
-    fits.into_iter().map(|c| Ranked { params: delay_shifted_start(&c, hold, dt), ..c }).collect()
+/// A fit of one pass (under `hold`) as a warm start of the next pass under the other hold: its
+/// delays moved by the half sample the holds differ by ([`delay_shifted_start`]). A hold change
+/// moves every other optimum a little, but a delay by h/2: carried over as it was, a
+/// first-order-held delay read as 0 under the zero-order hold (clipped there) starts the next
+/// pass at 0, where its fit does not move (fresh seed 10801 `input_delay` #1, mixed: the delay
+/// 1.4 ms, read as 0 under the first-order hold, and nothing selected).
+pub(super) fn moved_to_other_hold(c: Ranked, hold: InputHold, dt: f64) -> Ranked {
+    Ranked { params: delay_shifted_start(&c, hold, dt), ..c }
 }
 
 /// Offsets of the delay parameters of `c` (a delay of the input as a whole or of one input).

@@ -37,7 +37,7 @@ pub(super) struct Pass<'a> {
     substep_reruns: usize,
     /// Whether the hold was checked against the selected model
     /// ([`hold::selected_model_prefers_other`], once).
-    switch_checked: bool,
+    hold_checked: bool,
     /// The model selected before that check switched the hold (the next pass adopts it where
     /// its own selection ends worse: [`select::forward::adopt_carried`]).
     carried: Option<Ranked>,
@@ -120,7 +120,7 @@ impl<'a> Pass<'a> {
             nom,
             notes: Vec::new(),
             substep_reruns: 0,
-            switch_checked: false,
+            hold_checked: false,
             carried: None,
             // a long record's screening warm-starts the whole record's singles
             prev_singles: data.s.screened_singles.clone(),
@@ -213,8 +213,8 @@ impl<'a> Pass<'a> {
         if self.needs_more_substeps(data, &selection) {
             return Ok(Step::Restart);
         }
-        if !self.switch_checked {
-            self.switch_checked = true;
+        if !self.hold_checked {
+            self.hold_checked = true;
             let undone = hold::selected_model_prefers_other(
                 data,
                 &self.ctx,
@@ -223,8 +223,7 @@ impl<'a> Pass<'a> {
                 &mut self.hold_report,
             );
             if let Some((other, note)) = undone {
-                let carried = selection.chosen.clone().into_iter().collect();
-                self.carried = hold::carried_to_other_hold(carried, self.hold, data.dt).pop();
+                self.carried = selection.chosen.clone().map(|c| hold::moved_to_other_hold(c, self.hold, data.dt));
                 self.switch_hold(data, other, note, selection.ranking);
                 return Ok(Step::Restart);
             }
@@ -342,7 +341,7 @@ impl<'a> Pass<'a> {
     /// of this one with their delays moved by the h/2 the holds differ by.
     fn switch_hold(&mut self, data: &'a Setup<'a>, other: InputHold, note: String, fits: Vec<Ranked>) {
         self.notes.push(note);
-        let warm = hold::carried_to_other_hold(fits, self.hold, data.dt);
+        let warm = fits.into_iter().map(|c| hold::moved_to_other_hold(c, self.hold, data.dt)).collect();
         self.hold = other;
         self.disc_final = None;
         self.restart(data, self.ctx.substeps, warm);

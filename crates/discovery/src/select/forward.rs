@@ -180,9 +180,9 @@ pub(crate) fn adopt_carried(
     c.beats_nominal = true;
     c.cv = Some(cv);
     c.evidence = evidence_of(&c);
-    for r in selection.ranking.iter_mut().filter(|r| r.beats_nominal) {
+    // (`rank` writes every entry's evidence again)
+    for r in selection.ranking.iter_mut() {
         r.beats_nominal = false;
-        r.evidence = evidence_of(r);
     }
     let labels = label_list(&c);
     selection.ranking.retain(|r| r.refit != c.refit || !same_label_set(&label_list(r), &labels));
