@@ -114,39 +114,10 @@ pub fn run_case_with(
     }
     let start = std::time::Instant::now();
     let r = diagnose(&case.nominal, &case.recording, &s);
-    let seconds = start.elapsed().as_secs_f64();
-    let mut out = CaseResult {
-        class: class.into(),
-        index,
-        description: case.description.clone(),
-        conditions: case.conditions.clone(),
-        nominal_fit: case.nominal_fit,
-        predicted: "error".into(),
-        selected: "error".into(),
-        ties: vec![],
-        correct: false,
-        correct_or_tied: false,
-        model_incomplete: false,
-        param_error: None,
-        param_errors: vec![],
-        true_param: case.truth.as_ref().map(main_param),
-        est_param: None,
-        est_param_other_hold: None,
-        hold_used: String::new(),
-        est_std: None,
-        est_std_statistical: None,
-        est_std_jackknife: None,
-        fit_before: f64::NAN,
-        fit_after: f64::NAN,
-        delta_bic_selected: f64::NAN,
-        delta_bic_truth: None,
-        seconds,
-        error: None,
-    };
+    let mut out = CaseResult::unscored(class, index, &case, start.elapsed().as_secs_f64());
     match r {
         Err(e) => out.error = Some(e.to_string()),
         Ok(rep) => {
-            let fitted = rep.fitted_model.as_ref().map(|m| m.effects.list.clone()).unwrap_or_default();
             out.predicted = rep.effects.first().map(|e| e.kind.clone()).unwrap_or_else(|| "none".into());
             out.selected = rep.selected();
             out.hold_used = rep.hold.chosen.to_string();
@@ -164,79 +135,120 @@ pub fn run_case_with(
                 .map(|r| r.delta_bic)
                 .reduce(f64::max);
             if out.correct {
-                // Compare like with like: the same kind and, for forces, the same state (a force
-                // on another state is an observationally equivalent but different parameter).
-                let same = |a: &Effect, b: &Effect| match (a, b) {
-                    (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. })
-                    | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. })
-                    | (Effect::StribeckFriction { state: i, .. }, Effect::StribeckFriction { state: j, .. })
-                    | (Effect::AsymmetricCoulomb { state: i, .. }, Effect::AsymmetricCoulomb { state: j, .. })
-                    | (Effect::LoadFriction { state: i, .. }, Effect::LoadFriction { state: j, .. })
-                    | (Effect::Cogging { state: i, .. }, Effect::Cogging { state: j, .. }) => i == j,
-                    _ => a.kind() == b.kind(),
-                };
-                if let (Some(t), Some(e)) =
-                    (case.truth.as_ref(), case.truth.as_ref().and_then(|t| fitted.iter().find(|e| same(t, e))))
-                {
-                    // An input delay: the report states it under the hold used and, with
-                    // `other_hold`, under the other. The parameter error compares like with
-                    // like (the reading under the generator's convention: `foh` for the
-                    // continuous signal, `zoh` for held samples); the coverage (`est_param`
-                    // against `est_std`) scores the reported reading whatever hold the tool
-                    // used (the hold is never passed to it: where the data cannot tell the
-                    // holds apart, the delay's interval must cover both readings).
-                    let (tv, ev) = (main_param(t), main_param(e));
-                    let other = rep
-                        .effects
-                        .iter()
-                        .find(|f| f.kind == names::INPUT_DELAY)
-                        .and_then(|f| f.other_hold.as_ref())
-                        .filter(|_| matches!(t, Effect::InputDelay { .. }));
-                    let truth_hold = if case.conditions.hold == "zoh" { "zoh" } else { "foh" };
-                    let ev_convention = other.filter(|o| o.0 == truth_hold).map_or(ev, |o| o.1[0].1);
-                    out.est_param_other_hold = other.map(|o| o.1[0].1);
-                    out.est_param = Some(ev);
-                    out.param_error = Some((ev_convention - tv).abs() / tv.abs().max(1e-300));
-                    if let Some(truth_params) = physics::every_parameter(t) {
-                        out.param_errors = truth_params
-                            .iter()
-                            .zip(all_params(e))
-                            .map(|((n, a), (_, b))| (n.to_string(), (b - a).abs() / a.abs().max(1e-300)))
-                            .collect();
-                    }
-                    let label = match t {
-                        Effect::CoulombFriction { state, .. }
-                        | Effect::ConstantForce { state, .. }
-                        | Effect::StribeckFriction { state, .. }
-                        | Effect::AsymmetricCoulomb { state, .. }
-                        | Effect::LoadFriction { state, .. }
-                        | Effect::Cogging { state, .. } => {
-                            format!("{}(x{})", t.kind(), state + 1)
-                        }
-                        _ => String::new(),
-                    };
-                    // The main parameter's sigma: that of its hypothesis parameter, or of the
-                    // report's derived main parameter (Stribeck static level, cogging amplitude).
-                    let sd =
-                        |pick: fn(&crate::diagnose::FittedEffect) -> &Vec<(String, f64)>,
-                         pick_derived: fn(&crate::diagnose::DerivedParameter) -> f64| {
-                            let f = rep
-                                .effects
-                                .iter()
-                                .find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))?;
-                            match main_param_name(t) {
-                                Some(name) => pick(f).iter().find(|u| u.0 == name).map(|u| u.1),
-                                None => f.derived.as_ref().map(pick_derived),
-                            }
-                        };
-                    out.est_std = sd(|f| &f.uncertainty, |d| d.uncertainty);
-                    out.est_std_statistical = sd(|f| &f.uncertainty_statistical, |d| d.uncertainty_statistical);
-                    out.est_std_jackknife = sd(|f| &f.uncertainty_jackknife, |d| d.uncertainty_jackknife);
-                }
+                score_estimate(&case, &rep, &mut out);
             }
         }
     }
     out
+}
+
+impl CaseResult {
+    /// A case's result before its diagnosis is scored (`error` until then).
+    fn unscored(class: &'static str, index: usize, case: &bench_gen::Case, seconds: f64) -> Self {
+        CaseResult {
+            class: class.into(),
+            index,
+            description: case.description.clone(),
+            conditions: case.conditions.clone(),
+            nominal_fit: case.nominal_fit,
+            predicted: "error".into(),
+            selected: "error".into(),
+            ties: vec![],
+            correct: false,
+            correct_or_tied: false,
+            model_incomplete: false,
+            param_error: None,
+            param_errors: vec![],
+            true_param: case.truth.as_ref().map(main_param),
+            est_param: None,
+            est_param_other_hold: None,
+            hold_used: String::new(),
+            est_std: None,
+            est_std_statistical: None,
+            est_std_jackknife: None,
+            fit_before: f64::NAN,
+            fit_after: f64::NAN,
+            delta_bic_selected: f64::NAN,
+            delta_bic_truth: None,
+            seconds,
+            error: None,
+        }
+    }
+}
+
+/// Like with like: the same kind and, for forces, the same state (a force on another state
+/// is an observationally equivalent but different parameter).
+fn same_site(a: &Effect, b: &Effect) -> bool {
+    match (a, b) {
+        (Effect::CoulombFriction { state: i, .. }, Effect::CoulombFriction { state: j, .. })
+        | (Effect::ConstantForce { state: i, .. }, Effect::ConstantForce { state: j, .. })
+        | (Effect::StribeckFriction { state: i, .. }, Effect::StribeckFriction { state: j, .. })
+        | (Effect::AsymmetricCoulomb { state: i, .. }, Effect::AsymmetricCoulomb { state: j, .. })
+        | (Effect::LoadFriction { state: i, .. }, Effect::LoadFriction { state: j, .. })
+        | (Effect::Cogging { state: i, .. }, Effect::Cogging { state: j, .. }) => i == j,
+        _ => a.kind() == b.kind(),
+    }
+}
+
+/// The report's label of a force acting on a state (`coulomb_friction(x2)`; empty for the
+/// other effects, whose kind names them).
+fn state_label(t: &Effect) -> String {
+    match t {
+        Effect::CoulombFriction { state, .. }
+        | Effect::ConstantForce { state, .. }
+        | Effect::StribeckFriction { state, .. }
+        | Effect::AsymmetricCoulomb { state, .. }
+        | Effect::LoadFriction { state, .. }
+        | Effect::Cogging { state, .. } => format!("{}(x{})", t.kind(), state + 1),
+        _ => String::new(),
+    }
+}
+
+/// A correctly named single: its main parameter's error against the truth and its reported
+/// sigmas (the effect fitted at the true site; nothing where it was fitted elsewhere).
+fn score_estimate(case: &bench_gen::Case, rep: &crate::Report, out: &mut CaseResult) {
+    let fitted = rep.fitted_model.as_ref().map(|m| m.effects.list.clone()).unwrap_or_default();
+    let Some(t) = case.truth.as_ref() else { return };
+    let Some(e) = fitted.iter().find(|e| same_site(t, e)) else { return };
+    // An input delay: the report states it under the hold used and, with `other_hold`, under
+    // the other. The parameter error compares like with like (the reading under the
+    // generator's convention: `foh` for the continuous signal, `zoh` for held samples); the
+    // coverage (`est_param` against `est_std`) scores the reported reading whatever hold the
+    // tool used (the hold is never passed to it: where the data cannot tell the holds apart,
+    // the delay's interval must cover both readings).
+    let (tv, ev) = (main_param(t), main_param(e));
+    let other = rep
+        .effects
+        .iter()
+        .find(|f| f.kind == names::INPUT_DELAY)
+        .and_then(|f| f.other_hold.as_ref())
+        .filter(|_| matches!(t, Effect::InputDelay { .. }));
+    let truth_hold = if case.conditions.hold == "zoh" { "zoh" } else { "foh" };
+    let ev_convention = other.filter(|o| o.0 == truth_hold).map_or(ev, |o| o.1[0].1);
+    out.est_param_other_hold = other.map(|o| o.1[0].1);
+    out.est_param = Some(ev);
+    out.param_error = Some((ev_convention - tv).abs() / tv.abs().max(1e-300));
+    if let Some(truth_params) = physics::every_parameter(t) {
+        out.param_errors = truth_params
+            .iter()
+            .zip(all_params(e))
+            .map(|((n, a), (_, b))| (n.to_string(), (b - a).abs() / a.abs().max(1e-300)))
+            .collect();
+    }
+    let label = state_label(t);
+    // The main parameter's sigma: that of its hypothesis parameter, or of the report's derived
+    // main parameter (Stribeck static level, cogging amplitude).
+    let sd = |pick: fn(&crate::diagnose::FittedEffect) -> &Vec<(String, f64)>,
+              pick_derived: fn(&crate::diagnose::DerivedParameter) -> f64| {
+        let f = rep.effects.iter().find(|f| f.kind == t.kind() && (label.is_empty() || f.label == label))?;
+        match main_param_name(t) {
+            Some(name) => pick(f).iter().find(|u| u.0 == name).map(|u| u.1),
+            None => f.derived.as_ref().map(pick_derived),
+        }
+    };
+    out.est_std = sd(|f| &f.uncertainty, |d| d.uncertainty);
+    out.est_std_statistical = sd(|f| &f.uncertainty_statistical, |d| d.uncertainty_statistical);
+    out.est_std_jackknife = sd(|f| &f.uncertainty_jackknife, |d| d.uncertainty_jackknife);
 }
 
 /// The selected model's BIC gain over the nominal, from the ranking (0 when nothing was added).
@@ -320,7 +332,11 @@ pub fn run_classes(
 impl BenchResult {
     /// Confusion matrix and summary as text.
     pub fn to_text(&self) -> String {
-        let k = self.classes.len();
+        [self.confusion_text(), self.naming_text(), self.parameter_text(), self.time_text()].concat()
+    }
+
+    /// The confusion matrix: true class per row, predicted per column (then `other`).
+    fn confusion_text(&self) -> String {
         let short = |s: &str| s.chars().take(9).collect::<String>();
         let mut s = format!("{:>18}", "true \\ predicted");
         for c in &self.classes {
@@ -334,13 +350,18 @@ impl BenchResult {
             }
             s.push('\n');
         }
+        s
+    }
+
+    /// Top-1 (with reported ties), false alarms on `none`, misses, and top-1 per class.
+    fn naming_text(&self) -> String {
         let total = self.cases.len();
         let correct = self.cases.iter().filter(|c| c.correct).count();
         let tied = self.cases.iter().filter(|c| c.correct_or_tied).count();
         let non_none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class != "none").collect();
         let none: Vec<&CaseResult> = self.cases.iter().filter(|c| c.class == "none").collect();
         let false_alarms = none.iter().filter(|c| c.predicted != "none").count();
-        s += &format!(
+        let mut s = format!(
             "\ncorrect names: {correct}/{total} ({:.1} %); counting reported ties: {tied}/{total} ({:.1} %)\n",
             100.0 * correct as f64 / total.max(1) as f64,
             100.0 * tied as f64 / total.max(1) as f64
@@ -365,14 +386,19 @@ impl BenchResult {
                 rows.iter().filter(|r| r.correct_or_tied).count()
             );
         }
-        s += "\nparameter error of the main parameter (correctly named cases):\n";
+        s
+    }
+
+    /// The main parameter's error per class (within 15 %, and in reported sigmas), every
+    /// parameter of the friction library, and the pooled figures.
+    fn parameter_text(&self) -> String {
+        let mut s = "\nparameter error of the main parameter (correctly named cases):\n".to_string();
         for c in self.classes.iter().skip(1) {
-            let errs: Vec<f64> = self.cases.iter().filter(|r| &r.class == c).filter_map(|r| r.param_error).collect();
-            if errs.is_empty() {
+            let mut e: Vec<f64> = self.cases.iter().filter(|r| &r.class == c).filter_map(|r| r.param_error).collect();
+            if e.is_empty() {
                 s += &format!("  {c:>18}: no correctly named case\n");
                 continue;
             }
-            let mut e = errs.clone();
             e.sort_by(f64::total_cmp);
             let within = e.iter().filter(|x| **x <= 0.15).count();
             // Error in units of the reported uncertainty.
@@ -396,7 +422,28 @@ impl BenchResult {
                 z.len()
             );
         }
-        // Every parameter of the friction-library effects.
+        s += &self.every_parameter_text();
+        let (mut w2, mut w2s, mut nz, mut w15, mut np) = (0, 0, 0, 0, 0);
+        for r in &self.cases {
+            if let Some(e) = r.param_error {
+                np += 1;
+                w15 += usize::from(e <= 0.15);
+            }
+            if let (Some(e), Some(t), Some(sd)) = (r.est_param, r.true_param, r.est_std) {
+                nz += 1;
+                w2 += usize::from((e - t).abs() <= 2.0 * sd);
+                w2s += usize::from((e - t).abs() <= 2.0 * r.est_std_statistical.unwrap_or(sd));
+            }
+        }
+        s += &format!(
+            "all classes: main parameter within 15 %: {w15}/{np}; errors within 2 reported sigma: {w2}/{nz} ({w2s}/{nz} within 2 statistical sigma, without the jackknife)\n"
+        );
+        s
+    }
+
+    /// Every parameter of the friction-library effects: median, max, within 15 %.
+    fn every_parameter_text(&self) -> String {
+        let mut s = String::new();
         for c in self.classes.iter() {
             let rows: Vec<&CaseResult> =
                 self.cases.iter().filter(|r| &r.class == c && !r.param_errors.is_empty()).collect();
@@ -415,25 +462,13 @@ impl BenchResult {
             }
             s.push('\n');
         }
-        let (mut w2, mut w2s, mut nz, mut w15, mut np) = (0, 0, 0, 0, 0);
-        for r in &self.cases {
-            if let Some(e) = r.param_error {
-                np += 1;
-                w15 += usize::from(e <= 0.15);
-            }
-            if let (Some(e), Some(t), Some(sd)) = (r.est_param, r.true_param, r.est_std) {
-                nz += 1;
-                w2 += usize::from((e - t).abs() <= 2.0 * sd);
-                w2s += usize::from((e - t).abs() <= 2.0 * r.est_std_statistical.unwrap_or(sd));
-            }
-        }
-        s += &format!(
-            "all classes: main parameter within 15 %: {w15}/{np}; errors within 2 reported sigma: {w2}/{nz} ({w2s}/{nz} within 2 statistical sigma, without the jackknife)\n"
-        );
-        let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
-        s += &format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / total.max(1) as f64);
-        let _ = k;
         s
+    }
+
+    /// The diagnoses' total time and time per case.
+    fn time_text(&self) -> String {
+        let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
+        format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / self.cases.len().max(1) as f64)
     }
 }
 

@@ -516,11 +516,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     let Sampling { dt: dig_dt, over, drive, noise_rho } = sampling(profile, mix);
     let n = rng.random_range(2..=4);
     let plant = random_plant(&mut rng, n, over);
-    let tau_slow = {
-        let F = &plant.A + &plant.E * &plant.C;
-        let mu = F.complex_eigenvalues().iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max);
-        1.0 / mu.abs()
-    };
+    let tau_slow = slowest_time_constant(&plant);
     let period = TAU / plant.omega0;
     let dt = dig_dt.unwrap_or(period / 60.0);
     let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period) * length_factor();
@@ -546,12 +542,7 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
         let m = clean_nom.iter().sum::<f64>() / ns as f64;
         (clean_nom.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ns as f64).sqrt()
     };
-    // Velocity and position scales of the nominal run (y is the position, x_1 its rate).
-    fshape.v_rms = ((1..ns - 1).map(|k| ((clean_nom[k + 1] - clean_nom[k - 1]) / (2.0 * dt)).powi(2)).sum::<f64>()
-        / (ns - 2) as f64)
-        .sqrt();
-    fshape.pos_range = clean_nom.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-        - clean_nom.iter().copied().fold(f64::INFINITY, f64::min);
+    (fshape.v_rms, fshape.pos_range) = speed_and_range(&clean_nom, dt);
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let noise = measurement_noise(&mut rng, ns, noise_std, noise_rho);
     let measure_all = |effs: &[&Effect]| -> Vec<f64> {
@@ -592,26 +583,8 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
         measure_all(&effs)
     };
     let nominal_fit = fit_percent(&y, &clean_nom);
-    let theta = if nominal_has_play {
-        geometry::Shape::Interval(geometry::Interval::symmetric(plant.half_width).expect("positive half-width"))
-    } else {
-        geometry::Shape::origin(1)
-    };
-    let x0v = DVector::from_column_slice(&x0);
-    let z0 = &plant.C * &x0v;
-    let nominal = System::builder()
-        .name(format!("bench {} #{index} (n = {n})", classes.join("+")))
-        .A(plant.A.clone())
-        .B(plant.B.clone())
-        .C(plant.C.clone())
-        .E(plant.E.clone())
-        .theta(theta)
-        .input(Input::Sine { amplitudes: vec![1.0], omega: plant.omega0, phase: 0.0 })
-        .x0(x0v)
-        .z0(z0)
-        .sim(SimDefaults { dt, periods: 20, t_end: Some(duration) })
-        .build()
-        .expect("generated plant is valid");
+    let name = format!("bench {} #{index} (n = {n})", classes.join("+"));
+    let nominal = nominal_system(name, &plant, nominal_has_play, &x0, dt, duration);
     let recording = Recording::from_samples(
         &format!("bench-{}-{index}", classes.join("+")),
         &t,
@@ -627,6 +600,48 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
         conditions.short()
     );
     Case { class, nominal, truth, truths, classes: classes.to_vec(), recording, nominal_fit, description, conditions }
+}
+
+/// The slowest time constant of the plant with the play closed (`1 / |max Re eig(A + E C)|`).
+fn slowest_time_constant(plant: &Plant) -> f64 {
+    let F = &plant.A + &plant.E * &plant.C;
+    let mu = F.complex_eigenvalues().iter().map(|c| c.re).fold(f64::NEG_INFINITY, f64::max);
+    1.0 / mu.abs()
+}
+
+/// The velocity (RMS of the central difference) and position (range) scales of a position
+/// record `y` sampled at `dt`.
+fn speed_and_range(y: &[f64], dt: f64) -> (f64, f64) {
+    let ns = y.len();
+    let v_rms =
+        ((1..ns - 1).map(|k| ((y[k + 1] - y[k - 1]) / (2.0 * dt)).powi(2)).sum::<f64>() / (ns - 2) as f64).sqrt();
+    let range = y.iter().copied().fold(f64::NEG_INFINITY, f64::max) - y.iter().copied().fold(f64::INFINITY, f64::min);
+    (v_rms, range)
+}
+
+/// The nominal model file of a case: the plant, its play where the nominal has one (else
+/// none), the true initial state, and simulation defaults over the record's duration.
+fn nominal_system(name: String, plant: &Plant, has_play: bool, x0: &[f64], dt: f64, duration: f64) -> System {
+    let theta = if has_play {
+        geometry::Shape::Interval(geometry::Interval::symmetric(plant.half_width).expect("positive half-width"))
+    } else {
+        geometry::Shape::origin(1)
+    };
+    let x0v = DVector::from_column_slice(x0);
+    let z0 = &plant.C * &x0v;
+    System::builder()
+        .name(name)
+        .A(plant.A.clone())
+        .B(plant.B.clone())
+        .C(plant.C.clone())
+        .E(plant.E.clone())
+        .theta(theta)
+        .input(Input::Sine { amplitudes: vec![1.0], omega: plant.omega0, phase: 0.0 })
+        .x0(x0v)
+        .z0(z0)
+        .sim(SimDefaults { dt, periods: 20, t_end: Some(duration) })
+        .build()
+        .expect("generated plant is valid")
 }
 
 /// A standard normal sample (Box-Muller).

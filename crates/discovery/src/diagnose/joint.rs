@@ -167,15 +167,7 @@ pub fn diagnose_recordings(
     // `parallel: false` holds for the fits' Jacobians and starts too.
     let serial = s.serial_fits();
     let s = serial.as_ref().unwrap_or(s);
-    let Some(first) = recs.first() else {
-        return Err(DiscoveryError::NoRecording);
-    };
-    for r in recs.iter().chain(validate_on).skip(1) {
-        same_signals(first, r)?;
-    }
-    for r in recs.iter().chain(validate_on) {
-        s.validate(sys, r).map_err(|e| in_recording(r, e))?;
-    }
+    let first = checked_recordings(sys, recs, validate_on, s)?;
     // 1. Each recording on its own.
     let mut singles: Vec<(Report, Selected)> = Vec::new();
     for r in recs {
@@ -216,56 +208,30 @@ pub fn diagnose_recordings(
         (vec![], (!cands.is_empty()).then_some((0, f64::NAN)))
     };
     // 5. The selected model fitted on every recording, checked on those validated on.
-    let mut selected = best.map(|b| b.0);
-    let mut adopted = selected.map(|ci| {
-        let c = &cands[ci];
-        let sh = if n_fit >= 2 { fit_on(&data, &fit_idx, c, &base, free.as_ref(), s) } else { c.start.clone() };
-        sh
+    let adopted = best.and_then(|(ci, _)| {
+        let sh = if n_fit >= 2 { fit_on(&data, &fit_idx, &cands[ci], &base, free.as_ref(), s) } else { cands[ci].start.clone() };
+        let judged: Vec<Judged> =
+            data.iter().enumerate().map(|(j, d)| judge(d, &cands[ci], &sh, &base[j].x0, free.as_ref(), s)).collect();
+        let worse: Vec<usize> = (n_fit..all.len()).filter(|&j| judged[j].ms > base[j].ms).collect();
+        if worse.is_empty() {
+            return Some((ci, sh, judged));
+        }
+        notes.push(format!(
+            "{} fitted on the recordings worsens the recording(s) validated on ({}): not adopted, the nominal model stands.",
+            cands[ci].label,
+            worse.iter().map(|&j| format!("{} {} -> {}", all[j].source, fmt_units(&base[j].rmse, &units), fmt_units(&judged[j].rmse, &units))).collect::<Vec<_>>().join("; ")
+        ));
+        None
     });
-    let mut judged_final: Vec<Judged> = match (selected, &adopted) {
-        (Some(ci), Some(sh)) => {
-            data.iter().enumerate().map(|(j, d)| judge(d, &cands[ci], sh, &base[j].x0, free.as_ref(), s)).collect()
-        }
-        _ => vec![],
+    let selected = adopted.as_ref().map(|a| a.0);
+    let (final_cand, final_shared, final_judged): (&Candidate, Shared, &[Judged]) = match &adopted {
+        Some((ci, sh, judged)) => (&cands[*ci], sh.clone(), judged),
+        None => (&nominal, nominal.start.clone(), &base),
     };
-    if let Some(ci) = selected {
-        let worse: Vec<usize> = (n_fit..all.len()).filter(|&j| judged_final[j].ms > base[j].ms).collect();
-        if !worse.is_empty() {
-            notes.push(format!(
-                "{} fitted on the recordings worsens the recording(s) validated on ({}): not adopted, the nominal model stands.",
-                cands[ci].label,
-                worse.iter().map(|&j| format!("{} {} -> {}", all[j].source, fmt_units(&base[j].rmse, &units), fmt_units(&judged_final[j].rmse, &units))).collect::<Vec<_>>().join("; ")
-            ));
-            selected = None;
-            adopted = None;
-            judged_final = vec![];
-        }
-    }
-    let (final_cand, final_shared) = match (selected, adopted) {
-        (Some(ci), Some(sh)) => (&cands[ci], sh),
-        _ => (&nominal, nominal.start.clone()),
-    };
-    let final_judged: &[Judged] = if judged_final.is_empty() { &base } else { &judged_final };
     let std = joint_std(&data, &fit_idx, final_cand, &final_shared, final_judged, free.as_ref(), s);
     // The report.
-    let recordings: Vec<RecordingRow> = all
-        .iter()
-        .enumerate()
-        .map(|(j, r)| RecordingRow {
-            source: r.source.clone(),
-            role: if j < n_fit { "fit" } else { "validation" },
-            samples: r.len(),
-            dt: r.dt,
-            rmse_nominal: base[j].rmse.clone(),
-            rmse_own_fit: own_rmse[j].clone(),
-            rmse_left_out: match selected {
-                Some(ci) if n_fit >= 2 && j < n_fit => rows.get(ci).map(|c| c.rmse_left_out[j].clone()),
-                _ => None,
-            },
-            rmse_joint: final_judged[j].rmse.clone(),
-            worse_than_nominal: final_judged[j].ms > base[j].ms * (1.0 + 1e-9),
-        })
-        .collect();
+    let left_out = selected.filter(|_| n_fit >= 2).and_then(|ci| rows.get(ci));
+    let recordings = recording_rows(&all, n_fit, &base, &own_rmse, left_out, final_judged);
     let pb0 = problem(&data[0].ctx, final_cand, free.as_ref(), &final_shared.nominal);
     let effects = joint_effects(final_cand, &final_shared, &std.0);
     let nominal_refit = nominal_values(free.as_ref(), final_cand, &final_shared, &std.1, &std.2);
@@ -296,6 +262,52 @@ pub fn diagnose_recordings(
         per_recording: singles.iter().map(|(r, _)| (r.recording.clone(), r.verdict.clone())).collect(),
         fitted_model: Some(fitted_model),
     })
+}
+
+/// The first recording, once every recording has the first's signals and passes the
+/// settings' checks (each error names its recording).
+fn checked_recordings<'r>(
+    sys: &System,
+    recs: &'r [Recording],
+    validate_on: &[Recording],
+    s: &DiagnoseSettings,
+) -> Result<&'r Recording, DiscoveryError> {
+    let Some(first) = recs.first() else {
+        return Err(DiscoveryError::NoRecording);
+    };
+    for r in recs.iter().chain(validate_on).skip(1) {
+        same_signals(first, r)?;
+    }
+    for r in recs.iter().chain(validate_on) {
+        s.validate(sys, r).map_err(|e| in_recording(r, e))?;
+    }
+    Ok(first)
+}
+
+/// The report's row of each recording (fitted on, then validated on): the nominal, its own
+/// refit, the selected candidate left out (`left_out`), the adopted model (`adopted`).
+fn recording_rows(
+    all: &[&Recording],
+    n_fit: usize,
+    base: &[Judged],
+    own_rmse: &[Option<Vec<f64>>],
+    left_out: Option<&CandidateRow>,
+    adopted: &[Judged],
+) -> Vec<RecordingRow> {
+    all.iter()
+        .enumerate()
+        .map(|(j, r)| RecordingRow {
+            source: r.source.clone(),
+            role: if j < n_fit { "fit" } else { "validation" },
+            samples: r.len(),
+            dt: r.dt,
+            rmse_nominal: base[j].rmse.clone(),
+            rmse_own_fit: own_rmse[j].clone(),
+            rmse_left_out: left_out.filter(|_| j < n_fit).map(|c| c.rmse_left_out[j].clone()),
+            rmse_joint: adopted[j].rmse.clone(),
+            worse_than_nominal: adopted[j].ms > base[j].ms * (1.0 + 1e-9),
+        })
+        .collect()
 }
 
 /// The fit context of each recording. Hold and sub-steps: each recording fitted on as its
