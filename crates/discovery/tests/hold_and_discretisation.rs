@@ -336,3 +336,49 @@ fn the_model_that_switched_the_hold_stands_where_the_redone_selection_ends_worse
     assert!(kinds.contains(&"gap_width") && kinds.contains(&"coulomb_friction"), "{}", r.verdict);
     assert!(!r.model_incomplete, "{}", r.verdict);
 }
+
+#[test]
+fn a_first_order_held_delay_under_half_a_sample_beside_an_offset_switches_the_hold() {
+    // Mixed-profile pairs seed 10914, input delay + sensor offset #1: a first-order-held
+    // command delayed by 6.3 ms, sampled at 15.1 ms. The nominal model prefers the zero-order
+    // hold by 124.4 in BIC; there the delay would be negative, so sensor offset + input delay
+    // read it as 0 (+2188.5) and sensor offset + backlash inertia was selected (+2293.5). Under
+    // the first-order hold the true pair fits better and is selected.
+    let case = bench_gen::generate_pair(["input_delay", "sensor_offset"], 10914, 1, Profile::Mixed).unwrap();
+    let r = diagnose_known_state(&case);
+    // Control: the nominal model did prefer the zero-order hold.
+    assert!(r.hold.sse_zoh.unwrap() < r.hold.sse_foh.unwrap(), "{:?}", r.hold);
+    assert!(r.notes.iter().any(|n| n.contains("reads its delay as 0")), "{:?}", r.notes);
+    assert_eq!((r.hold.chosen, r.hold.switched), ("foh", true), "{:?}", r.hold);
+    let kinds: Vec<&str> = r.effects.iter().map(|e| e.kind.as_str()).collect();
+    assert!(kinds.contains(&"input_delay") && kinds.contains(&"sensor_offset"), "{}", r.verdict);
+    let d = r.effects.iter().find(|e| e.kind == "input_delay").unwrap();
+    let (est, sd) = (d.params[0].1, d.uncertainty[0].1);
+    let truth = 0.006279839857144656;
+    assert!((est - truth).abs() <= 2.0 * sd, "delay {est:.4e} +- {sd:.1e} against {truth:.4e}");
+}
+
+#[test]
+fn a_delay_at_zero_under_a_zero_order_held_recording_leaves_the_hold() {
+    // Negative control of the check above: a zero-order-held recording with a sensor offset
+    // alone. The input delay reads 0 there too, but under the first-order hold (delay near
+    // h/2) it fits no better than the offset selected under the zero-order hold: the hold
+    // stays, nothing is added beside the offset.
+    let case = (0..16)
+        .map(|i| bench_gen::generate_profile("sensor_offset", 4242, i, Profile::Digital))
+        .find(|c| c.conditions.hold == "zoh")
+        .expect("a zero-order-held case");
+    let r = diagnose_known_state(&case);
+    let dt = case.conditions.dt;
+    // The check had a model to ask: a delay read as 0.
+    assert!(
+        r.ranking
+            .iter()
+            .any(|c| c.kinds.iter().any(|k| k == "input_delay") && c.params.last().is_some_and(|&d| d <= 1e-3 * dt)),
+        "{:?}",
+        r.ranking.iter().map(|c| (&c.label, &c.params)).collect::<Vec<_>>()
+    );
+    assert!(!r.notes.iter().any(|n| n.contains("reads its delay as 0")), "{:?}", r.notes);
+    assert_eq!((r.hold.chosen, r.hold.switched), ("zoh", false), "{:?}", r.hold);
+    assert_eq!(r.selected(), "sensor_offset", "{}", r.verdict);
+}

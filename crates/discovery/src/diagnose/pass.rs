@@ -221,9 +221,21 @@ impl<'a> Pass<'a> {
                 selection.chosen.as_ref(),
                 self.hold,
                 &mut self.hold_report,
-            );
-            if let Some((other, note)) = undone {
-                self.carried = selection.chosen.clone().map(|c| hold::moved_to_other_hold(c, self.hold, data.dt));
+            )
+            .map(|(other, note)| (other, note, selection.chosen.clone()))
+            .or_else(|| {
+                hold::delay_at_bound_prefers_other(
+                    data,
+                    &self.ctx,
+                    &selection.ranking,
+                    selection.chosen.as_ref(),
+                    self.hold,
+                    &mut self.hold_report,
+                )
+                .map(|(other, note, r)| (other, note, Some(r)))
+            });
+            if let Some((other, note, carried)) = undone {
+                self.carried = carried.map(|c| hold::moved_to_other_hold(c, self.hold, data.dt));
                 self.switch_hold(data, other, note, selection.ranking);
                 return Ok(Step::Restart);
             }
