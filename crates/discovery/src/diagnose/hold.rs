@@ -311,10 +311,8 @@ pub(super) fn delay_at_bound_prefers_other(
     // zero-order hold was chosen over the first-order one with the effects in: fresh singles
     // seed 10923 (mixed) `asymmetric_coulomb` #3, zero-order held, went back to the first-order
     // hold with a delay of 0.92 h/2 (the zero-order hold's equivalent) without that guard.
-    if s.input_hold != HoldChoice::Auto || s.screened_hold.is_some() || hold != InputHold::Zoh || report.switched {
-        return None;
-    }
-    if !delay_offsets(c).is_empty() {
+    let asked = s.input_hold == HoldChoice::Auto && s.screened_hold.is_none() && hold == InputHold::Zoh;
+    if !asked || report.switched || !delay_offsets(c).is_empty() {
         return None;
     }
     let at_bound = |r: &Ranked| {
@@ -345,7 +343,7 @@ pub(super) fn delay_at_bound_prefers_other(
     );
     report.effect_delta_bic = Some(-d);
     report.chosen = other.name();
-    report.switched = !report.switched;
+    report.switched = true;
     Some((other, note, r.clone()))
 }
 
