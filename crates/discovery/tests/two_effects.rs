@@ -339,3 +339,44 @@ fn an_effect_that_gains_nothing_beside_the_others_refitted_is_dropped() {
     let single = r.ranking.iter().find(|x| x.kinds == ["cogging"]).unwrap();
     assert!(single.delta_bic > pair.delta_bic, "{} against {}", single.delta_bic, pair.delta_bic);
 }
+
+#[test]
+fn coloured_noise_on_a_none_recording_is_not_placed_outside_the_library() {
+    // A digital `none` recording under AR(1) noise: the nominal residual is not white, nothing
+    // is selected, and the residual is white once the noise's colour is removed. The verdict
+    // must not claim a mismatch outside the library (it did), and says why nothing is missing.
+    let case = bench_gen::generate_profile("none", 10925, 0, Profile::Digital);
+    assert!(case.truths.is_empty());
+    let r = run(&case);
+    assert!(!r.nominal_adequate, "control: the nominal residual must not be white ({:?})", r.residual_nominal);
+    assert!(r.effects.is_empty(), "{}", r.verdict);
+    assert!(!r.model_incomplete, "{}", r.verdict);
+    let e = r.residual_explained.as_ref().expect("why the residual is not missing physics");
+    assert_eq!(e.reason, "noise_colour");
+    assert!(e.q_auto > e.q_auto_threshold && e.q_auto_ar1 <= e.q_auto_threshold, "{e:?}");
+    assert!(r.verdict.starts_with("no missing physics found"), "{}", r.verdict);
+    assert!(!r.verdict.contains("outside the library"), "{}", r.verdict);
+    assert!(r.to_markdown(&[]).contains("## What is left"));
+}
+
+#[test]
+fn a_mismatch_the_library_misses_is_still_called_missing() {
+    // Negative control of the one above: Coulomb friction diagnosed with a library that holds
+    // only an input delay leaves a residual that is not noise: nothing explains it away, and
+    // the model is incomplete.
+    let case = bench_gen::generate_profile("coulomb_friction", 27, 0, Profile::Classic);
+    let s = DiagnoseSettings {
+        initial_state: Some(discovery::diagnose::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        }),
+        library: Some(vec!["input_delay".to_string()]),
+        ..Default::default()
+    };
+    let r = diagnose(&case.nominal, &case.recording, &s).unwrap();
+    assert!(r.effects.is_empty(), "{}", r.verdict);
+    assert!(r.model_incomplete, "{}", r.verdict);
+    assert!(r.residual_explained.is_none(), "{:?}", r.residual_explained);
+    assert!(r.verdict.contains("something is still missing"), "{}", r.verdict);
+    assert!(!r.verdict.contains("not missing physics") && !r.verdict.contains("no missing physics"), "{}", r.verdict);
+}

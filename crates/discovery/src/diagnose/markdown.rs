@@ -91,6 +91,9 @@ impl Report {
 
     /// What the final model leaves unexplained (where it is incomplete).
     fn md_remaining(&self) -> String {
+        if let Some(e) = &self.residual_explained {
+            return format!("\n## What is left\n\nThe final model's residual is not white, but {}: the model is not called incomplete.\n", e.text());
+        }
         let Some(r) = &self.remaining else { return String::new() };
         let mut s = format!(
             "\n## Still missing\n\nThe final model's residual is not white (Q = {:.1} against the 99 % threshold {:.1}; {:.1} with an AR(1) noise colour of {} removed, {} with the input; {} with the input before) and its RMS is {} times the noise level: the model is incomplete. Where the residual left concentrates:\n\n",

@@ -51,8 +51,8 @@ pub use crate::select::{CvResult, Ranked, NOMINAL_REFIT, NOT_TESTABLE_SHARE};
 pub use hold::ScreenedHold;
 pub use joint::{diagnose_recordings, JointReport};
 pub use report::{
-    DerivedParameter, FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue, Remaining, Report,
-    Series, FITTED_INPUT_FILE,
+    DerivedParameter, Explained, FittedEffect, HoldReport, InitialStateReport, LocalisationInfo, NominalValue,
+    Remaining, Report, Series, FITTED_INPUT_FILE,
 };
 pub use settings::{DiagnoseSettings, HoldChoice, InitialState, Metric, SERVO_FIT_PERCENT};
 
@@ -132,19 +132,21 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
     // Report: headline, verdict, notes.
     let headline = verdict::headline(&data, &outcome.fit_before, &fitted.fit_after, &mut notes);
     let held_out = verdict::held_out_extension(&outcome.ranking, outcome.chosen.as_ref());
+    // What the final model leaves: something still missing and where, or why it is not.
+    let leftover = remaining(&data, &pass, &nominal, &outcome, &fitted, held_out.clone());
     let mut verdict = verdict::verdict(
         nominal.nominal_adequate,
+        &nominal.residual_nominal,
         &outcome.missing_inputs,
         outcome.chosen.as_ref(),
         &outcome.equivalents,
         &fitted.nominal_refit,
         &outcome.cv_rejected,
         held_out.as_ref(),
+        leftover.explained(),
         &headline.text,
     );
-    // What the final model leaves: something still missing, and where.
-    let remaining = remaining(&data, &pass, &nominal, &outcome, &fitted, held_out);
-    if let Some(r) = &remaining {
+    if let Leftover::Missing(r) = &leftover {
         verdict += &format!("; {}", verdict::still_missing(r, outcome.chosen.as_ref(), s.max_effects));
     }
     notes::closing(&data, &pass, &outcome, &fitted, headline.use_rmse, &mut notes);
@@ -154,7 +156,7 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
         scales: pass.ctx.scales.clone(),
         chosen: outcome.chosen.clone(),
     };
-    Ok((assemble(&data, pass, nominal, outcome, unc, fitted, headline, (verdict, remaining), notes), selected))
+    Ok((assemble(&data, pass, nominal, outcome, unc, fitted, headline, (verdict, leftover), notes), selected))
 }
 
 /// The residual's RMS must exceed the noise level (difference estimator) by this factor for
@@ -162,6 +164,27 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
 /// evidence of missing physics worth a second effect (a converged single effect leaves 0.95-1.08
 /// on the benchmark; two effects with one missed leave 1.4 and more).
 pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
+
+/// What [`remaining`] found in the final model's residual.
+enum Leftover {
+    /// Not judged: the nominal model was adequate, or a recorded input is missing from it.
+    NotJudged,
+    /// White about zero.
+    White,
+    /// Not white, but not missing physics either (coloured noise, or a misfit within the noise).
+    Explained(Explained),
+    /// Something is still missing: the model is incomplete.
+    Missing(Remaining),
+}
+
+impl Leftover {
+    fn explained(&self) -> Option<&Explained> {
+        match self {
+            Leftover::Explained(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 /// What the final model (selected, else nominal) leaves unexplained where the nominal was not
 /// adequate and no missing input was found: `Some` (the model is incomplete) where its residual
@@ -187,7 +210,7 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 /// Neither exempts a model that a fitted candidate beats on the held-out segment by half
 /// ([`verdict::held_out_extension`], `held_out`): the effect acts where the estimation data do not reach.
 ///
-/// With the localisation of that residual.
+/// With the localisation of that residual; where an exemption applies, which one.
 fn remaining(
     data: &Setup,
     pass: &Pass,
@@ -195,10 +218,10 @@ fn remaining(
     outcome: &Outcome,
     fitted: &Fitted,
     held_out: Option<(String, f64)>,
-) -> Option<Remaining> {
+) -> Leftover {
     let t = &fitted.residual_fitted;
     if nominal.nominal_adequate || outcome.missing_inputs.iter().any(|c| c.missing) {
-        return None;
+        return Leftover::NotJudged;
     }
     let (ctx, n, p) = (&pass.ctx, data.n_samp, data.p);
     let e_fit: Vec<f64> = ctx.y.iter().zip(&fitted.fit_sim.y).map(|(a, b)| a - b).collect();
@@ -206,7 +229,7 @@ fn remaining(
     // a residual white about a mean off zero is something left too (a missing offset)
     let mean_off_zero = crate::residual::mean_off_zero(&e_fit, n, p, &ar1, data.lag_step);
     if t.white && !mean_off_zero {
-        return None;
+        return Leftover::White;
     }
     let t_w = data.residual_tests(&e_w, &ctx.w);
     let rms_over_noise: Vec<f64> = (0..p)
@@ -222,11 +245,18 @@ fn remaining(
     let exempt =
         !mean_off_zero && (t_w.white || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)));
     if exempt && held_out.is_none() {
-        return None;
+        return Leftover::Explained(Explained {
+            reason: if t_w.white { "noise_colour" } else { "within_noise" },
+            q_auto: t.q_auto,
+            q_auto_threshold: t.q_auto_threshold,
+            q_auto_ar1: t_w.q_auto,
+            ar1,
+            rms_over_noise,
+        });
     }
     let contact = fitted.fit_sim.contact.iter().any(|&c| c).then_some(&fitted.fit_sim.contact[..]);
     let loc = crate::localise::localise(data.rec.t0, data.dt, &ctx.y, &e_fit, p, &ctx.w, data.m, contact, 10);
-    Some(Remaining {
+    Leftover::Missing(Remaining {
         q_auto: t.q_auto,
         q_auto_threshold: t.q_auto_threshold,
         q_auto_ar1: t_w.q_auto,
@@ -348,7 +378,7 @@ fn assemble(
     unc: Uncertainty,
     fitted: Fitted,
     headline: Headline,
-    (verdict, remaining): (String, Option<Remaining>),
+    (verdict, leftover): (String, Leftover),
     notes: Vec<String>,
 ) -> Report {
     let (rec, n_samp, k_est) = (data.rec, data.n_samp, data.k_est);
@@ -388,8 +418,12 @@ fn assemble(
         residual_nominal: nominal.residual_nominal,
         residual_fitted: fitted.residual_fitted,
         nominal_adequate: nominal.nominal_adequate,
-        model_incomplete: remaining.is_some(),
-        remaining,
+        model_incomplete: matches!(leftover, Leftover::Missing(_)),
+        residual_explained: leftover.explained().cloned(),
+        remaining: match leftover {
+            Leftover::Missing(r) => Some(r),
+            _ => None,
+        },
         verdict,
         effects: fitted.effects,
         uncertainty_method: unc.method,

@@ -160,6 +160,45 @@ pub struct LocalisationInfo {
     pub null: localise::NullReference,
 }
 
+/// Why a final residual that is not white leaves the model complete (`report.json`
+/// `residual_explained`): what `model_incomplete` was judged on where it is false although the
+/// nominal model was not adequate.
+#[derive(Debug, Clone, Serialize)]
+pub struct Explained {
+    /// `noise_colour`: white once an AR(1) colour is removed, with a mean within that colour's
+    /// bound (coloured measurement noise); `within_noise`: its RMS within
+    /// [`super::INCOMPLETE_NOISE_RATIO`] times the noise level.
+    pub reason: &'static str,
+    /// Portmanteau statistic of the final residual and its 99 % threshold, and the statistic
+    /// once the AR(1) filter (coefficient per output) is removed.
+    pub q_auto: f64,
+    pub q_auto_threshold: f64,
+    pub q_auto_ar1: f64,
+    pub ar1: Vec<f64>,
+    /// RMS of the final residual over the noise level, per output.
+    pub rms_over_noise: Vec<f64>,
+}
+
+impl Explained {
+    /// The explanation in words (the verdict's and the report's).
+    pub fn text(&self) -> String {
+        let list = |v: &[f64]| v.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ");
+        let left = format!("the residual left (Q = {:.1} against {:.1})", self.q_auto, self.q_auto_threshold);
+        match self.reason {
+            "noise_colour" => format!(
+                "{left} is white once an AR(1) colour ({}) is removed (Q = {:.1}), with a mean zero within that colour's bound, as coloured measurement noise is",
+                list(&self.ar1),
+                self.q_auto_ar1
+            ),
+            _ => format!(
+                "{left} has an RMS of {} times the noise level (at most {}): a misfit within the noise",
+                list(&self.rms_over_noise),
+                super::INCOMPLETE_NOISE_RATIO
+            ),
+        }
+    }
+}
+
 /// What the final model leaves unexplained (issue 27 item 4): its residual's whiteness tests, its
 /// size against the noise, and where the residual's energy concentrates (the localisation of [`localise`] run on the final
 /// residual instead of the nominal one).
@@ -261,6 +300,9 @@ pub struct Report {
     pub model_incomplete: bool,
     /// With `model_incomplete`: what is left and where.
     pub remaining: Option<Remaining>,
+    /// Without it, where the final residual is not white although the nominal model was not
+    /// adequate: why that residual is not missing physics.
+    pub residual_explained: Option<Explained>,
     pub verdict: String,
     pub effects: Vec<FittedEffect>,
     /// What the reported 1-sigma of the fitted parameters includes, and what it does not.

@@ -2,11 +2,12 @@
 //! where fit % saturates) and its text ([`verdict`]: nothing missing, an input missing, the
 //! missing physics or refitted plant parameters, or nothing the library explains).
 use super::markdown::{fmt_opt, fmt_units, g4};
-use super::report::{NominalValue, Remaining};
+use super::report::{Explained, NominalValue, Remaining};
 use super::settings::{Metric, SERVO_FIT_PERCENT};
 use super::setup::Setup;
 use crate::fit::missing_input::MissingInput;
 use crate::metrics::{self, Fit};
+use crate::residual::ResidualTests;
 use crate::select::{Equivalent, Ranked};
 
 /// The verdict's metric part.
@@ -51,18 +52,39 @@ pub(super) fn headline(data: &Setup, fit_before: &Fit, fit_after: &Fit, notes: &
     Headline { use_rmse, metric, text, units }
 }
 
-/// The verdict's text.
+/// The residual tests `t` failed, in words ("not white", "correlated with the input", "off
+/// zero"); where it passed them all (a single effect overruled them), that.
+fn failed_tests(t: &ResidualTests) -> String {
+    let failed: Vec<&str> =
+        [(t.white, "not white"), (t.uncorrelated, "correlated with the input"), (t.zero_mean, "off zero")]
+            .into_iter()
+            .filter(|(passed, _)| !passed)
+            .map(|(_, what)| what)
+            .collect();
+    if failed.is_empty() {
+        "within the residual tests (overruled by an effect's held-out gain)".to_string()
+    } else {
+        failed.join(" and ")
+    }
+}
+
+/// The verdict's text. Where nothing is selected and the final residual, not white, is
+/// `explained` without missing physics, the verdict says so instead of placing a mismatch
+/// outside the library (coloured measurement noise on a `none` recording is not missing physics).
 pub(super) fn verdict(
     nominal_adequate: bool,
+    nominal_tests: &ResidualTests,
     missing_inputs: &[MissingInput],
     chosen: Option<&Ranked>,
     equivalents: &[Equivalent],
     nominal_refit: &[NominalValue],
     cv_rejected: &[(String, f64, String)],
     held_out: Option<&(String, f64)>,
+    explained: Option<&Explained>,
     headline: &str,
 ) -> String {
     let missing: Vec<&MissingInput> = missing_inputs.iter().filter(|c| c.missing).collect();
+    let failed = failed_tests(nominal_tests);
     let untestable = chosen.is_some_and(|c| c.cv.as_ref().is_some_and(|v| v.status == "not_testable"));
     let refit_only = chosen.is_some_and(|c| c.refit && c.parts.is_empty());
     if nominal_adequate {
@@ -104,13 +126,19 @@ pub(super) fn verdict(
         }
     } else if !cv_rejected.is_empty() {
         format!(
-            "the nominal residual is not white; {} improve(s) the estimation fit but not the held-out folds of the blocked cross-validation, so nothing is added (see the ranking)",
-            cv_rejected.iter().map(|c| c.0.clone()).collect::<Vec<_>>().join(", ")
+            "the nominal residual is {failed}; {} improve(s) the estimation fit but not the held-out folds of the blocked cross-validation, so nothing is added (see the ranking){}",
+            cv_rejected.iter().map(|c| c.0.clone()).collect::<Vec<_>>().join(", "),
+            explained.map_or(String::new(), |e| format!("; what is left is not missing physics: {}", e.text()))
         )
     } else if let Some((label, _)) = held_out {
-        format!("the nominal residual is not white; no effect of the library improves the estimation fit by the required margin, but {label} improves the held-out segment")
+        format!("the nominal residual is {failed}; no effect of the library improves the estimation fit by the required margin, but {label} improves the held-out segment")
+    } else if let Some(e) = explained {
+        format!(
+            "no missing physics found: the nominal residual is {failed}, but {}; no effect of the library improves the fit by the required margin",
+            e.text()
+        )
     } else {
-        "the nominal residual is not white, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library".to_string()
+        format!("the nominal residual is {failed}, but no effect of the library improves the fit by the required margin (BIC beyond the discretisation error, and held-out folds): the mismatch is outside the library")
     }
 }
 
