@@ -360,6 +360,28 @@ fn coloured_noise_on_a_none_recording_is_not_placed_outside_the_library() {
 }
 
 #[test]
+fn a_white_residual_correlated_with_the_input_on_a_none_recording_is_said_so() {
+    // A mixed-profile `none` recording whose nominal residual is white but correlated with the
+    // input (a first-order hold standing in for a zero-order-held command): nothing is
+    // selected, the model is not called incomplete, and the verdict says why instead of
+    // placing a mismatch outside the library.
+    let case = bench_gen::generate_profile("none", 10941, 8, Profile::Mixed);
+    assert!(case.truths.is_empty());
+    let r = run(&case);
+    let t = &r.residual_nominal;
+    assert!(t.white && !t.uncorrelated, "control: white and correlated with the input ({t:?})");
+    assert!(r.effects.is_empty() && !r.model_incomplete, "{}", r.verdict);
+    let e = r.residual_explained.as_ref().expect("why the residual is not missing physics");
+    assert_eq!(e.reason, "white");
+    assert!(
+        r.verdict.starts_with("no missing physics found: the nominal residual is correlated with the input"),
+        "{}",
+        r.verdict
+    );
+    assert!(r.to_markdown(&[]).contains("## What is left"));
+}
+
+#[test]
 fn a_mismatch_the_library_misses_is_still_called_missing() {
     // Negative control of the one above: Coulomb friction diagnosed with a library that holds
     // only an input delay leaves a residual that is not noise: nothing explains it away, and

@@ -91,8 +91,11 @@ impl Report {
 
     /// What the final model leaves unexplained (where it is incomplete).
     fn md_remaining(&self) -> String {
-        if let Some(e) = &self.residual_explained {
-            return format!("\n## What is left\n\nThe final model's residual is not white, but {}: the model is not called incomplete.\n", e.text());
+        if let Some(e) = self.residual_explained.as_ref().filter(|e| e.reason != "white" || !e.uncorrelated) {
+            let text = e.text();
+            let mut first = text.chars();
+            let capital: String = first.next().map(|c| c.to_uppercase().chain(first).collect()).unwrap_or_default();
+            return format!("\n## What is left\n\n{capital}: the model is not called incomplete.\n");
         }
         let Some(r) = &self.remaining else { return String::new() };
         let mut s = format!(

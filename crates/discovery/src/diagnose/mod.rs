@@ -169,9 +169,8 @@ pub const INCOMPLETE_NOISE_RATIO: f64 = 1.1;
 enum Leftover {
     /// Not judged: the nominal model was adequate, or a recorded input is missing from it.
     NotJudged,
-    /// White about zero.
-    White,
-    /// Not white, but not missing physics either (coloured noise, or a misfit within the noise).
+    /// White about zero, or not white but not missing physics either (coloured noise, or a
+    /// misfit within the noise).
     Explained(Explained),
     /// Something is still missing: the model is incomplete.
     Missing(Remaining),
@@ -228,16 +227,27 @@ fn remaining(
     let (e_w, ar1) = crate::residual::prewhiten_ar1(&e_fit, n, p);
     // a residual white about a mean off zero is something left too (a missing offset)
     let mean_off_zero = crate::residual::mean_off_zero(&e_fit, n, p, &ar1, data.lag_step);
-    if t.white && !mean_off_zero {
-        return Leftover::White;
-    }
-    let t_w = data.residual_tests(&e_w, &ctx.w);
     let rms_over_noise: Vec<f64> = (0..p)
         .map(|i| {
             let ms = (0..n).map(|k| e_fit[k * p + i].powi(2)).sum::<f64>() / n.max(1) as f64;
             ms.sqrt() / data.noise[i].max(1e-300)
         })
         .collect();
+    let explained = |reason, q_auto_ar1, ar1, rms_over_noise| {
+        Leftover::Explained(Explained {
+            reason,
+            q_auto: t.q_auto,
+            q_auto_threshold: t.q_auto_threshold,
+            q_auto_ar1,
+            ar1,
+            rms_over_noise,
+            uncorrelated: t.uncorrelated,
+        })
+    };
+    if t.white && !mean_off_zero {
+        return explained("white", t.q_auto, ar1, rms_over_noise);
+    }
+    let t_w = data.residual_tests(&e_w, &ctx.w);
     let margin = data.s.select.margin_bic + nominal.delta_bic_disc;
     let unconfirmed = verdict::unconfirmed_extension(&outcome.ranking, outcome.chosen.as_ref(), margin);
     let within_noise = rms_over_noise.iter().all(|&r| r <= INCOMPLETE_NOISE_RATIO);
@@ -245,14 +255,7 @@ fn remaining(
     let exempt =
         !mean_off_zero && (t_w.white || (within_noise && (t.uncorrelated || unconfirmed.is_none() || !above_noise)));
     if exempt && held_out.is_none() {
-        return Leftover::Explained(Explained {
-            reason: if t_w.white { "noise_colour" } else { "within_noise" },
-            q_auto: t.q_auto,
-            q_auto_threshold: t.q_auto_threshold,
-            q_auto_ar1: t_w.q_auto,
-            ar1,
-            rms_over_noise,
-        });
+        return explained(if t_w.white { "noise_colour" } else { "within_noise" }, t_w.q_auto, ar1, rms_over_noise);
     }
     let contact = fitted.fit_sim.contact.iter().any(|&c| c).then_some(&fitted.fit_sim.contact[..]);
     let loc = crate::localise::localise(data.rec.t0, data.dt, &ctx.y, &e_fit, p, &ctx.w, data.m, contact, 10);

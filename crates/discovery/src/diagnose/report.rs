@@ -160,14 +160,15 @@ pub struct LocalisationInfo {
     pub null: localise::NullReference,
 }
 
-/// Why a final residual that is not white leaves the model complete (`report.json`
-/// `residual_explained`): what `model_incomplete` was judged on where it is false although the
-/// nominal model was not adequate.
+/// Why the final model is not called incomplete where the nominal model was not adequate
+/// (`report.json` `residual_explained`; `remaining` where it is): what `model_incomplete` was
+/// judged on.
 #[derive(Debug, Clone, Serialize)]
 pub struct Explained {
-    /// `noise_colour`: white once an AR(1) colour is removed, with a mean within that colour's
-    /// bound (coloured measurement noise); `within_noise`: its RMS within
-    /// [`super::INCOMPLETE_NOISE_RATIO`] times the noise level.
+    /// `white`: the final residual is white about zero; `noise_colour`: not white, but white
+    /// once an AR(1) colour is removed, with a mean within that colour's bound (coloured
+    /// measurement noise); `within_noise`: its RMS within [`super::INCOMPLETE_NOISE_RATIO`] times
+    /// the noise level.
     pub reason: &'static str,
     /// Portmanteau statistic of the final residual and its 99 % threshold, and the statistic
     /// once the AR(1) filter (coefficient per output) is removed.
@@ -177,6 +178,8 @@ pub struct Explained {
     pub ar1: Vec<f64>,
     /// RMS of the final residual over the noise level, per output.
     pub rms_over_noise: Vec<f64>,
+    /// Whether the final residual is uncorrelated with every input (1 % level).
+    pub uncorrelated: bool,
 }
 
 impl Explained {
@@ -185,6 +188,14 @@ impl Explained {
         let list = |v: &[f64]| v.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ");
         let left = format!("the residual left (Q = {:.1} against {:.1})", self.q_auto, self.q_auto_threshold);
         match self.reason {
+            "white" => format!(
+                "{left} is white about zero{}",
+                if self.uncorrelated {
+                    ""
+                } else {
+                    " (its correlation with the input alone, as an input hold or gain slightly off leaves, is not called missing physics)"
+                }
+            ),
             "noise_colour" => format!(
                 "{left} is white once an AR(1) colour ({}) is removed (Q = {:.1}), with a mean zero within that colour's bound, as coloured measurement noise is",
                 list(&self.ar1),
