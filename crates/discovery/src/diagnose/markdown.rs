@@ -95,7 +95,7 @@ impl Report {
             let text = e.text();
             let mut first = text.chars();
             let capital: String = first.next().map(|c| c.to_uppercase().chain(first).collect()).unwrap_or_default();
-            return format!("\n## What is left\n\n{capital}: the model is not called incomplete.\n");
+            return format!("\n## What is left\n\n{capital}; the model is not called incomplete.\n");
         }
         let Some(r) = &self.remaining else { return String::new() };
         let mut s = format!(
