@@ -168,7 +168,7 @@ pub(super) fn overturned_by_effects(
         // nominal (automatic for the leading effects, which clear it here; the delay asked
         // wherever it ranks must earn it: on a zero-order-held recording with nothing missing,
         // "first-order hold + h/2" can beat the best effect, the nominal itself, by a few BIC).
-        let bic_o = c.bic - select::bic(c.sse_estimation, n_res, 0) + select::bic(r_o.sse, n_res, 0);
+        let bic_o = bic_under_other_hold(c, r_o.sse, n_res);
         if bic_nom - bic_o < margin {
             continue;
         }
@@ -197,9 +197,7 @@ pub(super) fn overturned_by_effects(
                 hold.name(),
                 other.name()
             );
-            report.effect_delta_bic = Some(d);
-            report.chosen = other.name();
-            report.switched = true;
+            report.switch_to(other, d);
             return Some((other, note));
         }
     }
@@ -269,9 +267,7 @@ pub(super) fn selected_model_prefers_other(
             other.name()
         )
     };
-    report.effect_delta_bic = Some(-d);
-    report.chosen = other.name();
-    report.switched = !report.switched;
+    report.switch_to(other, -d);
     Some((other, note))
 }
 
@@ -324,9 +320,8 @@ pub(super) fn delay_at_bound_prefers_other(
     if r_o.status == fit::FitStatus::Failed || !r_o.sse.is_finite() {
         return None;
     }
-    // BIC of `r` under the other hold (its own parameter count), against the selected model's
-    let bic_o = r.bic - select::bic(r.sse_estimation, data.n_res, 0) + select::bic(r_o.sse, data.n_res, 0);
-    let d = (c.bic - bic_o) * colour_deflation(&r.problem(&ctx_o), &r_o);
+    // against the selected model's BIC
+    let d = (c.bic - bic_under_other_hold(r, r_o.sse, data.n_res)) * colour_deflation(&r.problem(&ctx_o), &r_o);
     if !(d > s.select.tie_bic) {
         return None;
     }
@@ -341,9 +336,7 @@ pub(super) fn delay_at_bound_prefers_other(
         c.label,
         other.name()
     );
-    report.effect_delta_bic = Some(-d);
-    report.chosen = other.name();
-    report.switched = true;
+    report.switch_to(other, -d);
     Some((other, note, r.clone()))
 }
 
@@ -376,6 +369,12 @@ fn colour_deflation(pb: &fit::Problem, r: &FitResult) -> f64 {
 }
 
 /// The hold that is not `hold`.
+/// BIC of the fitted model `c` refitted under the other hold to the estimation SSE `sse_other`
+/// (the same parameter count: only the likelihood term changes).
+fn bic_under_other_hold(c: &Ranked, sse_other: f64, n_res: usize) -> f64 {
+    c.bic - select::bic(c.sse_estimation, n_res, 0) + select::bic(sse_other, n_res, 0)
+}
+
 fn other_hold(hold: InputHold) -> InputHold {
     if hold == InputHold::Zoh {
         InputHold::Foh

@@ -45,6 +45,14 @@ pub struct HoldReport {
 }
 
 impl HoldReport {
+    /// The hold switched to `to` by a check whose evidence is `effect_delta_bic` (see the
+    /// field); a second switch undoes the first (`switched` toggles).
+    pub(super) fn switch_to(&mut self, to: dynamics::extended::InputHold, effect_delta_bic: f64) {
+        self.effect_delta_bic = Some(effect_delta_bic);
+        self.chosen = to.name();
+        self.switched = !self.switched;
+    }
+
     /// How the hold actually used was reached, for the report's header (after `Input hold:
     /// **zoh**`): requested, the nominal's preference, or switched by the effects; and whether
     /// a selected delay can tell the holds apart.
