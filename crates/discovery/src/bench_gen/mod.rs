@@ -176,6 +176,11 @@ pub enum Signal {
     Knots { dt_knot: f64, v: Vec<f64> },
     /// Sine segments of length `seg`: amplitude and frequency per segment.
     Segments { seg: f64, a: Vec<f64>, omega: Vec<f64> },
+    /// A logarithmic frequency sweep `a sin(phi(t))` from `omega_lo` to `omega_hi` over
+    /// `duration` (held at `omega_hi` after it).
+    Chirp { a: f64, omega_lo: f64, omega_hi: f64, duration: f64 },
+    /// Random steps: level `v[i]` from `edges[i]` on (`edges[0] = 0`, ascending).
+    Steps { edges: Vec<f64>, v: Vec<f64> },
 }
 
 impl Signal {
@@ -197,8 +202,64 @@ impl Signal {
                 // Smooth window so that segments join continuously.
                 a[i] * (omega[i] * tl).sin() * (PI * tl / seg).sin().powi(2).sqrt()
             }
+            Signal::Chirp { a, omega_lo, omega_hi, duration } => {
+                let r = omega_hi / omega_lo;
+                let phi = |t: f64| omega_lo * duration / r.ln() * (r.powf(t / duration) - 1.0);
+                let ph = if t <= *duration { phi(t) } else { phi(*duration) + omega_hi * (t - duration) };
+                a * ph.sin()
+            }
+            Signal::Steps { edges, v } => v[edges.partition_point(|&e| e <= t).saturating_sub(1)],
         }
     }
+}
+
+/// An input kind forced on every case in place of the drawn one (multisine, filtered noise
+/// or sine segments): inputs the diagnosis was never developed on, for held-out checks. The
+/// forced input is drawn from a stream of its own, so every other draw of a case stays as it
+/// was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ForcedInput {
+    /// A logarithmic sweep from 0.05-0.15 to 1.2-2 times the natural frequency.
+    Chirp,
+    /// Random levels in [-1, 1] held for one to six natural periods, changing on samples.
+    Steps,
+}
+
+impl ForcedInput {
+    /// From its name (`chirp` or `steps`).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "chirp" => Some(ForcedInput::Chirp),
+            "steps" => Some(ForcedInput::Steps),
+            _ => None,
+        }
+    }
+}
+
+/// The input kind that `BENCH_SIGNAL` (`chirp` or `steps`) forces on every case of the
+/// benchmarks ([`ForcedInput`]; unset: the drawn kinds).
+pub fn forced_signal() -> Option<ForcedInput> {
+    ForcedInput::parse(&std::env::var("BENCH_SIGNAL").ok()?)
+}
+
+/// The `forced` input for a plant of natural frequency `w0` over `duration`, sampled every
+/// `dt` (steps change on the sample grid).
+fn forced(forced: ForcedInput, mix: u64, w0: f64, duration: f64, dt: f64) -> (Signal, &'static str) {
+    let mut rng = ChaCha8Rng::seed_from_u64(mix ^ 0x5167_4A1E_0000_0031);
+    if forced == ForcedInput::Chirp {
+        let (lo, hi) = (w0 * rng.random_range(0.05..0.15), w0 * rng.random_range(1.2..2.0));
+        return (Signal::Chirp { a: rng.random_range(0.6..1.0), omega_lo: lo, omega_hi: hi, duration }, "chirp");
+    }
+    // Dwell times of one to six natural periods, levels uniform in [-1, 1].
+    let period = TAU / w0;
+    // (edges at `k dt` computed as the sample times are, so each falls on its sample exactly)
+    let (mut edges, mut v, mut k) = (vec![0.0], vec![rng.random_range(-1.0..1.0)], 0usize);
+    while (k as f64) * dt < duration {
+        k += ((rng.random_range(1.0..6.0) * period) / dt).round().max(1.0) as usize;
+        edges.push(k as f64 * dt);
+        v.push(rng.random_range(-1.0..1.0));
+    }
+    (Signal::Steps { edges, v }, "random steps")
 }
 
 /// A generated case.
@@ -460,7 +521,13 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
 
 /// Generates case number `index` of `class` from `seed` in `profile`.
 pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
-    generate_classes(&[class], seed, index, profile)
+    generate_classes(&[class], seed, index, profile, forced_signal())
+}
+
+/// [`generate_profile`] with the input `input` in place of the drawn one (and of
+/// `BENCH_SIGNAL`'s).
+pub fn generate_with_input(class: &'static str, seed: u64, index: usize, profile: Profile, input: ForcedInput) -> Case {
+    generate_classes(&[class], seed, index, profile, Some(input))
 }
 
 /// Whether two classes can be concealed in one recording by [`generate_pair`]: distinct, not
@@ -496,13 +563,19 @@ pub fn pairs() -> Vec<[&'static str; 2]> {
 /// plant, input and noise are drawn as for the first class alone. `None` where the pair is not
 /// [`pair_compatible`].
 pub fn generate_pair(pair: [&'static str; 2], seed: u64, index: usize, profile: Profile) -> Option<Case> {
-    pair_compatible(pair[0], pair[1]).then(|| generate_classes(&pair, seed, index, profile))
+    pair_compatible(pair[0], pair[1]).then(|| generate_classes(&pair, seed, index, profile, forced_signal()))
 }
 
 /// Generates case number `index` concealing every class of `classes` (one, or a pair) from
 /// `seed` in `profile`. One class draws exactly what it always did; the second of a pair takes
-/// its target and sign from a stream of its own.
-fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: Profile) -> Case {
+/// its target and sign from a stream of its own. `input` replaces the drawn input kind.
+fn generate_classes(
+    classes: &[&'static str],
+    seed: u64,
+    index: usize,
+    profile: Profile,
+    input: Option<ForcedInput>,
+) -> Case {
     let class = classes[0];
     let class_index = all_classes().iter().position(|c| *c == class).unwrap_or(0);
     let mut mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
@@ -522,6 +595,10 @@ fn generate_classes(classes: &[&'static str], seed: u64, index: usize, profile: 
     let duration = (10.0 * tau_slow).max(25.0 * period).min(80.0 * period) * length_factor();
     let ns = (duration / dt) as usize + 1;
     let (signal, sig_name) = random_signal(&mut rng, plant.omega0, duration);
+    let (signal, sig_name) = match input {
+        Some(f) => forced(f, mix, plant.omega0, duration, dt),
+        None => (signal, sig_name),
+    };
     let t: Vec<f64> = (0..ns).map(|k| k as f64 * dt).collect();
     let w: Vec<f64> = t.iter().map(|&tk| signal.eval(tk)).collect();
     let wmax = w.iter().map(|v| v.abs()).fold(0.0, f64::max);

@@ -229,6 +229,22 @@ impl Family for Friction {
         }
     }
 
+    /// A Coulomb level from a generalisation's estimate: a Stribeck law's sliding level, its
+    /// static level and their mean; a direction-dependent law's mean level and each of its
+    /// two; a load-dependent law's level without and with a third more for the load's part.
+    fn starts_from_general(&self, simple: &Hypothesis, kind: Kind, general: &[f64]) -> Option<Vec<Vec<f64>>> {
+        if !matches!(simple.kind, Kind::CoulombFriction { .. }) || kind.simpler_form() != Some(simple.kind) {
+            return None;
+        }
+        let levels = match (kind, general) {
+            (Kind::StribeckFriction { .. }, &[l, ex, _]) => [l, l + ex, l + 0.5 * ex],
+            (Kind::AsymmetricCoulomb { .. }, &[lp, ln]) => [0.5 * (lp + ln), lp, ln],
+            (Kind::LoadFriction { .. }, &[l, _]) => [l, 1.33 * l, 1.67 * l],
+            _ => return None,
+        };
+        Some(levels.iter().filter(|l| l.is_finite() && **l > 0.0).map(|&l| vec![simple.unit_of(0, l)]).collect())
+    }
+
     fn main_parameter(&self, effect: &Effect) -> Option<(f64, Option<&'static str>)> {
         match effect {
             Effect::CoulombFriction { level, .. } => Some((*level, Some(LEVEL))),
@@ -354,6 +370,32 @@ mod tests {
             asym.effect(&[0.3, 0.1], &s),
             Effect::AsymmetricCoulomb { state: 1, level_positive: 0.3, level_negative: 0.1 }
         );
+    }
+
+    #[test]
+    fn coulomb_friction_restarts_from_its_generalisations_levels() {
+        let coulomb = level(Kind::CoulombFriction { state: 1 }, 2.0, LEVEL);
+        let levels = |kind: Kind, general: &[f64]| -> Vec<f64> {
+            let starts = Friction.starts_from_general(&coulomb, kind, general).expect("a generalisation");
+            starts.iter().map(|u| coulomb.param_at(0, u[0])).collect()
+        };
+        let close = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+        // Stribeck [level, static excess, velocity]: sliding, static and their mean
+        let st = levels(Kind::StribeckFriction { state: 1 }, &[0.3, 0.2, 0.05]);
+        assert!(close(&st, &[0.3, 0.5, 0.4]), "{st:?}");
+        // direction-dependent: the mean level, then each
+        let asym = levels(Kind::AsymmetricCoulomb { state: 1 }, &[0.33, 0.36]);
+        assert!(close(&asym, &[0.345, 0.33, 0.36]), "{asym:?}");
+        let load = levels(Kind::LoadFriction { state: 1 }, &[0.3, 0.1]);
+        assert!(close(&load, &[0.3, 0.399, 0.501]), "{load:?}");
+        // negative controls: another state's law, a kind that generalises nothing, a
+        // generalisation handed as the simpler form
+        assert!(Friction.starts_from_general(&coulomb, Kind::AsymmetricCoulomb { state: 3 }, &[0.3, 0.3]).is_none());
+        assert!(Friction.starts_from_general(&coulomb, Kind::CoulombFriction { state: 1 }, &[0.3]).is_none());
+        let asym_h = asymmetric(1, 2.0);
+        assert!(Friction
+            .starts_from_general(&asym_h, Kind::StribeckFriction { state: 1 }, &[0.3, 0.2, 0.05])
+            .is_none());
     }
 
     #[test]

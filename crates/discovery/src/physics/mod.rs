@@ -155,6 +155,12 @@ pub trait Family: Sync {
     fn starts_from_simpler(&self, _h: &Hypothesis, _simpler: &[f64]) -> Option<Vec<Vec<f64>>> {
         None
     }
+    /// Starts (unit coordinates of `simple`) from the estimate `general` (physical units) of a
+    /// generalisation of kind `kind` of `simple`, for a simpler form whose own starts ended at
+    /// another minimum; `None` where `kind` does not generalise `simple`.
+    fn starts_from_general(&self, _simple: &Hypothesis, _kind: Kind, _general: &[f64]) -> Option<Vec<Vec<f64>>> {
+        None
+    }
     /// The main parameter of a model-file `effect` (the one that sets its size, which a
     /// benchmark sets and scores) and the hypothesis parameter that estimates it (`None` where
     /// the main parameter is derived from several).
@@ -185,6 +191,12 @@ pub fn main_parameter(effect: &Effect) -> (f64, Option<&'static str>) {
 /// [`Family::starts_from_simpler`]).
 pub fn starts_from_simpler(h: &Hypothesis, simpler: &[f64]) -> Option<Vec<Vec<f64>>> {
     h.kind.family().starts_from_simpler(h, simpler)
+}
+
+/// Starts for the simpler form `simple` from the estimate of its generalisation `kind` (see
+/// [`Family::starts_from_general`]).
+pub fn starts_from_general(simple: &Hypothesis, kind: Kind, general: &[f64]) -> Option<Vec<Vec<f64>>> {
+    simple.kind.family().starts_from_general(simple, kind, general)
 }
 
 /// The main parameter of `kind` at hypothesis parameters `theta` where it is derived from
