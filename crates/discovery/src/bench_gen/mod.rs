@@ -141,6 +141,15 @@ pub fn length_factor() -> f64 {
         .unwrap_or(1.0)
 }
 
+/// The measurement noise's level in dB of the nominal output's standard deviation:
+/// `BENCH_NOISE_DB` (a finite number; default -30, about 3.2 %). The noise stream is the
+/// same at every level (scaled), and the effects' magnitudes are set against the default
+/// level, so a case differs only by its noise (and the truth's stepping, converged to a tenth
+/// of the new noise's sigma).
+pub fn noise_db() -> f64 {
+    std::env::var("BENCH_NOISE_DB").ok().and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite()).unwrap_or(-30.0)
+}
+
 /// The sampling and noise conditions of one case (reported per case by the benchmark).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Conditions {
@@ -620,8 +629,11 @@ fn generate_classes(
         (clean_nom.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ns as f64).sqrt()
     };
     (fshape.v_rms, fshape.pos_range) = speed_and_range(&clean_nom, dt);
+    // The effects' magnitudes are set against the default noise level; the recording carries
+    // the same noise scaled to `noise_db` (exactly the default's at -30 dB).
     let noise_std = ystd * 10f64.powf(-30.0 / 20.0);
     let noise = measurement_noise(&mut rng, ns, noise_std, noise_rho);
+    let noise_scale = 10f64.powf((noise_db() + 30.0) / 20.0);
     let measure_all = |effs: &[&Effect]| -> Vec<f64> {
         plant_sim::simulate_effects(&plant, hw_nom, effs, &signal, &x0, dt, ns, drive)
             .iter()
@@ -650,14 +662,15 @@ fn generate_classes(
         .collect();
     let truth = truths.first().cloned();
     let effs: Vec<&Effect> = truths.iter().collect();
-    let y = if converged_truth() {
+    let y: Vec<f64> = if converged_truth() {
         // The magnitudes above were set on the 20-per-sample grid; the recording's truth is
         // converged to a tenth of a sigma of any fitted parameter (white-noise count of samples).
-        let tol = 0.1 * noise_std / (ns as f64).sqrt();
+        let tol = 0.1 * noise_std * noise_scale / (ns as f64).sqrt();
         let (clean, _) = plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive, tol);
-        clean.iter().zip(&noise).map(|(a, b)| a + b).collect()
+        clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect()
     } else {
-        measure_all(&effs)
+        let clean = plant_sim::simulate_effects(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive);
+        clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect()
     };
     let nominal_fit = fit_percent(&y, &clean_nom);
     let name = format!("bench {} #{index} (n = {n})", classes.join("+"));
