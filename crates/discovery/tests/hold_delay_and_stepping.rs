@@ -184,6 +184,7 @@ fn the_header_states_the_hold_used_after_a_switch() {
         decisive: true,
         effect_delta_bic: Some(8.0),
         switched: true,
+        effects_undecided: false,
         delay_delta_bic: None,
         delay_other_hold: vec![],
         delay_ambiguous: false,
@@ -193,6 +194,10 @@ fn the_header_states_the_hold_used_after_a_switch() {
     // Negative control: without the switch the nominal's preference is the reason given.
     let kept = HoldReport { switched: false, chosen: "zoh", ..h };
     assert!(!kept.header().contains("switched") && kept.header().contains("than with foh"), "{}", kept.header());
+    assert!(!kept.header().contains("not confirmed"), "{}", kept.header());
+    // Kept, but the best effect fits both holds alike: the header says the data do not confirm it.
+    let undecided = HoldReport { effect_delta_bic: Some(0.8), effects_undecided: true, ..kept.clone() };
+    assert!(undecided.header().contains("alike (+0.8): not confirmed"), "{}", undecided.header());
 }
 
 /// The stepping tests' wide play in the loop (the catching-up projection is first order in the

@@ -51,6 +51,7 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                 decisive: false,
                 effect_delta_bic: None,
                 switched: false,
+                effects_undecided: false,
                 delay_delta_bic: None,
                 delay_other_hold: vec![],
                 delay_ambiguous: false,
@@ -80,6 +81,7 @@ pub(super) fn first_choice(data: &Setup) -> (InputHold, HoldReport, SubstepCheck
                     decisive: d >= s.select.tie_bic,
                     effect_delta_bic,
                     switched,
+                    effects_undecided: false,
                     delay_delta_bic: None,
                     delay_other_hold: vec![],
                     delay_ambiguous: false,
@@ -151,7 +153,7 @@ pub(super) fn overturned_by_effects(
     // The input delay too, wherever it ranks: hold and delay trade off, so under this hold a
     // delay that the other hold reads as tau may need a negative one (a first-order-held
     // input delayed by less than h/2 read under a zero-order hold) and rank nowhere.
-    if let Some(d) = singles.iter().find(|c| !delay_offsets(c).is_empty()) {
+    if let Some(d) = singles.iter().find(|c| has_delay(c)) {
         if !leading.iter().any(|c| std::ptr::eq(*c, d)) {
             leading.push(d);
         }
@@ -234,10 +236,7 @@ pub(super) fn selected_model_prefers_other(
 ) -> Option<(InputHold, String)> {
     let c = chosen?;
     let s = data.s;
-    if s.input_hold != HoldChoice::Auto
-        || s.screened_hold.is_some()
-        || (!report.switched && !delay_offsets(c).is_empty())
-    {
+    if s.input_hold != HoldChoice::Auto || s.screened_hold.is_some() || (!report.switched && has_delay(c)) {
         return None;
     }
     let other = other_hold(hold);
@@ -308,7 +307,7 @@ pub(super) fn delay_at_bound_prefers_other(
     // seed 10923 (mixed) `asymmetric_coulomb` #3, zero-order held, went back to the first-order
     // hold with a delay of 0.92 h/2 (the zero-order hold's equivalent) without that guard.
     let asked = s.input_hold == HoldChoice::Auto && s.screened_hold.is_none() && hold == InputHold::Zoh;
-    if !asked || report.switched || !delay_offsets(c).is_empty() {
+    if !asked || report.switched || has_delay(c) {
         return None;
     }
     let at_bound = |r: &Ranked| {
@@ -340,11 +339,38 @@ pub(super) fn delay_at_bound_prefers_other(
     Some((other, note, r.clone()))
 }
 
+/// Whether an `auto` hold the nominal chose decisively, and the effects did not switch, is
+/// left undecided by the best effect: it fits both holds within `tie_bic`
+/// ([`HoldReport::effects_undecided`]). Not where the selected model has an input delay
+/// (`delay_selected`: [`delay_under_both_holds`] reads it under both holds and states the
+/// case, with the delay's interval).
+pub(super) fn effects_undecided(report: &HoldReport, delay_selected: bool, tie_bic: f64) -> bool {
+    report.requested == HoldChoice::Auto
+        && report.decisive
+        && !report.switched
+        && !delay_selected
+        && report.effect_delta_bic.is_some_and(|d| d.abs() <= tie_bic)
+}
+
+/// Whether model `c` has an input delay (on the input, or on one input of several).
+pub(super) fn has_delay(c: &Ranked) -> bool {
+    !delay_offsets(c).is_empty()
+}
+
 /// The note that states the hold and how it was chosen (none after a switch: its own note
 /// says why).
 pub(super) fn note(report: &HoldReport, hold: InputHold, tie_bic: f64) -> Option<String> {
     match (report.requested, report.decisive) {
         (HoldChoice::Auto, _) if report.switched => None,
+        (HoldChoice::Auto, true) if report.effects_undecided => {
+            let other = other_hold(hold).name();
+            Some(format!(
+                "Input hold: {} (chosen from the data: the nominal model fits better by {:.1} in BIC than with {other}). The best effect, refitted with {other}, fits as well ({:+.1} in BIC, within the tie margin {tie_bic}): the nominal's preference may have come from the missing effect, and the recording does not confirm the hold. Where the sampled command is continuous or interpolated, run with --input-hold {other} and compare.",
+                hold.name(),
+                report.delta_bic.unwrap_or(0.0),
+                report.effect_delta_bic.unwrap_or(f64::NAN)
+            ))
+        }
         (HoldChoice::Auto, true) => Some(format!(
             "Input hold: {} (chosen from the data: the nominal model fits better by {:.1} in BIC than with {}).",
             hold.name(),
@@ -496,4 +522,40 @@ pub(super) fn delay_under_both_holds(
         s.select.tie_bic,
         widened.join("; ")
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_decisive_hold_the_best_effect_fits_alike_is_undecided() {
+        let kept = HoldReport {
+            requested: HoldChoice::Auto,
+            chosen: "zoh",
+            sse_zoh: Some(6.1),
+            sse_foh: Some(7.4),
+            delta_bic: Some(254.7),
+            decisive: true,
+            effect_delta_bic: Some(0.8),
+            switched: false,
+            effects_undecided: false,
+            delay_delta_bic: None,
+            delay_other_hold: vec![],
+            delay_ambiguous: false,
+        };
+        // chirp 10953 #1: zoh by 254.7 for the nominal, the best effect +0.8 either way
+        assert!(effects_undecided(&kept, false, 6.0));
+        assert!(effects_undecided(&HoldReport { effect_delta_bic: Some(-5.9), ..kept.clone() }, false, 6.0));
+        // negative controls: the effect confirms the hold, the hold was switched, the nominal
+        // was not decisive, the hold was requested, the effects were never asked
+        assert!(!effects_undecided(&HoldReport { effect_delta_bic: Some(-6.1), ..kept.clone() }, false, 6.0));
+        assert!(!effects_undecided(&HoldReport { switched: true, ..kept.clone() }, false, 6.0));
+        assert!(!effects_undecided(&HoldReport { decisive: false, ..kept.clone() }, false, 6.0));
+        let fixed = HoldReport { requested: HoldChoice::Fixed(InputHold::Zoh), ..kept.clone() };
+        assert!(!effects_undecided(&fixed, false, 6.0));
+        assert!(!effects_undecided(&HoldReport { effect_delta_bic: None, ..kept.clone() }, false, 6.0));
+        // a selected delay is read under both holds, with its interval, elsewhere
+        assert!(!effects_undecided(&kept, true, 6.0));
+    }
 }

@@ -109,6 +109,13 @@ fn diagnose_whole(sys: &System, rec: &Recording, s: &DiagnoseSettings) -> Result
     let mut notes = std::mem::take(&mut pass.notes);
     // What the selection leaves standing: missing inputs, the initial state.
     let mut outcome = conclude(&data, &pass, &nominal, selection, &mut notes);
+    // A hold the best effect does not confirm (for a selected delay, its reading under both
+    // holds below says so, with the delay's interval).
+    pass.hold_report.effects_undecided = hold::effects_undecided(
+        &pass.hold_report,
+        outcome.chosen.as_ref().is_some_and(hold::has_delay),
+        s.select.tie_bic,
+    );
     notes::selection(&data, &pass, nominal.delta_bic_disc, &outcome.cv_rejected, &mut notes);
     // Refit: the selected model's uncertainty and the fitted model.
     let unc = refit::uncertainty(&data, &pass.ctx, outcome.chosen.as_mut(), pass.finer_fit.as_ref());

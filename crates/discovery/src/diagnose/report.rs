@@ -34,6 +34,10 @@ pub struct HoldReport {
     pub effect_delta_bic: Option<f64>,
     /// Whether the hold was switched by that check.
     pub switched: bool,
+    /// `auto`, not switched: the nominal's choice was decisive, but the best effect fits both
+    /// holds within the tie margin (`effect_delta_bic`): the preference may be the missing
+    /// effect's, and the recording does not confirm the hold once the effect is in.
+    pub effects_undecided: bool,
     /// `auto` with a selected input delay: `BIC(selected model refitted under the other
     /// hold) - BIC(selected model)`.
     pub delay_delta_bic: Option<f64>,
@@ -62,6 +66,10 @@ impl HoldReport {
             (HoldChoice::Auto, Some(d)) if self.switched => format!(
                 " (auto: the nominal model preferred {other} by {d:.1} in BIC, but the best effect fits better with {} by {:.1}: switched to it)",
                 self.chosen,
+                self.effect_delta_bic.unwrap_or(f64::NAN)
+            ),
+            (HoldChoice::Auto, Some(d)) if self.effects_undecided => format!(
+                " (auto: the nominal model fits better by {d:.1} in BIC than with {other}, but the best effect fits both holds alike ({:+.1}): not confirmed by the data)",
                 self.effect_delta_bic.unwrap_or(f64::NAN)
             ),
             (HoldChoice::Auto, Some(d)) => format!(
