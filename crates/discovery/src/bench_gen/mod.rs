@@ -740,3 +740,57 @@ pub(crate) fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     let u2: f64 = rng.random();
     (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn random_steps_change_on_samples_and_dwell_one_to_six_periods() {
+        let (w0, dt) = (30.0, 2.3e-3);
+        let (Signal::Steps { edges, v }, name) = forced(ForcedInput::Steps, 7, w0, 5.0, dt) else {
+            panic!("steps expected")
+        };
+        assert_eq!(name, "random steps");
+        let period = TAU / w0;
+        assert!(edges.len() > 3 && *edges.last().unwrap() >= 5.0, "{edges:?}");
+        for (i, pair) in edges.windows(2).enumerate() {
+            // on the sample grid, computed as the sample times are
+            let k = (pair[1] / dt).round() as usize;
+            assert_eq!(pair[1], k as f64 * dt);
+            let dwell = pair[1] - pair[0];
+            assert!(dwell >= period - dt && dwell <= 6.0 * period + dt, "dwell {dwell} of period {period}");
+            // the new level from the edge on, the old one just before
+            let s = Signal::Steps { edges: edges.clone(), v: v.clone() };
+            assert_eq!(s.eval(pair[1]), v[i + 1]);
+            assert_eq!(s.eval(pair[1] - 0.5 * dt), v[i]);
+        }
+        assert!(v.iter().all(|x| (-1.0..=1.0).contains(x)));
+    }
+
+    #[test]
+    fn the_chirp_sweeps_from_its_low_to_its_high_frequency() {
+        let (Signal::Chirp { a, omega_lo, omega_hi, duration }, _) = forced(ForcedInput::Chirp, 7, 30.0, 10.0, 1e-3)
+        else {
+            panic!("chirp expected")
+        };
+        assert!(omega_lo < 30.0 * 0.15 && omega_hi > 30.0 * 1.2 && duration == 10.0);
+        let s = Signal::Chirp { a: 1.0, omega_lo, omega_hi, duration };
+        // the frequency from the time between upward zero crossings, at the start and after
+        // the sweep (held at its top)
+        let crossings = |t0: f64, t1: f64| -> Vec<f64> {
+            let n = ((t1 - t0) / 1e-5) as usize;
+            (0..n).map(|i| t0 + i as f64 * 1e-5).filter(|&t| s.eval(t) <= 0.0 && s.eval(t + 1e-5) > 0.0).collect()
+        };
+        let early = crossings(0.0, 4.0 * TAU / omega_lo);
+        let late = crossings(duration, duration + 4.0 * TAU / omega_hi);
+        let freq = |c: &[f64]| TAU / (c[1] - c[0]);
+        // log sweep: omega(t) = omega_lo (omega_hi / omega_lo)^(t / duration), at the first
+        // period's middle
+        let mid = 0.5 * (early[0] + early[1]);
+        let expected = omega_lo * (omega_hi / omega_lo).powf(mid / duration);
+        assert!((freq(&early) / expected - 1.0).abs() < 0.02, "{} vs {expected}", freq(&early));
+        assert!((freq(&late) / omega_hi - 1.0).abs() < 1e-3, "{} vs {omega_hi}", freq(&late));
+        assert!(a > 0.0 && a <= 1.0);
+    }
+}
