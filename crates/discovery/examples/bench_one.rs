@@ -6,6 +6,10 @@
 //! makes the recordings F times longer. A miss is followed by a line comparing the selected
 //! model's BIC gain with the best ranked single of the true class.
 fn main() {
+    if let Some(e) = discovery::bench_gen::env_error() {
+        eprintln!("error: {e}");
+        std::process::exit(2);
+    }
     let args: Vec<String> = std::env::args().collect();
     let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);

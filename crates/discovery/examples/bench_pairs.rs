@@ -21,6 +21,10 @@
 //! more (a fit that missed the true parameters, or a reading fitting coloured noise: not the
 //! recording's ceiling), and the misses flagged among the rest.
 fn main() {
+    if let Some(e) = discovery::bench_gen::env_error() {
+        eprintln!("error: {e}");
+        std::process::exit(2);
+    }
     use discovery::bench_gen;
     let args: Vec<String> = std::env::args().collect();
     let cases: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1);

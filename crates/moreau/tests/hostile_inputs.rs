@@ -543,6 +543,33 @@ fn merge_of_a_folder_refuses_a_conflicting_extra_json() {
     assert!(!p.join("merged2").exists());
 }
 
+/// The benchmark's environment variables: a typo is refused before any case runs, not read as
+/// the default and reported as if the condition had been set.
+#[test]
+fn discover_bench_refuses_a_benchmark_variable_it_cannot_read() {
+    let d = workdir();
+    let p = d.path();
+    let run = |k: &str, v: &str| {
+        Command::new(env!("CARGO_BIN_EXE_moreau"))
+            .args(["discover-bench", "--cases", "1", "--classes", "none"])
+            .env(k, v)
+            .current_dir(p)
+            .output()
+            .unwrap()
+    };
+    for (k, v, needle) in [
+        ("BENCH_SIGNAL", "chrip", "chirp or steps"),
+        ("BENCH_NOISE_DB", "loud", "finite level in dB"),
+        ("BENCH_NOISE_DB", "NaN", "finite level in dB"),
+        ("BENCH_LENGTH", "-2", "positive factor"),
+        ("BENCH_TRUTH", "fine", "expected coarse"),
+    ] {
+        let o = run(k, v);
+        assert_refused(&o, &[k, v, needle]);
+        assert!(o.stdout.is_empty());
+    }
+}
+
 /// `discover-bench --json <unwritable>` failed only after the benchmark; `--allow-large` was
 /// advised when it had been given.
 #[test]

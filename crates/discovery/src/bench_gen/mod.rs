@@ -150,6 +150,28 @@ pub fn noise_db() -> f64 {
     std::env::var("BENCH_NOISE_DB").ok().and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite()).unwrap_or(-30.0)
 }
 
+/// What is wrong with the benchmark's environment variables (`BENCH_SIGNAL`,
+/// `BENCH_NOISE_DB`, `BENCH_LENGTH`, `BENCH_TRUTH`), naming the variable and its value; `None`
+/// where each is unset or valid. The generator reads them leniently (an invalid value falls
+/// back to the default); the runners refuse to start on one, so a typo does not pass for a
+/// measurement under the condition it names.
+pub fn env_error() -> Option<String> {
+    let var = |k: &str| std::env::var(k).ok();
+    if let Some(v) = var("BENCH_SIGNAL").filter(|v| ForcedInput::parse(v).is_none()) {
+        return Some(format!("BENCH_SIGNAL={v:?}: expected chirp or steps (or unset: the drawn inputs)"));
+    }
+    if let Some(v) = var("BENCH_NOISE_DB").filter(|v| !v.parse::<f64>().is_ok_and(f64::is_finite)) {
+        return Some(format!("BENCH_NOISE_DB={v:?}: expected a finite level in dB (default -30)"));
+    }
+    if let Some(v) = var("BENCH_LENGTH").filter(|v| !v.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)) {
+        return Some(format!("BENCH_LENGTH={v:?}: expected a positive factor (default 1)"));
+    }
+    if let Some(v) = var("BENCH_TRUTH").filter(|v| v != "coarse") {
+        return Some(format!("BENCH_TRUTH={v:?}: expected coarse (or unset: the converged truth)"));
+    }
+    None
+}
+
 /// The sampling and noise conditions of one case (reported per case by the benchmark).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Conditions {

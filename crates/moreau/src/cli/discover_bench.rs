@@ -43,6 +43,9 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     if a.cases == 0 {
         anyhow::bail!("--cases must be at least 1 (got 0)");
     }
+    if let Some(e) = discovery::bench_gen::env_error() {
+        anyhow::bail!("{e}");
+    }
     // each case simulates and fits several hypotheses (seconds); the results stay in memory
     crate::budget::check(
         "discover-bench: --cases",
