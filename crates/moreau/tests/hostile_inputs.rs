@@ -411,14 +411,18 @@ fn outputs_never_replace_inputs_devices_or_links() {
 #[test]
 fn a_closed_stdout_ends_quietly() {
     let d = workdir();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_moreau"))
+    // The reader is gone before the command starts, as with `| head -c 0` once `head` has
+    // exited: closing it after the spawn raced the command's few lines into the pipe's buffer
+    // (exit 0 on a fast start, seen once in CI).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let child = Command::new(env!("CARGO_BIN_EXE_moreau"))
         .args(["validate", "w.toml", "w.toml", "w.toml"])
         .current_dir(d.path())
-        .stdout(std::process::Stdio::piped())
+        .stdout(writer)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    drop(child.stdout.take()); // the reader goes away, as `| head -c 0` would
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
