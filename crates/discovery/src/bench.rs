@@ -89,6 +89,19 @@ pub fn all_params(e: &Effect) -> Vec<(&'static str, f64)> {
     physics::every_parameter(e).unwrap_or_else(|| vec![("main", main_param(e))])
 }
 
+/// Settings `s` with the true initial state of `case` (its nominal model's `x0`, `z0`) where
+/// they state none, as the model file written by `discover-bench --write-cases` does.
+pub fn with_case_start(case: &bench_gen::Case, s: &DiagnoseSettings) -> DiagnoseSettings {
+    let mut s = s.clone();
+    if s.initial_state.is_none() {
+        s.initial_state = Some(crate::diagnose::InitialState {
+            x0: case.nominal.x0.iter().copied().collect(),
+            z0: Some(case.nominal.z0.iter().copied().collect()),
+        });
+    }
+    s
+}
+
 /// Runs one case of the classic profile.
 pub fn run_case(class: &'static str, seed: u64, index: usize, s: &DiagnoseSettings) -> CaseResult {
     run_case_with(class, seed, index, Profile::Classic, s)
@@ -105,13 +118,7 @@ pub fn run_case_with(
     s: &DiagnoseSettings,
 ) -> CaseResult {
     let case = bench_gen::generate_profile(class, seed, index, profile);
-    let mut s = s.clone();
-    if s.initial_state.is_none() {
-        s.initial_state = Some(crate::diagnose::InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        });
-    }
+    let s = with_case_start(&case, s);
     let start = std::time::Instant::now();
     let r = diagnose(&case.nominal, &case.recording, &s);
     let mut out = CaseResult::unscored(class, index, &case, start.elapsed().as_secs_f64());
@@ -533,13 +540,7 @@ pub fn run_pair_case(
     s: &DiagnoseSettings,
 ) -> Option<PairResult> {
     let case = bench_gen::generate_pair(pair, seed, index, profile)?;
-    let mut s = s.clone();
-    if s.initial_state.is_none() {
-        s.initial_state = Some(crate::diagnose::InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        });
-    }
+    let s = with_case_start(&case, s);
     let start = std::time::Instant::now();
     let r = diagnose(&case.nominal, &case.recording, &s);
     let mut out = PairResult {

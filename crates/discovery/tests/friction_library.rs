@@ -139,13 +139,7 @@ fn coulomb_friction_under_random_steps_is_refitted_from_its_generalisation() {
         bench_gen::ForcedInput::Steps,
     );
     let Some(Effect::CoulombFriction { level: truth, .. }) = case.truth else { panic!("{:?}", case.truth) };
-    let s = DiagnoseSettings {
-        initial_state: Some(discovery::InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        ..Default::default()
-    };
+    let s = discovery::bench::with_case_start(&case, &DiagnoseSettings::default());
     let r = discovery::diagnose(&case.nominal, &case.recording, &s).unwrap();
     assert_eq!(r.selected(), "coulomb_friction", "{}", r.verdict);
     let e = &r.effects[0];

@@ -120,13 +120,45 @@ impl Profile {
     }
 }
 
+/// Benchmark variable `key` as `parse` reads it: `Ok(None)` unset, `Err` naming the variable
+/// and its value where `parse` refuses it (`expected`: what it takes). The generator reads each
+/// leniently (a refused value falls back to the default); [`env_error`] refuses to run on one.
+fn bench_var<T>(key: &str, parse: impl Fn(&str) -> Option<T>, expected: &str) -> Result<Option<T>, String> {
+    match std::env::var(key) {
+        Err(_) => Ok(None),
+        Ok(v) => parse(&v).map(Some).ok_or_else(|| format!("{key}={v:?}: expected {expected}")),
+    }
+}
+
+/// `BENCH_TRUTH` (`coarse`).
+fn truth_var() -> Result<Option<()>, String> {
+    bench_var("BENCH_TRUTH", |v| (v == "coarse").then_some(()), "coarse (or unset: the converged truth)")
+}
+
+/// `BENCH_LENGTH` (a positive factor).
+fn length_var() -> Result<Option<f64>, String> {
+    let positive = |v: &str| v.parse::<f64>().ok().filter(|f| f.is_finite() && *f > 0.0);
+    bench_var("BENCH_LENGTH", positive, "a positive factor (default 1)")
+}
+
+/// `BENCH_NOISE_DB` (a finite level in dB).
+fn noise_var() -> Result<Option<f64>, String> {
+    let finite = |v: &str| v.parse::<f64>().ok().filter(|f| f.is_finite());
+    bench_var("BENCH_NOISE_DB", finite, "a finite level in dB (default -30)")
+}
+
+/// `BENCH_SIGNAL` ([`ForcedInput::parse`]).
+fn signal_var() -> Result<Option<ForcedInput>, String> {
+    bench_var("BENCH_SIGNAL", ForcedInput::parse, "chirp or steps (or unset: the drawn inputs)")
+}
+
 /// Each recording's truth is stepped until halving the step moves it by less than a tenth of a
 /// sigma of any fitted parameter ([`plant_sim::simulate_converged`]). `BENCH_TRUTH=coarse`
 /// gives the truth of the tables before 2026-11-26 instead (20 fine steps per sample, whose
 /// first-order play, friction and inertia updates leave it up to about a sigma off on
 /// friction and backlash-inertia cases; BENCHMARKS.md, issue 27 item 2).
 pub fn converged_truth() -> bool {
-    !std::env::var("BENCH_TRUTH").is_ok_and(|v| v == "coarse")
+    !matches!(truth_var(), Ok(Some(())))
 }
 
 /// Each recording's duration is multiplied by `BENCH_LENGTH` (a positive number; default 1):
@@ -134,11 +166,7 @@ pub fn converged_truth() -> bool {
 /// draws after the input signal differ from the default length's (the signal's draws depend
 /// on its duration): fresh cases, not the short ones made long.
 pub fn length_factor() -> f64 {
-    std::env::var("BENCH_LENGTH")
-        .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|f| f.is_finite() && *f > 0.0)
-        .unwrap_or(1.0)
+    length_var().ok().flatten().unwrap_or(1.0)
 }
 
 /// The measurement noise's level in dB of the nominal output's standard deviation:
@@ -147,29 +175,16 @@ pub fn length_factor() -> f64 {
 /// level, so a case differs only by its noise (and the truth's stepping, converged to a tenth
 /// of the new noise's sigma).
 pub fn noise_db() -> f64 {
-    std::env::var("BENCH_NOISE_DB").ok().and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite()).unwrap_or(-30.0)
+    noise_var().ok().flatten().unwrap_or(-30.0)
 }
 
 /// What is wrong with the benchmark's environment variables (`BENCH_SIGNAL`,
-/// `BENCH_NOISE_DB`, `BENCH_LENGTH`, `BENCH_TRUTH`), naming the variable and its value; `None`
-/// where each is unset or valid. The generator reads them leniently (an invalid value falls
-/// back to the default); the runners refuse to start on one, so a typo does not pass for a
-/// measurement under the condition it names.
+/// `BENCH_NOISE_DB`, `BENCH_LENGTH`, `BENCH_TRUTH`), naming the first refused variable and its
+/// value; `None` where each is unset or valid. The generator reads them leniently; the runners
+/// refuse to start on one, so a typo does not pass for a measurement under the condition it
+/// names.
 pub fn env_error() -> Option<String> {
-    let var = |k: &str| std::env::var(k).ok();
-    if let Some(v) = var("BENCH_SIGNAL").filter(|v| ForcedInput::parse(v).is_none()) {
-        return Some(format!("BENCH_SIGNAL={v:?}: expected chirp or steps (or unset: the drawn inputs)"));
-    }
-    if let Some(v) = var("BENCH_NOISE_DB").filter(|v| !v.parse::<f64>().is_ok_and(f64::is_finite)) {
-        return Some(format!("BENCH_NOISE_DB={v:?}: expected a finite level in dB (default -30)"));
-    }
-    if let Some(v) = var("BENCH_LENGTH").filter(|v| !v.parse::<f64>().is_ok_and(|f| f.is_finite() && f > 0.0)) {
-        return Some(format!("BENCH_LENGTH={v:?}: expected a positive factor (default 1)"));
-    }
-    if let Some(v) = var("BENCH_TRUTH").filter(|v| v != "coarse") {
-        return Some(format!("BENCH_TRUTH={v:?}: expected coarse (or unset: the converged truth)"));
-    }
-    None
+    [signal_var().err(), noise_var().err(), length_var().err(), truth_var().err()].into_iter().flatten().next()
 }
 
 /// The sampling and noise conditions of one case (reported per case by the benchmark).
@@ -242,6 +257,12 @@ impl Signal {
             Signal::Steps { edges, v } => v[edges.partition_point(|&e| e <= t).saturating_sub(1)],
         }
     }
+
+    /// Whether the signal jumps (steps): a jump between fine grid points, as a delayed one
+    /// falls, is a first-order error of the fine stepping.
+    pub fn has_jumps(&self) -> bool {
+        matches!(self, Signal::Steps { .. })
+    }
 }
 
 /// An input kind forced on every case in place of the drawn one (multisine, filtered noise
@@ -270,7 +291,7 @@ impl ForcedInput {
 /// The input kind that `BENCH_SIGNAL` (`chirp` or `steps`) forces on every case of the
 /// benchmarks ([`ForcedInput`]; unset: the drawn kinds).
 pub fn forced_signal() -> Option<ForcedInput> {
-    ForcedInput::parse(&std::env::var("BENCH_SIGNAL").ok()?)
+    signal_var().ok().flatten()
 }
 
 /// The `forced` input for a plant of natural frequency `w0` over `duration`, sampled every
@@ -684,16 +705,15 @@ fn generate_classes(
         .collect();
     let truth = truths.first().cloned();
     let effs: Vec<&Effect> = truths.iter().collect();
-    let y: Vec<f64> = if converged_truth() {
+    let clean = if converged_truth() {
         // The magnitudes above were set on the 20-per-sample grid; the recording's truth is
         // converged to a tenth of a sigma of any fitted parameter (white-noise count of samples).
         let tol = 0.1 * noise_std * noise_scale / (ns as f64).sqrt();
-        let (clean, _) = plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive, tol);
-        clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect()
+        plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive, tol).0
     } else {
-        let clean = plant_sim::simulate_effects(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive);
-        clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect()
+        plant_sim::simulate_effects(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive)
     };
+    let y: Vec<f64> = clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect();
     let nominal_fit = fit_percent(&y, &clean_nom);
     let name = format!("bench {} #{index} (n = {n})", classes.join("+"));
     let nominal = nominal_system(name, &plant, nominal_has_play, &x0, dt, duration);

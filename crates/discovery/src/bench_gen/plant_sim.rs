@@ -75,7 +75,7 @@ pub fn simulate_effects(
 /// [`FINE_MAX`]) until doubling changes `y` by less than `tol` (RMS over the samples), and the
 /// finer run is returned. A change `d` of the output biases a fitted parameter by at most about
 /// `d sqrt(N) / noise` of its sigma (`N` samples of white noise), so `tol = 0.1 noise / sqrt(N)`
-/// keeps the truth within a tenth of a sigma of the converged one. A smooth truth (no play, no friction, no inertia) is second order
+/// keeps the truth within a tenth of a sigma of the converged one. A smooth truth (no play, no friction, no inertia, no input jump) is second order
 /// at 20 and returned as it is. Returns `y` and the fine steps per sample used.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_converged(
@@ -92,8 +92,7 @@ pub fn simulate_converged(
     let at = |fine: usize| simulate_fine(pl, hw, effs, sig, x0, dt, ns, drive, fine);
     let mut fine = FINE;
     let mut y = at(fine);
-    // (a step of the input between fine grid points, as a delayed step is, is first order too)
-    if !first_order(hw, effs) && !matches!(sig, Signal::Steps { .. }) {
+    if !first_order(hw, effs, sig) {
         return (y, fine);
     }
     while fine < FINE_MAX {
@@ -113,9 +112,11 @@ fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
     (a.iter().zip(b).map(|(u, v)| (u - v).powi(2)).sum::<f64>() / a.len().max(1) as f64).sqrt()
 }
 
-/// Whether the truth has an update that [`simulate_fine`] steps to first order.
-fn first_order(hw: f64, effs: &[&Effect]) -> bool {
+/// Whether the truth has an update that [`simulate_fine`] steps to first order: a play, a
+/// friction law, backlash inertia, or an input that jumps ([`Signal::has_jumps`]).
+fn first_order(hw: f64, effs: &[&Effect], sig: &Signal) -> bool {
     hw > 0.0
+        || sig.has_jumps()
         || effs.iter().any(|e| {
             matches!(
                 e,

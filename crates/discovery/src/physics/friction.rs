@@ -233,7 +233,8 @@ impl Family for Friction {
     /// static level and their mean; a direction-dependent law's mean level and each of its
     /// two; a load-dependent law's level without and with a third more for the load's part.
     fn starts_from_general(&self, simple: &Hypothesis, kind: Kind, general: &[f64]) -> Option<Vec<Vec<f64>>> {
-        if !matches!(simple.kind, Kind::CoulombFriction { .. }) || kind.simpler_form() != Some(simple.kind) {
+        // (the simpler form of every friction generalisation is Coulomb friction on its state)
+        if kind.simpler_form() != Some(simple.kind) {
             return None;
         }
         let levels = match (kind, general) {

@@ -211,8 +211,10 @@ pub(crate) fn fit_singles(
         if plan.parallel { cands.par_iter().map(one).collect() } else { cands.iter().map(one).collect() };
     // Restarts between nested laws: a simpler form from its generalisation's estimate, then
     // each generalisation from its simpler form's.
-    refit_where_better(ctx, plan, &from_generalisations(&cands, &singles, plan.select.margin_bic), &mut singles, nom);
-    refit_where_better(ctx, plan, &from_simpler_forms(&cands, &singles), &mut singles, nom);
+    let scores = (bic_nom, val_sse_nom);
+    let redo = from_generalisations(&cands, &singles, plan.select.margin_bic);
+    refit_where_better(ctx, plan, &redo, &mut singles, &nom.x0, scores);
+    refit_where_better(ctx, plan, &from_simpler_forms(&cands, &singles), &mut singles, &nom.x0, scores);
     // Grey-box refit: the freed nominal parameters alone, ranked with the effects ("the
     // plant's parameters were off" is a hypothesis of its own, not missing physics).
     if let Some(free) = ctx.free {
@@ -282,18 +284,19 @@ fn from_simpler_forms(cands: &[Hypothesis], singles: &[Ranked]) -> Vec<(usize, H
         .collect()
 }
 
-/// Each single `singles[i]` of `redo` fitted again as its hypothesis there (other starts); the
-/// better of the two fits stands.
+/// Each single `singles[i]` of `redo` fitted again as its hypothesis there (other starts) from
+/// `x0`, scored against the nominal's `(bic_nom, val_sse_nom)`; the better of the two fits
+/// stands.
 fn refit_where_better(
     ctx: &FitContext,
     plan: &Plan,
     redo: &[(usize, Hypothesis)],
     singles: &mut [Ranked],
-    nom: &FitResult,
+    x0: &[f64],
+    (bic_nom, val_sse_nom): (f64, f64),
 ) {
-    let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
     let again = |(i, h): &(usize, Hypothesis)| {
-        (*i, fit_hypothesis(ctx, plan, vec![h.clone()], None, None, &nom.x0, bic_nom, val_sse_nom))
+        (*i, fit_hypothesis(ctx, plan, vec![h.clone()], None, None, x0, bic_nom, val_sse_nom))
     };
     let refits: Vec<(usize, Ranked)> =
         if plan.parallel { redo.par_iter().map(again).collect() } else { redo.iter().map(again).collect() };
