@@ -117,18 +117,9 @@ impl ExtendedModel {
                 cmd = queue.pop_front().expect("the queue holds the command just pushed");
             }
             // the plant input from sample k on: saturated, through the input play
+            let up = uplay.get_or_insert_with(|| self.input.play_start(&cmd, m));
             for j in 0..m {
-                let mut v = cmd[j];
-                if let Some(l) = self.input.saturation {
-                    v = v.clamp(-l, l);
-                }
-                if let Some(width) = self.input.play {
-                    let r = 0.5 * width;
-                    let up = uplay.get_or_insert_with(|| vec![v; m]);
-                    up[j] = up[j].clamp(v - r, v + r);
-                    v = up[j];
-                }
-                held[k * m + j] = v;
+                held[k * m + j] = self.input.shaped(cmd[j], &mut up[j]);
             }
             if k + 1 == ns {
                 break;
