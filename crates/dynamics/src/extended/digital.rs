@@ -76,7 +76,8 @@ impl ExtendedModel {
     /// The closed digital loop driven by the reference `w` (flat, `k * m + j`): see the module
     /// documentation. The plant input before the first command arrives (computation delay)
     /// is 0.
-    pub(super) fn simulate_loop(
+    /// The dimensions are `N, M, P` (`super::simulate::with_dims`).
+    pub(super) fn simulate_loop<const N: usize, const M: usize, const P: usize>(
         &self,
         dl: &DigitalLoop,
         w: &[f64],
@@ -84,7 +85,7 @@ impl ExtendedModel {
         x0: &[f64],
         z0: Option<&[f64]>,
     ) -> SimOutput {
-        let (n, m, p) = (self.n, self.m, self.p);
+        let (n, m, p) = self.dims::<N, M, P>();
         let ns = w.len() / m;
         let mut out = SimOutput::zeros(ns, n, p);
         let mut st = self.start(x0, z0);
@@ -129,8 +130,8 @@ impl ExtendedModel {
                 for (pi, &(fa, fb, pc)) in parts[..np].iter().enumerate() {
                     let tau = k as f64 + 0.5 * (fa + fb) - shift;
                     let idx = if tau <= 0.0 { 0 } else { (tau.floor() as usize).min(k) };
-                    self.step_plant(&mut st, pc, &held[idx * m..(idx + 1) * m], &dw);
-                    let hit = self.step_play(&mut st, pc);
+                    self.step_plant::<N, M, P>(&mut st, pc, &held[idx * m..(idx + 1) * m], &dw);
+                    let hit = self.step_play::<N, M, P>(&mut st, pc);
                     if s + 1 == sub && pi + 1 == np {
                         if let Some(hit) = hit {
                             out.contact[k + 1] = hit;
