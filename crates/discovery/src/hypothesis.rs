@@ -124,10 +124,16 @@ fn velocity_sites(sys: &System, s: &Scales) -> Vec<Site> {
 /// All single-effect hypotheses applicable to `sys`: the library's families at the play, each
 /// velocity state, the input and the sensor, in that order.
 pub fn candidates(sys: &System, s: &Scales) -> Vec<Hypothesis> {
+    candidates_in(sys, s, None)
+}
+
+/// [`candidates`] narrowed to `library` (labels or names, [`physics::in_library`]; `None`:
+/// all), without the work of stating the others.
+pub fn candidates_in(sys: &System, s: &Scales, library: Option<&[String]>) -> Vec<Hypothesis> {
     let mut sites = vec![Site::Play];
     sites.extend(velocity_sites(sys, s));
     sites.extend([Site::Input, Site::Sensor]);
-    physics::hypotheses_at(&sites, &Context { sys, scales: s })
+    physics::hypotheses_at(&sites, &Context { sys, scales: s, library })
 }
 
 /// Per-input hypotheses for a model with `m > 1` inputs (none for `m = 1`): the library's
@@ -146,7 +152,7 @@ pub fn per_input_candidates(sys: &System, s: &Scales, w: &[f64]) -> Vec<Hypothes
             Site::OneInput { input: j, absmax, range }
         })
         .collect();
-    physics::hypotheses_at(&sites, &Context { sys, scales: s })
+    physics::hypotheses_at(&sites, &Context { sys, scales: s, library: None })
 }
 
 #[cfg(test)]

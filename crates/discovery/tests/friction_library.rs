@@ -33,6 +33,21 @@ fn cogging_scan_finds_the_period_and_the_hypothesis_is_offered() {
     // Without the nominal run there is no scan and no cogging hypothesis.
     assert!(hypothesis::cogging_scan(sys, &base, 0, 1).is_empty());
     assert!(!hypothesis::candidates(sys, &base).iter().any(|h| matches!(h.kind, Kind::Cogging { .. })));
+    // A narrowed library states exactly its own hypotheses (by label or by name), the same as
+    // the full list filtered; cogging (whose scan runs over the record) only where asked.
+    let all = hypothesis::candidates(sys, &scales);
+    for lib in [vec!["coulomb_friction(x2)".to_string()], vec!["cogging".into(), "gap_width".into()], vec![]] {
+        let narrowed: Vec<Kind> = hypothesis::candidates_in(sys, &scales, Some(&lib)).iter().map(|h| h.kind).collect();
+        let filtered: Vec<Kind> =
+            all.iter().map(|h| h.kind).filter(|k| lib.iter().any(|l| *l == k.label() || l == k.name())).collect();
+        assert_eq!(narrowed, filtered, "library {lib:?}");
+        assert_eq!(
+            narrowed.contains(&Kind::Cogging { state: 1, position_state: 0 }),
+            lib[..].contains(&"cogging".into())
+        );
+    }
+    // Negative control: the unnarrowed list holds more than any of them.
+    assert!(all.len() > 3);
 }
 
 /// The scales of `case`'s recording with its nominal run (4 sub-steps, the first 70 % the

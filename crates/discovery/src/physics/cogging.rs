@@ -182,7 +182,10 @@ fn cogging(sys: &System, s: &Scales, pos: usize, vel: usize, fs: f64) -> Option<
 impl Family for Cogging {
     fn hypotheses(&self, site: &Site, cx: &Context) -> Vec<Hypothesis> {
         match *site {
-            Site::Velocity { state, force_bound, position_state: Some(pos), .. } => {
+            // The scan runs over the record: only where the library asks for cogging.
+            Site::Velocity { state, force_bound, position_state: Some(pos), .. }
+                if cx.allows(Kind::Cogging { state, position_state: pos }) =>
+            {
                 cogging(cx.sys, cx.scales, pos, state, force_bound).into_iter().collect()
             }
             _ => vec![],

@@ -126,6 +126,23 @@ pub enum Site {
 pub struct Context<'a> {
     pub sys: &'a System,
     pub scales: &'a Scales,
+    /// The hypotheses allowed, by label or name (`None`: every one;
+    /// `DiagnoseSettings::library`).
+    pub library: Option<&'a [String]>,
+}
+
+impl Context<'_> {
+    /// Whether the library allows `kind` (see [`in_library`]). A family whose hypothesis costs
+    /// work to state (the cogging scan runs over the record) asks before doing it.
+    pub fn allows(&self, kind: Kind) -> bool {
+        self.library.is_none_or(|lib| in_library(lib, kind))
+    }
+}
+
+/// Whether `kind` is among `library`'s entries, by label (`coulomb_friction(x2)`) or by name
+/// (`coulomb_friction`, every state).
+pub fn in_library(library: &[String], kind: Kind) -> bool {
+    library.iter().any(|l| *l == kind.label() || l == kind.name())
 }
 
 /// One family of effects (one file of this folder).
@@ -178,7 +195,11 @@ pub static FAMILIES: [&dyn Family; 5] =
 
 /// The hypotheses of every family at each of `sites`, sites first, families second.
 pub fn hypotheses_at(sites: &[Site], cx: &Context) -> Vec<Hypothesis> {
-    sites.iter().flat_map(|site| FAMILIES.iter().flat_map(move |f| f.hypotheses(site, cx))).collect()
+    sites
+        .iter()
+        .flat_map(|site| FAMILIES.iter().flat_map(move |f| f.hypotheses(site, cx)))
+        .filter(|h| cx.allows(h.kind))
+        .collect()
 }
 
 /// The main parameter of a model-file effect and the hypothesis parameter that estimates it

@@ -191,12 +191,13 @@ pub(crate) fn fit_singles(
     prev: Option<&[Ranked]>,
 ) -> Vec<Ranked> {
     let (bic_nom, val_sse_nom) = nominal_scores(ctx, nom);
-    let mut cands = hypothesis::candidates(sys, &ctx.scales);
+    let mut cands = hypothesis::candidates_in(sys, &ctx.scales, plan.library);
     // Several inputs: play, saturation and delay on each input alone, too.
-    cands.extend(crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w));
-    if let Some(lib) = plan.library {
-        cands.retain(|h| lib.iter().any(|l| *l == h.kind.label() || l == h.kind.name()));
-    }
+    cands.extend(
+        crate::fit::input_effects::candidates(sys, &ctx.scales, &ctx.w)
+            .into_iter()
+            .filter(|h| plan.library.is_none_or(|lib| crate::physics::in_library(lib, h.kind))),
+    );
     let warm = |h: &Hypothesis| -> Option<Vec<f64>> {
         let label = h.kind.label();
         prev?
