@@ -16,8 +16,11 @@
 //! Delay under an unknown hold ([`delay_under_both_holds`], `auto` only): a selected input
 //! delay is refitted under the other hold; where the two fits differ by less than the tie
 //! margin the recording cannot tell "zero-order hold + tau" from "first-order hold + tau +
-//! h/2", and the delay's 1-sigma is widened by half the distance between the two readings (so
-//! that its 2-sigma interval reaches the other reading and that reading's own 1-sigma).
+//! h/2", and the delay's 1-sigma is widened by the distance between the two readings (so that
+//! its 1-sigma interval reaches the other reading, and its 2-sigma interval that reading's own
+//! 2-sigma: the truth lies at either reading, and half the distance left it at 1.4-1.95 sigma
+//! from the one reported whenever it lay at the other, BENCHMARKS "Issue 27 on seeds
+//! 10966-10980").
 use super::report::HoldReport;
 use super::settings::HoldChoice;
 use super::setup::Setup;
@@ -466,7 +469,7 @@ fn delay_offsets(c: &Ranked) -> Vec<usize> {
 /// where the difference, counted for the colour of the selected model's residual
 /// (`(1 - rho)/(1 + rho)` independent samples per sample), is within the tie margin
 /// (`report.delay_ambiguous`) the delays'
-/// 1-sigma in `chosen.std` grows by half the distance between the readings, and the note
+/// 1-sigma in `chosen.std` grows by the distance between the readings, and the note
 /// that says so is returned. Call after the uncertainty is combined (it widens the final
 /// sigma).
 pub(super) fn delay_under_both_holds(
@@ -504,7 +507,7 @@ pub(super) fn delay_under_both_holds(
     for (j, &i) in at.iter().enumerate() {
         let gap = (report.delay_other_hold[j] - c.params[i]).abs();
         if gap.is_finite() {
-            c.std[i] += 0.5 * gap;
+            c.std[i] += gap;
             widened.push(format!(
                 "{:.4e} s (this hold) and {:.4e} s ({})",
                 c.params[i],
@@ -514,7 +517,7 @@ pub(super) fn delay_under_both_holds(
         }
     }
     Some(format!(
-        "Input hold and delay: the delay model fits the {} and the {} hold alike ({:+.1} in BIC, {:+.1} counted for the residual's colour, within the tie margin {}): the recording cannot tell which hold the plant saw, and the delay reads {}. Its reported 1-sigma is widened by half the distance between the readings, so that +-2 sigma covers both; use --input-hold if the hold is known.",
+        "Input hold and delay: the delay model fits the {} and the {} hold alike ({:+.1} in BIC, {:+.1} counted for the residual's colour, within the tie margin {}): the recording cannot tell which hold the plant saw, and the delay reads {}. Its reported 1-sigma is widened by the distance between the readings, so that +-1 sigma reaches both; use --input-hold if the hold is known.",
         hold.name(),
         other.name(),
         d,
