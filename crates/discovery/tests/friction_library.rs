@@ -39,7 +39,7 @@ fn cogging_scan_finds_the_period_and_the_hypothesis_is_offered() {
     for lib in [vec!["coulomb_friction(x2)".to_string()], vec!["cogging".into(), "gap_width".into()], vec![]] {
         let narrowed: Vec<Kind> = hypothesis::candidates_in(sys, &scales, Some(&lib)).iter().map(|h| h.kind).collect();
         let filtered: Vec<Kind> =
-            all.iter().map(|h| h.kind).filter(|k| lib.iter().any(|l| *l == k.label() || l == k.name())).collect();
+            all.iter().map(|h| h.kind).filter(|k| discovery::physics::in_library(&lib, *k)).collect();
         assert_eq!(narrowed, filtered, "library {lib:?}");
         assert_eq!(
             narrowed.contains(&Kind::Cogging { state: 1, position_state: 0 }),

@@ -48,22 +48,17 @@ impl InputPath {
         v.clamp(-self.limit, self.limit)
     }
 
-    /// The input play's output for the saturated input `v`, from its state `u` (updated; it
-    /// starts at the first saturated sample); `v` itself without a play.
+    /// `v` saturated and passed through the input play from its state `u` (updated; it starts
+    /// at the first saturated sample, [`InputPath::play_start`]); without a play, `v` saturated.
     #[inline(always)]
-    pub(super) fn played(&self, v: f64, u: &mut f64) -> f64 {
+    pub(super) fn shaped(&self, v: f64, u: &mut f64) -> f64 {
+        let v = self.saturated(v);
         if self.half_play > 0.0 {
             *u = u.clamp(v - self.half_play, v + self.half_play);
             *u
         } else {
             v
         }
-    }
-
-    /// `v` saturated and passed through the input play (state `u`).
-    #[inline(always)]
-    pub(super) fn shaped(&self, v: f64, u: &mut f64) -> f64 {
-        self.played(self.saturated(v), u)
     }
 
     /// An `input_delay` (negative delays count as 0).
