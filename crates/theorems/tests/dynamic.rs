@@ -1,5 +1,5 @@
 //! Simulation-based properties: Theorem 1 (stat1), Lemma 2 (xX), Theorem 2 (path), (zinf) and
-//! (QZdot), 2,000 cases each by default (short horizons, `h = T/500` capped at `0.01`, `n <= 4`;
+//! (QZdot), 2,000 cases each by default (short horizons, `h = T/2000` capped at `0.0025`, `n <= 4`;
 //! Theorem 2 draws intervals, balls and ellipsoids, ball intersections are in the ignored
 //! `theorem2_ball_intersections` test because their projection costs ~50x more). Change the
 //! count with `THEOREMS_SIM_CASES` (Theorem 2, QZdot), `THEOREMS_THEOREM1_CASES`,
