@@ -13,10 +13,8 @@
 //! then 3 periods are measured: path length per period `sum |Dz|` (minimum over the periods)
 //! and speed `max |Dz|/h`.
 //! Tolerance (discretisation, first-order scheme): `2%` of the right-hand side. The scheme's
-//! `max |Dz|/h` overshoots the continuous speed by O(h): on the persisted case `0473c29a` of
-//! `proptest-regressions/dynamic.txt` it reads 15.14, 14.41, 14.00, 13.79, 13.68 at
-//! `h = T/500 ... T/8000` (limit about 13.57) against the bound 14.24, so `T/500` (used until
-//! 2026-11-29) failed the claim by 6 % where the continuous speed keeps it by 4.7 %.
+//! `max |Dz|/h` overshoots the continuous speed by O(h); the step is chosen on a measured case
+//! (`proofs-notes/theorem2-zinf.md`, "Step").
 //! Negative controls: (path) `d` replaced by `0` (the tube ignored); (zinf) the bound halved.
 use super::sets_prelude::*;
 use super::simulation::simulate;
