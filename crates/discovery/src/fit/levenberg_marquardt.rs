@@ -188,13 +188,43 @@ pub(crate) trait Objective: Sync {
     /// Whether a forward step `h` on variable `c` would leave the box (then it is taken
     /// backwards).
     fn step_back(&self, v: &[f64], c: usize, h: f64) -> bool;
+    /// The residual at `vp`, which differs from `v` (residual `r0`) in variable `c` alone (a
+    /// Jacobian column); [`Objective::res`] at `vp` unless the objective knows a cheaper way.
+    fn res_beside(&self, v: &[f64], vp: &[f64], c: usize, r0: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
+        let _ = (v, c, r0);
+        self.res(vp, evals)
+    }
 }
+
+/// An initial-state column of the Jacobian takes the base run's residual from the sample
+/// where the perturbed run's state is within this share of the step of the base run's, in
+/// every state (in the fit's state scales; [`Problem::residual_merged`]): the perturbation
+/// has decayed to `1e-8` of its size, and the column's entries after that would be below
+/// `1e-8` of those of the start, under the forward difference's own truncation error.
+pub const MERGE_DECAY: f64 = 1e-8;
 
 impl Objective for Vars<'_, '_> {
     fn res(&self, v: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
         *evals += 1;
         let (t, n, x) = self.split(v);
         self.pb.residual_to(&t, &n, &x, self.k_end)
+    }
+    /// An initial-state variable: the run from `vp` beside the run from `v` until they
+    /// merge ([`Problem::residual_merged`], [`MERGE_DECAY`]); the whole run where that does
+    /// not apply.
+    fn res_beside(&self, v: &[f64], vp: &[f64], c: usize, r0: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
+        let off = self.k + self.kn;
+        if c < off || self.xs.is_empty() {
+            return self.res(vp, evals);
+        }
+        *evals += 1;
+        let (t, n, x) = self.split(vp);
+        let x_base: Vec<f64> = (0..self.xs.len()).map(|i| v[off + i] * self.xs[i]).collect();
+        let step = (vp[c] - v[c]).abs();
+        let x_tol: Vec<f64> = self.xs.iter().map(|s| MERGE_DECAY * step * s.abs()).collect();
+        self.pb
+            .residual_merged(&t, &n, &x_base, &x, self.k_end, r0, &x_tol)
+            .or_else(|| self.pb.residual_to(&t, &n, &x, self.k_end))
     }
     fn clamp(&self, v: &mut [f64]) {
         for x in v.iter_mut().take(self.k) {
@@ -232,7 +262,7 @@ pub(crate) fn jacobian<O: Objective>(
         let step = if vars.step_back(v, c, h) { -h } else { h };
         vp[c] += step;
         let mut e = 0;
-        let rp = vars.res(&vp, &mut e);
+        let rp = vars.res_beside(v, &vp, c, r0, &mut e);
         (step, rp, e)
     };
     let cols: Vec<(f64, Option<Vec<f64>>, usize)> =

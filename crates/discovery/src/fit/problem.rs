@@ -143,20 +143,10 @@ impl<'a> Problem<'a> {
     }
 
     pub fn simulate_with(&self, theta: &[f64], nom: &[f64], x0: &[f64], len: Option<usize>) -> Option<SimOutput> {
-        let effects = self.effects(theta);
-        let refitted: Option<System> = match self.refit.as_ref() {
-            Some(r) => Some(r.free.system_at(nom)?),
-            None => None,
-        };
-        let sys = refitted.as_ref().unwrap_or(self.sys);
-        let maps = match &refitted {
-            None => self.maps.clone(),
-            Some(s) => step_maps(s, self.dt, self.substeps)?,
-        };
         let len = len.unwrap_or(self.w.len() / self.m);
         let ops = self.input_ops(theta);
         if ops.is_empty() {
-            let ext = ExtendedModel::from_maps(sys, &effects, maps, self.substeps).ok()?.with_hold(self.hold);
+            let ext = self.model_at(theta, nom, self.substeps)?;
             let out = ext.simulate_from(&self.w[..len * self.m], self.dt, x0, self.z0.as_deref());
             return out.finite.then_some(out);
         }
@@ -165,7 +155,7 @@ impl<'a> Problem<'a> {
         let sub = self.substeps.max(1);
         let (m, p, n) = (self.m, self.p, x0.len());
         let wf = input_effects::transform(&self.w[..len * m], m, self.dt, sub, self.hold, &ops);
-        let ext = ExtendedModel::from_maps(sys, &effects, maps, 1).ok()?.with_hold(self.hold);
+        let ext = self.model_at(theta, nom, 1)?;
         let fine = ext.simulate_from(&wf, self.dt / sub as f64, x0, self.z0.as_deref());
         if !fine.finite {
             return None;
@@ -182,6 +172,59 @@ impl<'a> Problem<'a> {
             x: pick(&fine.x, n),
         })
     }
+    /// The extended model at `(theta, nom)` (per-input effects left out: see
+    /// [`Problem::input_ops`]), stepped `substeps` times per step of the problem's step maps.
+    fn model_at(&self, theta: &[f64], nom: &[f64], substeps: usize) -> Option<ExtendedModel> {
+        let effects = self.effects(theta);
+        let refitted: Option<System> = match self.refit.as_ref() {
+            Some(r) => Some(r.free.system_at(nom)?),
+            None => None,
+        };
+        let sys = refitted.as_ref().unwrap_or(self.sys);
+        let maps = match &refitted {
+            None => self.maps.clone(),
+            Some(s) => step_maps(s, self.dt, self.substeps)?,
+        };
+        Some(ExtendedModel::from_maps(sys, &effects, maps, substeps).ok()?.with_hold(self.hold))
+    }
+
+    /// [`Problem::residual_to`] at `x0` from a run beside the one from `x0_base`, whose
+    /// residual is `r0` ([`ExtendedModel::simulate_merging`]): from the sample where the two
+    /// runs' states are within `x_tol` of each other (per state; the outputs' tolerance
+    /// follows from it), the rest of the residual is `r0`'s. The base run is dropped after
+    /// `1 / MERGE_GIVE_UP` of the samples. `None` where that run does not apply (per-input
+    /// effects, a digital loop) or the simulation failed: run [`Problem::residual_to`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn residual_merged(
+        &self,
+        theta: &[f64],
+        nom: &[f64],
+        x0_base: &[f64],
+        x0: &[f64],
+        k_end: usize,
+        r0: &[f64],
+        x_tol: &[f64],
+    ) -> Option<Vec<f64>> {
+        if !self.input_ops(theta).is_empty() {
+            return None;
+        }
+        let (len, p) = (k_end.min(self.k_est), self.p);
+        let ext = self.model_at(theta, nom, self.substeps)?;
+        let w = &self.w[..len * self.m];
+        let run = ext.simulate_merging(w, self.dt, x0_base, x0, self.z0.as_deref(), x_tol)?;
+        if !run.out.finite {
+            return None;
+        }
+        let upto = run.merged_at.unwrap_or(len) * p;
+        let (b0, b1) = self.exclude.unwrap_or((0, 0));
+        let mut r = Vec::with_capacity(r0.len());
+        for idx in (0..len * p).filter(|idx| !(b0 * p..b1 * p).contains(idx)) {
+            let v = if idx < upto { (run.out.y[idx] - self.y[idx]) * self.weights[idx % p] } else { *r0.get(r.len())? };
+            r.push(v);
+        }
+        (r.len() == r0.len()).then_some(r)
+    }
+
     /// Weighted residual on the estimation samples (None if the simulation blew up).
     pub fn residual(&self, theta: &[f64], x0: &[f64]) -> Option<Vec<f64>> {
         let nom = self.refit.as_ref().map(|r| r.values.clone()).unwrap_or_default();

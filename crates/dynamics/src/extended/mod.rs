@@ -7,6 +7,8 @@
 //! - [`simulate`]: its fixed-step simulator (one sub-step = input, linear step and forces,
 //!   play), [`simulate_trajectory`] for a model file and [`regime_by_simulation`] under a
 //!   periodic input.
+//! - [`merge`]: a run from a perturbed initial state beside the base run until the two
+//!   merge (the initial-state columns of a finite-difference Jacobian).
 //! - [`digital`]: the loop closed by a digital controller (`[controller]`): ticks every
 //!   `period`, computation delay, the command held between ticks.
 //! - [`play`]: the play in the loop, the catching-up projection
@@ -28,6 +30,7 @@ pub mod digital;
 pub mod forces;
 pub mod friction;
 pub mod input;
+pub mod merge;
 pub mod model;
 pub mod play;
 pub mod simulate;
@@ -36,6 +39,7 @@ pub mod step_maps;
 pub use self::model::ExtendedModel;
 pub use crate::linear::hold::InputHold;
 pub use digital::closed_loop_mu;
+pub use merge::MergedRun;
 pub use play::theta_is_point;
 pub use simulate::{regime_by_simulation, simulate_trajectory, SimOutput, SimulatedRegime};
 pub use step_maps::StepMaps;

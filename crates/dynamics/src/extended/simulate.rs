@@ -34,6 +34,7 @@ macro_rules! with_dims {
         }
     };
 }
+pub(super) use with_dims;
 
 /// Result of a simulation on the sample grid.
 #[derive(Debug, Clone)]
@@ -179,20 +180,20 @@ pub(super) struct RunState {
     xn: Vec<f64>,
     /// The play's deviation `q = z - y`.
     q: Vec<f64>,
-    z: Vec<f64>,
+    pub(super) z: Vec<f64>,
     pub(super) y: Vec<f64>,
     /// Coasting velocity of the backlash output (`backlash_inertia`).
-    v: Vec<f64>,
+    pub(super) v: Vec<f64>,
     /// With a play: `y` at the start of the current step and of the step before,
     /// and the length of the step before (0 before the first), for the output's velocity
     /// ([`ExtendedModel::output_velocity`]).
-    y_start: Vec<f64>,
-    y_before: Vec<f64>,
+    pub(super) y_start: Vec<f64>,
+    pub(super) y_before: Vec<f64>,
     h_before: f64,
     h_last: f64,
     /// With a play: whether it was projected (in contact) at the last step's end, and the
     /// change of `q` predicted over the current step (free: `z` coasts or stays).
-    touching: Vec<bool>,
+    pub(super) touching: Vec<bool>,
     dq: Vec<f64>,
     scratch: Vec<f64>,
     /// `q` before the projection.
@@ -201,7 +202,7 @@ pub(super) struct RunState {
 
 /// The input over each piece of a step: the start value `w0` and the increment `dw` (zero
 /// under a zero-order hold).
-struct InputDrive<'w> {
+pub(super) struct InputDrive<'w> {
     w: &'w [f64],
     m: usize,
     ns: usize,
@@ -218,7 +219,7 @@ struct InputDrive<'w> {
 }
 
 impl<'w> InputDrive<'w> {
-    fn new(input: &InputPath, w: &'w [f64], dt: f64, m: usize, ns: usize) -> Self {
+    pub(super) fn new(input: &InputPath, w: &'w [f64], dt: f64, m: usize, ns: usize) -> Self {
         let shift = input.delay / dt;
         // Zero-order hold: saturation and input play act on the held samples exactly.
         let held = match input.hold {
@@ -313,34 +314,69 @@ impl ExtendedModel {
         if ns == 0 {
             return out;
         }
-        let sub = self.substeps;
+        self.run_samples::<N, M, P>(w, dt, &mut st, &mut out, |_, _| true);
+        out.x_rms.iter_mut().for_each(|v| *v = (*v / ns as f64).sqrt());
+        out
+    }
+
+    /// The free run from `st` over the samples of `w`: records each sample in `out` and steps
+    /// to the next, until the last, a state that leaves the finite numbers (the rest of `out`
+    /// `NaN`), or `go_on(k + 1, &st)` returning `false` after the step to sample `k + 1`.
+    #[inline(always)]
+    pub(super) fn run_samples<const N: usize, const M: usize, const P: usize>(
+        &self,
+        w: &[f64],
+        dt: f64,
+        st: &mut RunState,
+        out: &mut SimOutput,
+        mut go_on: impl FnMut(usize, &RunState) -> bool,
+    ) {
+        let (_, m, p) = self.dims::<N, M, P>();
+        let ns = w.len() / m;
         let pieces = Pieces::new(self);
         let mut drive = InputDrive::new(&self.input, w, dt, m, ns);
         for k in 0..ns {
-            out.record(k, &st, &self.offset);
+            out.record(k, st, &self.offset);
             if k + 1 == ns {
                 break;
             }
-            for s in 0..sub {
-                let (parts, np) = pieces.of_substep(s, sub);
-                for (pi, &(fa, fb, pc)) in parts[..np].iter().enumerate() {
-                    drive.advance(&self.input, k, fa, fb);
-                    self.step_plant::<N, M, P>(&mut st, pc, &drive.w0, &drive.dw);
-                    let hit = self.step_play::<N, M, P>(&mut st, pc);
-                    if s + 1 == sub && pi + 1 == np {
-                        if let Some(hit) = hit {
-                            out.contact[k + 1] = hit;
-                        }
-                    }
-                }
+            if let Some(hit) = self.step_sample::<N, M, P>(st, &mut drive, &pieces, k) {
+                out.contact[k + 1] = hit;
             }
             if !st.x.iter().all(|v| v.is_finite()) {
                 out.diverged_after(k, ns, p);
                 break;
             }
+            if !go_on(k + 1, st) {
+                break;
+            }
         }
-        out.x_rms.iter_mut().for_each(|v| *v = (*v / ns as f64).sqrt());
-        out
+    }
+
+    /// Sample interval `k` (every sub-step and its pieces): from sample `k` to `k + 1`.
+    /// Whether the play is in contact at its end (`None` without a play).
+    #[inline(always)]
+    pub(super) fn step_sample<const N: usize, const M: usize, const P: usize>(
+        &self,
+        st: &mut RunState,
+        drive: &mut InputDrive,
+        pieces: &Pieces,
+        k: usize,
+    ) -> Option<bool> {
+        let sub = self.substeps;
+        let mut last = None;
+        for s in 0..sub {
+            let (parts, np) = pieces.of_substep(s, sub);
+            for (pi, &(fa, fb, pc)) in parts[..np].iter().enumerate() {
+                drive.advance(&self.input, k, fa, fb);
+                self.step_plant::<N, M, P>(st, pc, &drive.w0, &drive.dw);
+                let hit = self.step_play::<N, M, P>(st, pc);
+                if s + 1 == sub && pi + 1 == np {
+                    last = hit;
+                }
+            }
+        }
+        last
     }
 
     /// `y = C x`.
