@@ -2,7 +2,8 @@
 //! Usage: `cargo run --release -p discovery --example bench_one CASES SEED [classic|digital|mixed]
 //! [CLASSES]`, `CLASSES` one of `classic` (default: the original 9 classes), `friction`
 //! (none, coulomb_friction and the friction library), `all`, or a comma-separated list.
-//! `SCREEN=N` in the environment sets `screen_samples` (0: never screen); `BENCH_LENGTH=F`
+//! `SCREEN=N` in the environment sets `screen_samples` (0: never screen); `ESTIMATE_X0=1`
+//! has the initial state estimated (as for a model file that states none); `BENCH_LENGTH=F`
 //! makes the recordings F times longer. A miss is followed by a line comparing the selected
 //! model's BIC gain with the best ranked single of the true class.
 fn main() {
@@ -23,6 +24,7 @@ fn main() {
     if let Some(n) = std::env::var("SCREEN").ok().and_then(|v| v.parse().ok()) {
         s.screen_samples = n;
     }
+    s.estimate_x0 = std::env::var("ESTIMATE_X0").is_ok_and(|v| v == "1");
     let r = discovery::bench::run_classes(&classes, cases, seed, profile, &s, |c| {
         println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
         if !c.correct {
