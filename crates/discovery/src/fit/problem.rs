@@ -191,9 +191,10 @@ impl<'a> Problem<'a> {
     /// [`Problem::residual_to`] at `x0` from a run beside the one from `x0_base`, whose
     /// residual is `r0` ([`ExtendedModel::simulate_merging`]): from the sample where the two
     /// runs' states are within `x_tol` of each other (per state; the outputs' tolerance
-    /// follows from it), the rest of the residual is `r0`'s. The base run is dropped after
-    /// `1 / MERGE_GIVE_UP` of the samples. `None` where that run does not apply (per-input
-    /// effects, a digital loop) or the simulation failed: run [`Problem::residual_to`].
+    /// follows from it), the rest of the residual is `r0`'s (the base run goes on only while
+    /// the runs approach each other fast enough, see `dynamics::extended::merge`). `None`
+    /// where that run does not apply (per-input effects, a digital loop) or the simulation
+    /// failed: run [`Problem::residual_to`].
     #[allow(clippy::too_many_arguments)]
     pub fn residual_merged(
         &self,
