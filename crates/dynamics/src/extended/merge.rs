@@ -9,7 +9,7 @@
 //! samples; a plant with an integrator or a play at rest never forgets it (the runs go on to
 //! the end then). [`ExtendedModel::simulate_merging`] steps both runs sample by sample and
 //! stops where they merge. Two runs cost twice one, so the base run goes on only while the
-//! distance between the runs shrinks fast enough to merge within half the record (judged at
+//! distance between the runs shrinks fast enough to merge early in the record (judged at
 //! [`CHECKPOINTS`] points, [`worth_going_on`]); else the perturbed run finishes alone (the cost
 //! of a plain run plus the samples run beside, at least a sixteenth of the record).
 use super::model::ExtendedModel;
@@ -108,8 +108,9 @@ const CHECKPOINTS: usize = 32;
 /// The share of the record within which the extrapolated decay must merge the runs for the
 /// base run to go on ([`worth_going_on`]): two runs to the merge cost less than the plain run
 /// where it comes before half the record; the extrapolation from the run so far comes late
-/// (the early decay is the slowest: on the test plant below, 1583 predicted at sample 465,
-/// merged at 1395 of 3000), so it is allowed up to three quarters.
+/// (the early decay is the slowest: on the test plant below over 3,000 samples, the decay up to
+/// sample 465 extrapolated to a merge at 1583, and the runs merged at 1395), so it is allowed
+/// up to three quarters.
 const MERGE_WITHIN: f64 = 0.75;
 
 /// The largest distance between `a` and `b` in units of `tol`, over every quantity that
@@ -134,8 +135,8 @@ fn distance(a: &RunState, b: &RunState, tol: &MergeTolerance) -> f64 {
 /// on; from there the distance must have fallen by a decade (a plant with an integrator never
 /// forgets its initial state: it stops there, at a sixteenth of a run's extra cost); from
 /// `ns / 8` the decay so far, extrapolated geometrically, must merge the runs within
-/// [`MERGE_WITHIN`] of the record. Contact flags that differ (`d`
-/// infinite) defer the judgement up to `ns / 8`.
+/// [`MERGE_WITHIN`] of the record. Contact flags that differ (`d` infinite) defer the
+/// judgement up to `ns / 8`.
 fn worth_going_on(first: f64, d: f64, k: usize, ns: usize) -> bool {
     if 16 * k < ns {
         return true;
