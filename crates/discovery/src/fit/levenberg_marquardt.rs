@@ -210,21 +210,17 @@ impl Objective for Vars<'_, '_> {
         self.pb.residual_to(&t, &n, &x, self.k_end)
     }
     /// An initial-state variable: the run from `vp` beside the run from `v` until they
-    /// merge ([`Problem::residual_merged`], [`MERGE_DECAY`]); the whole run where that does
-    /// not apply.
+    /// merge ([`Problem::residual_merged`], [`MERGE_DECAY`]).
     fn res_beside(&self, v: &[f64], vp: &[f64], c: usize, r0: &[f64], evals: &mut usize) -> Option<Vec<f64>> {
-        let off = self.k + self.kn;
-        if c < off || self.xs.is_empty() {
+        if c < self.k + self.kn || self.xs.is_empty() {
             return self.res(vp, evals);
         }
         *evals += 1;
         let (t, n, x) = self.split(vp);
-        let x_base: Vec<f64> = (0..self.xs.len()).map(|i| v[off + i] * self.xs[i]).collect();
+        let x_base = self.split(v).2;
         let step = (vp[c] - v[c]).abs();
         let x_tol: Vec<f64> = self.xs.iter().map(|s| MERGE_DECAY * step * s.abs()).collect();
-        self.pb
-            .residual_merged(&t, &n, &x_base, &x, self.k_end, r0, &x_tol)
-            .or_else(|| self.pb.residual_to(&t, &n, &x, self.k_end))
+        self.pb.residual_merged(&t, &n, &x_base, &x, self.k_end, r0, &x_tol)
     }
     fn clamp(&self, v: &mut [f64]) {
         for x in v.iter_mut().take(self.k) {

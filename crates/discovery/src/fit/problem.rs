@@ -192,9 +192,8 @@ impl<'a> Problem<'a> {
     /// residual is `r0` ([`ExtendedModel::simulate_merging`]): from the sample where the two
     /// runs' states are within `x_tol` of each other (per state; the outputs' tolerance
     /// follows from it), the rest of the residual is `r0`'s (the base run goes on only while
-    /// the runs approach each other fast enough, see `dynamics::extended::merge`). `None`
-    /// where that run does not apply (per-input effects, a digital loop) or the simulation
-    /// failed: run [`Problem::residual_to`].
+    /// the runs approach each other fast enough, see `dynamics::extended::merge`). Per-input
+    /// effects and a digital loop are run whole. `None` where the simulation failed.
     #[allow(clippy::too_many_arguments)]
     pub fn residual_merged(
         &self,
@@ -207,23 +206,36 @@ impl<'a> Problem<'a> {
         x_tol: &[f64],
     ) -> Option<Vec<f64>> {
         if !self.input_ops(theta).is_empty() {
-            return None;
+            return self.residual_to(theta, nom, x0, k_end);
         }
-        let (len, p) = (k_end.min(self.k_est), self.p);
+        let len = k_end.min(self.k_est);
         let ext = self.model_at(theta, nom, self.substeps)?;
-        let w = &self.w[..len * self.m];
-        let run = ext.simulate_merging(w, self.dt, x0_base, x0, self.z0.as_deref(), x_tol)?;
-        if !run.out.finite {
+        let (w, z0) = (&self.w[..len * self.m], self.z0.as_deref());
+        let (out, merged_at) = match ext.simulate_merging(w, self.dt, x0_base, x0, z0, x_tol) {
+            Some(run) => (run.out, run.merged_at),
+            None => (ext.simulate_from(w, self.dt, x0, z0), None),
+        };
+        if !out.finite {
             return None;
         }
-        let upto = run.merged_at.unwrap_or(len) * p;
+        self.weighted_residual(&out.y, len, merged_at.map(|k| (k, r0)))
+    }
+
+    /// The weighted residual `(yhat - y) w` of the simulated outputs `yhat` on the first `len`
+    /// samples, the held-out block left out; with `base = (k, r0)`, from sample `k` on the
+    /// entries of `r0` (the same layout) instead. `None` where `r0` is too short.
+    fn weighted_residual(&self, yhat: &[f64], len: usize, base: Option<(usize, &[f64])>) -> Option<Vec<f64>> {
+        let p = self.p;
         let (b0, b1) = self.exclude.unwrap_or((0, 0));
-        let mut r = Vec::with_capacity(r0.len());
-        for idx in (0..len * p).filter(|idx| !(b0 * p..b1 * p).contains(idx)) {
-            let v = if idx < upto { (run.out.y[idx] - self.y[idx]) * self.weights[idx % p] } else { *r0.get(r.len())? };
-            r.push(v);
-        }
-        (r.len() == r0.len()).then_some(r)
+        let from = base.map_or(len, |b| b.0) * p;
+        (0..len * p)
+            .filter(|idx| !(b0 * p..b1 * p).contains(idx))
+            .enumerate()
+            .map(|(j, idx)| match base {
+                Some((_, r0)) if idx >= from => r0.get(j).copied(),
+                _ => Some((yhat[idx] - self.y[idx]) * self.weights[idx % p]),
+            })
+            .collect()
     }
 
     /// Weighted residual on the estimation samples (None if the simulation blew up).
@@ -250,14 +262,7 @@ impl<'a> Problem<'a> {
     pub fn residual_to(&self, theta: &[f64], nom: &[f64], x0: &[f64], k_end: usize) -> Option<Vec<f64>> {
         let k_end = k_end.min(self.k_est);
         let out = self.simulate_with(theta, nom, x0, Some(k_end))?;
-        let p = self.p;
-        let (b0, b1) = self.exclude.unwrap_or((0, 0));
-        Some(
-            (0..k_end * p)
-                .filter(|idx| !(b0 * p..b1 * p).contains(idx))
-                .map(|idx| (out.y[idx] - self.y[idx]) * self.weights[idx % p])
-                .collect(),
-        )
+        self.weighted_residual(&out.y, k_end, None)
     }
 }
 
