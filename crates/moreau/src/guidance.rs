@@ -111,7 +111,29 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mu
     let psi = Psi { alpha: rep.alpha.lower, lambda: rep.lambda_star, beta: rep.beta_star };
     let (p0, pinf) = (psi.at_zero(), psi.eval(rep.gamma_inf));
     let kappa_needed = if pinf < 0.0 { p0 / (p0 - pinf) } else { f64::INFINITY };
-    let blocking = if !rep.R.is_finite() {
+    let blocking = blocking_reason(rep, p0, pinf, kappa_needed);
+    let large_amplitude_limit = large_amplitude_limit(sys, rep);
+    let sensitivities = sensitivities(sys, s, &bounds, &mut notes);
+    let amplitude = if rep.R.is_finite() && amplitudes(sys).is_some() && rep.effects.is_empty() {
+        amplitude_search(sys, s, &bounds, &mut notes)
+    } else {
+        None
+    };
+    Guidance {
+        kappa_star: rep.kappa_star,
+        kappa_needed,
+        blocking,
+        large_amplitude_limit,
+        sensitivities,
+        amplitude,
+        notes,
+    }
+}
+
+/// What stands between the report and a certificate (`p0 = psi(0)`, `pinf = psi(gamma_inf)`,
+/// `kappa_needed` the least `kappa*` that makes `theta*` negative).
+fn blocking_reason(rep: &ThetaReport, p0: f64, pinf: f64, kappa_needed: f64) -> String {
+    if !rep.R.is_finite() {
         "Theta is not strongly convex (R infinite): gamma = 0 and theta = psi(0) >= 0 for every admissible Pi; no bound of this kind can certify (proofs-notes/psi0.md)".to_string()
     } else if pinf >= 0.0 {
         format!(
@@ -125,8 +147,13 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mu
         )
     } else {
         "theta* < 0 at these values; the best bound is certified".to_string()
-    };
-    let large_amplitude_limit = match (&sys.input, rep.R.is_finite()) {
+    }
+}
+
+/// Under a sine input with Theta strongly convex: the least over the report's curve of
+/// `(1 - 2/pi) psi(0) - (2/pi) lambda`, the limit of theta at large amplitude.
+fn large_amplitude_limit(sys: &System, rep: &ThetaReport) -> Option<f64> {
+    match (&sys.input, rep.R.is_finite()) {
         (Input::Sine { .. }, true) => {
             let k = 2.0 / std::f64::consts::PI;
             rep.curve
@@ -138,9 +165,12 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mu
                 .reduce(f64::min)
         }
         _ => None,
-    };
+    }
+}
 
-    // Sensitivities of the best verified bound (or of theta when none is verified).
+/// Sensitivities of the best verified bound (or of theta when none is verified) to the input's
+/// amplitude and frequency and to Theta's scale: central differences in the logarithm.
+fn sensitivities(sys: &System, s: &GuidanceSettings, bounds: &Bounds, notes: &mut Vec<String>) -> Vec<Sensitivity> {
     let mut sensitivities = Vec::new();
     let value = |sys: &System| bounds.report(sys).map(|r| r.theta_best);
     let h = s.step;
@@ -163,81 +193,80 @@ pub fn guidance(sys: &System, rep: &ThetaReport, s: &GuidanceSettings, memo: &mu
         notes.push("the input is not a sine, square wave or multisine: amplitude and frequency are not varied".into());
     }
     push("theta.scale", with(sys, Parameter::ThetaScale, up), with(sys, Parameter::ThetaScale, dn));
+    sensitivities
+}
 
-    // Smallest amplitude factor that certifies (bracket by doubling, then bisection).
-    let mut amplitude = None;
-    if rep.R.is_finite() && amplitudes(sys).is_some() && rep.effects.is_empty() {
-        let mut evaluations = 0;
-        let mut eval = |f: f64| {
-            evaluations += 1;
-            with_amplitude_factor(sys, f).as_ref().and_then(|s| bounds.certifies(s))
-        };
-        let (mut lo, mut hi) = (1.0f64, None);
-        if let Some(v) = bounds.certifies(sys) {
-            notes.push(
-                "already certified: the amplitude search looks for the smallest factor <= 1 that still certifies"
-                    .into(),
-            );
-            let mut f = 1.0;
-            hi = Some((1.0, v));
-            lo = f64::NAN;
-            while f > 1.0 / s.max_factor {
-                f *= 0.5;
-                match eval(f) {
-                    Some(v) => hi = Some((f, v)),
-                    None => {
-                        lo = f;
-                        break;
-                    }
-                }
-            }
-            if lo.is_nan() {
-                notes.push(format!("every factor down to 1/{} certifies", s.max_factor));
-                hi = None;
-            }
-        } else {
-            let mut f = 1.0;
-            while f < s.max_factor {
-                f *= 2.0;
-                match eval(f) {
-                    Some(v) => {
-                        hi = Some((f, v));
-                        break;
-                    }
-                    None => lo = f,
+/// Smallest amplitude factor that certifies: bracketed by doubling (or, already certified, by
+/// halving), then bisected in the logarithm. `None` for an input without amplitudes.
+fn amplitude_search(
+    sys: &System,
+    s: &GuidanceSettings,
+    bounds: &Bounds,
+    notes: &mut Vec<String>,
+) -> Option<AmplitudeSearch> {
+    let base = amplitudes(sys)?.to_vec();
+    let mut evaluations = 0;
+    let mut eval = |f: f64| {
+        evaluations += 1;
+        with_amplitude_factor(sys, f).as_ref().and_then(|s| bounds.certifies(s))
+    };
+    let (mut lo, mut hi) = (1.0f64, None);
+    if let Some(v) = bounds.certifies(sys) {
+        notes.push(
+            "already certified: the amplitude search looks for the smallest factor <= 1 that still certifies".into(),
+        );
+        let mut f = 1.0;
+        hi = Some((1.0, v));
+        lo = f64::NAN;
+        while f > 1.0 / s.max_factor {
+            f *= 0.5;
+            match eval(f) {
+                Some(v) => hi = Some((f, v)),
+                None => {
+                    lo = f;
+                    break;
                 }
             }
         }
-        if let Some(mut best) = hi {
-            for _ in 0..s.bisection_steps {
-                let mid = (lo * best.0).sqrt();
-                match eval(mid) {
-                    Some(v) => best = (mid, v),
-                    None => lo = mid,
+        if lo.is_nan() {
+            notes.push(format!("every factor down to 1/{} certifies", s.max_factor));
+            hi = None;
+        }
+    } else {
+        let mut f = 1.0;
+        while f < s.max_factor {
+            f *= 2.0;
+            match eval(f) {
+                Some(v) => {
+                    hi = Some((f, v));
+                    break;
                 }
+                None => lo = f,
             }
-            let a = amplitudes(sys).expect("checked").iter().map(|x| x * best.0).collect();
-            amplitude = Some(AmplitudeSearch {
-                factor: best.0,
-                amplitudes: a,
-                theta_best: best.1 .0,
-                method: best.1 .1,
-                below: lo,
-                evaluations,
-            });
-        } else if !lo.is_nan() {
+        }
+    }
+    let Some(mut best) = hi else {
+        if !lo.is_nan() {
             notes.push(format!("no amplitude factor up to {} certifies", s.max_factor));
         }
+        return None;
+    };
+    for _ in 0..s.bisection_steps {
+        let mid = (lo * best.0).sqrt();
+        match eval(mid) {
+            Some(v) => best = (mid, v),
+            None => lo = mid,
+        }
     }
-    Guidance {
-        kappa_star: rep.kappa_star,
-        kappa_needed,
-        blocking,
-        large_amplitude_limit,
-        sensitivities,
-        amplitude,
-        notes,
-    }
+    let a = base.iter().map(|x| x * best.0).collect();
+    Some(AmplitudeSearch {
+        factor: best.0,
+        amplitudes: a,
+        theta_best: best.1 .0,
+        method: best.1 .1,
+        below: lo,
+        evaluations,
+    })
 }
 
 impl Guidance {
