@@ -26,7 +26,7 @@ fn main() {
     }
     s.estimate_x0 = std::env::var("ESTIMATE_X0").is_ok_and(|v| v == "1");
     let r = discovery::bench::run_classes(&classes, cases, seed, profile, &s, |c| {
-        println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.seconds, c.description, c.error);
+        println!("{:>18} -> {:<30} incomplete {} ties {:?} nominal fit {:.1} before {:.1} after {:.1} perr {:?} {:?} true {:?} est {:?} sd {:?} sdstat {:?} {:.1}s {} {:?}", c.class, c.selected, c.model_incomplete, c.ties, c.nominal_fit, c.fit_before, c.fit_after, c.param_error, c.param_errors, c.true_param, c.est_param, c.est_std, c.est_std_statistical, c.seconds, c.description, c.error);
         if !c.correct {
             println!(
                 "{:>18}    miss: selected dBIC {:.1}, best single of the truth {}",

@@ -9,6 +9,8 @@
 //! model incomplete, the final residual's portmanteau statistic, the BIC gains of the selected
 //! model and of the true pair (where fitted), the time and the case.
 //!
+//! `ESTIMATE_X0=1` has the initial state estimated (as for a model file that states none).
+//!
 //! `BENCH_PAIRS_TRUTH` set: each unflagged miss is diagnosed again with only its two true
 //! effects offered (`DiagnoseSettings::library`), and the line `truth only` gives what that
 //! selects, its BIC gain over the nominal and its residual's portmanteau statistic. Where the
@@ -49,9 +51,10 @@ fn main() {
     // unflagged misses by what the true pair, offered alone, gains against the reading selected
     let (mut unshown, mut short) = (0, 0);
     let truth = std::env::var("BENCH_PAIRS_TRUTH").ok();
+    let settings = discovery::DiagnoseSettings { estimate_x0: estimate_x0(), ..Default::default() };
     for i in 0..cases {
         for &p in &pairs {
-            let Some(r) = discovery::bench::run_pair_case(p, seed, i, profile, &Default::default()) else { continue };
+            let Some(r) = discovery::bench::run_pair_case(p, seed, i, profile, &settings) else { continue };
             println!(
                 "{:>36} #{i} -> {:<40} named {} (or equivalent {}) incomplete {} Q {:.1}/{:.1} dBIC {:.1} true pair {} {:.1}s {} equivalents {:?} {:?}",
                 format!("{}+{}", p[0], p[1]),
@@ -110,6 +113,11 @@ fn main() {
     }
 }
 
+/// `ESTIMATE_X0=1`: the initial state estimated, as for a model file that states none.
+fn estimate_x0() -> bool {
+    std::env::var("ESTIMATE_X0").is_ok_and(|v| v == "1")
+}
+
 /// The selection's BIC margin (`select::Margins::default`): a reading that beats another by
 /// less is not preferred to it.
 const MARGIN_BIC: f64 = 10.0;
@@ -137,8 +145,11 @@ fn print_truth_ceiling(
     profile: discovery::bench_gen::Profile,
     gain: f64,
 ) -> Option<TruthReading> {
-    let s =
-        discovery::DiagnoseSettings { library: Some(vec![p[0].to_string(), p[1].to_string()]), ..Default::default() };
+    let s = discovery::DiagnoseSettings {
+        library: Some(vec![p[0].to_string(), p[1].to_string()]),
+        estimate_x0: estimate_x0(),
+        ..Default::default()
+    };
     let t = discovery::bench::run_pair_case(p, seed, i, profile, &s)?;
     println!(
         "{:>36}    truth only -> {:<40} named {} dBIC {:.1} (selected from the library {:.1}: truth {}) Q {:.1}/{:.1} incomplete {}",
@@ -171,6 +182,7 @@ fn print_ranking(p: [&'static str; 2], seed: u64, i: usize, profile: discovery::
             x0: case.nominal.x0.iter().copied().collect(),
             z0: Some(case.nominal.z0.iter().copied().collect()),
         }),
+        estimate_x0: estimate_x0(),
         ..Default::default()
     };
     let Ok(rep) = discovery::diagnose(&case.nominal, &case.recording, &s) else { return };

@@ -108,7 +108,7 @@ fn main() {
         let truth = case.truth.clone().unwrap();
         let x0: Vec<f64> = sys.x0.iter().copied().collect();
         let xs: Vec<f64> = x0.iter().map(|_| 0.1).collect();
-        for f in [0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 2.0] {
+        for f in [0.0, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 1.8, 2.0, 2.5] {
             let e = match &truth {
                 Effect::BacklashInertia { mass, damping } => {
                     Effect::BacklashInertia { mass: mass * f, damping: *damping }
@@ -125,6 +125,15 @@ fn main() {
                     }
                 }
                 Effect::CoulombFriction { state, level } => Effect::CoulombFriction { state: *state, level: level * f },
+                // the asymmetry scaled about the mean level (f = 0: Coulomb friction)
+                Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
+                    let mean = 0.5 * (level_positive + level_negative);
+                    Effect::AsymmetricCoulomb {
+                        state: *state,
+                        level_positive: mean + (level_positive - mean) * f,
+                        level_negative: mean + (level_negative - mean) * f,
+                    }
+                }
                 _ => panic!("no profile for {truth:?}"),
             };
             let pb = Problem {
@@ -141,7 +150,11 @@ fn main() {
                 weights: vec![1.0 / sd],
                 maps: maps.clone(),
                 substeps: sub,
-                hold: dynamics::extended::InputHold::Foh,
+                hold: if std::env::var("HOLD").as_deref() == Ok("zoh") {
+                    dynamics::extended::InputHold::Zoh
+                } else {
+                    dynamics::extended::InputHold::Foh
+                },
                 z0: None,
                 exclude: None,
                 refit: None,
