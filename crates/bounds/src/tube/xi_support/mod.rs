@@ -134,6 +134,18 @@ struct Accum {
     tiling: f64,
 }
 
+/// What [`TubeKernel::reach`] proves about the semigroup over the horizon.
+struct Reach {
+    /// Length of the quadrature's horizon.
+    s_max: f64,
+    /// The tail beyond `s_max` (infinite horizon; per unit `|v|`, with `D_Theta`).
+    tail_unit: f64,
+    /// `sup ||e^{sF}||` on `[0, s_max]`.
+    msup: f64,
+    /// `int_0^inf ||e^{sF}||` when proven.
+    i_inf: Option<f64>,
+}
+
 impl TubeKernel {
     /// Builds the quadrature of `sigma_{L Xi}` for `K(s) = L e^{sF} E` and the set `theta`.
     pub fn new(
@@ -181,55 +193,8 @@ impl TubeKernel {
         let LF = L * F;
         let LF2 = &LF * F;
         let tol = settings.tol_abs;
-        // Proven semigroup bounds: sup ||e^{sF}|| on the horizon, and int_0^inf when Hurwitz.
-        let (s_max, tail_unit, msup, i_inf) = match horizon {
-            Horizon::Finite(t) => {
-                if !(t >= 0.0 && t.is_finite()) {
-                    return Err(BoundsError::BadSetting {
-                        name: "horizon",
-                        value: t,
-                        reason: "must be finite and >= 0",
-                    });
-                }
-                let i_inf = sg.bounds.as_ref().ok().map(|b| b.integral);
-                (t, 0.0, exp_sup_on(F, t, &sg.bounds), i_inf)
-            }
-            Horizon::Infinite => {
-                let b = sg.bounds.clone()?;
-                let i_inf = b.integral;
-                let mu = sg.mu.clone()?;
-                let mut S = 8.0 / -mu;
-                let mut tail;
-                loop {
-                    // ||L e^{SF}||_F from above: the computed product, its rounding, and the error
-                    // of e^{SF}.
-                    let (X, eX) = exp_at(F, S, b.sup);
-                    let LX = L * &X;
-                    let nLX = frob(&LX) + gamma(F.nrows()) * nL * frob(&X) + nL * eX;
-                    tail = d_theta * nLX * nE * i_inf * (1.0 + 1e-10);
-                    if tail <= 0.5 * tol || S > 1e6 / -mu {
-                        break;
-                    }
-                    S *= 1.25;
-                }
-                (S, tail, b.sup, Some(i_inf))
-            }
-        };
-        // The rounded F (proofs-notes/tube-quadrature.md): int ||e^{s F_exact} - e^{sF}|| over the horizon.
-        let eps = settings.f_radius;
-        let f_term = if eps == 0.0 {
-            0.0
-        } else {
-            let via_integral = match i_inf {
-                Some(i) if eps * i < 0.5 => eps * i * i / (1.0 - eps * i),
-                _ => f64::INFINITY,
-            };
-            let via_gronwall = match horizon {
-                Horizon::Finite(t) => 0.5 * t * t * msup * msup * eps * (msup * eps * t).exp(),
-                Horizon::Infinite => f64::INFINITY,
-            };
-            d_theta * nL * nE * via_integral.min(via_gronwall) * (1.0 + 1e-6)
-        };
+        let Reach { s_max, tail_unit, msup, i_inf } = Self::reach(L, F, E, d_theta, sg, horizon, tol)?;
+        let f_term = Self::f_rounding_term(settings.f_radius, i_inf, horizon, msup, d_theta * nL * nE);
         // Cell widths: graded as h(s) = h0 e^{grade s} (the remainder per cell decays like
         // e^{mu s} h^3), capped at 1 / ||F||; h0 shrinks (remainder ~ h0^2) until the summed
         // remainders are below tol / 2. The grading only affects efficiency, not rigour.
@@ -283,6 +248,72 @@ impl TubeKernel {
             }
             h0 /= (k.remainder / (0.4 * tol)).sqrt().max(1.5);
         }
+    }
+
+    /// Proven semigroup bounds over the horizon: its length `s_max` (for an infinite horizon,
+    /// grown until the tail beyond it, `tail_unit`, is below `tol / 2`), `sup ||e^{sF}||` on it
+    /// and `int_0^inf ||e^{sF}||` when `F` is Hurwitz.
+    fn reach(
+        L: &DMatrix<f64>,
+        F: &DMatrix<f64>,
+        E: &DMatrix<f64>,
+        d_theta: f64,
+        sg: &SemigroupData,
+        horizon: Horizon,
+        tol: f64,
+    ) -> Result<Reach, BoundsError> {
+        let (nE, nL) = (frob(E), frob(L));
+        Ok(match horizon {
+            Horizon::Finite(t) => {
+                if !(t >= 0.0 && t.is_finite()) {
+                    return Err(BoundsError::BadSetting {
+                        name: "horizon",
+                        value: t,
+                        reason: "must be finite and >= 0",
+                    });
+                }
+                let i_inf = sg.bounds.as_ref().ok().map(|b| b.integral);
+                Reach { s_max: t, tail_unit: 0.0, msup: exp_sup_on(F, t, &sg.bounds), i_inf }
+            }
+            Horizon::Infinite => {
+                let b = sg.bounds.clone()?;
+                let i_inf = b.integral;
+                let mu = sg.mu.clone()?;
+                let mut S = 8.0 / -mu;
+                let mut tail;
+                loop {
+                    // ||L e^{SF}||_F from above: the computed product, its rounding, and the error
+                    // of e^{SF}.
+                    let (X, eX) = exp_at(F, S, b.sup);
+                    let LX = L * &X;
+                    let nLX = frob(&LX) + gamma(F.nrows()) * nL * frob(&X) + nL * eX;
+                    tail = d_theta * nLX * nE * i_inf * (1.0 + 1e-10);
+                    if tail <= 0.5 * tol || S > 1e6 / -mu {
+                        break;
+                    }
+                    S *= 1.25;
+                }
+                Reach { s_max: S, tail_unit: tail, msup: b.sup, i_inf: Some(i_inf) }
+            }
+        })
+    }
+
+    /// The rounded F (proofs-notes/tube-quadrature.md): `int ||e^{s F_exact} - e^{sF}||` over
+    /// the horizon for `||F_exact - F|| <= eps`, times `scale = D_Theta ||L|| ||E||`; the
+    /// lesser of the bound through `int_0^inf` and Gronwall's on a finite horizon.
+    fn f_rounding_term(eps: f64, i_inf: Option<f64>, horizon: Horizon, msup: f64, scale: f64) -> f64 {
+        if eps == 0.0 {
+            return 0.0;
+        }
+        let via_integral = match i_inf {
+            Some(i) if eps * i < 0.5 => eps * i * i / (1.0 - eps * i),
+            _ => f64::INFINITY,
+        };
+        let via_gronwall = match horizon {
+            Horizon::Finite(t) => 0.5 * t * t * msup * msup * eps * (msup * eps * t).exp(),
+            Horizon::Infinite => f64::INFINITY,
+        };
+        scale * via_integral.min(via_gronwall) * (1.0 + 1e-6)
     }
 
     /// The kernel with its floating-point terms (proofs-notes/tube-quadrature.md), per unit
