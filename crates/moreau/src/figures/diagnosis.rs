@@ -170,126 +170,175 @@ pub fn figures_sized(r: &Report, preset: Option<SizePreset>) -> Vec<(String, Fig
     if n < 2 {
         return vec![];
     }
-    let unit = r.units.first().cloned().unwrap_or_default();
-    let vunit = discovery::metrics::per_second(&unit);
-    let vunit = if unit.is_empty() { String::new() } else { vunit };
-    let en = diff(&c.y, &c.nominal);
-    let ef = diff(&c.y, &c.fitted);
-    let ven = diff(&c.v, &c.v_nominal);
-    let vef = diff(&c.v, &c.v_fitted);
+    let panels = Panels::of(r, &c);
     let pw: Vec<(f64, f64)> = r.windows.iter().map(|w| (w.t_start, w.t_end)).collect();
     let vw: Vec<(f64, f64)> = r.velocity_windows.iter().map(|w| (w.t_start, w.t_end)).collect();
-    let val = Some((r.validation_segment[0], "validation from here"));
-    let nominal_c = canvas::ORANGE;
-    let fitted_c = canvas::BLUE;
     let sel = r.selected();
-    let fitted_label = format!("fitted ({sel})");
     let all = (0, n);
-    let record = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
-        panel(
-            "y",
-            &unit,
-            &c.t,
-            k,
-            &[
-                ("measured", &c.y, MEASURED, false),
-                ("nominal", &c.nominal, nominal_c, true),
-                (&fitted_label, &c.fitted, fitted_c, false),
-            ],
-            shade,
-            "located window",
-            mark,
-            max,
-        )
-    };
-    let residual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
-        panel(
-            "residual y − ŷ",
-            &unit,
-            &c.t,
-            k,
-            &[("nominal", &en, nominal_c, true), ("fitted", &ef, fitted_c, false)],
-            shade,
-            "located window",
-            mark,
-            max,
-        )
-    };
-    let vresidual = |k: (usize, usize), shade: &[(f64, f64)], mark, max| {
-        panel(
-            "velocity residual",
-            &vunit,
-            &c.t,
-            k,
-            &[("nominal", &ven, nominal_c, true), ("fitted", &vef, fitted_c, false)],
-            shade,
-            "located window",
-            mark,
-            max,
-        )
-    };
-    let stack = |title: String, mut panels: Vec<Figure>, size: (u32, u32)| {
-        let size = preset.map_or(size, |p| stack_size(p, panels.len()));
-        let mut top = panels.remove(0);
-        top.title = title;
-        top.size = size;
-        for p in &mut panels {
-            p.size = size;
+    let mut out = vec![
+        (
+            "fit".to_string(),
+            stack(
+                preset,
+                format!("Measured vs nominal vs fitted (output 1): {sel}"),
+                vec![panels.record(all, &pw, 4000), panels.residual(all, &pw, 4000)],
+                (1200, 760),
+            ),
+        ),
+        (
+            "residual".to_string(),
+            stack(
+                preset,
+                "Residuals (output 1), each with its located windows shaded".to_string(),
+                vec![panels.residual(all, &pw, 4000), panels.velocity_residual(all, &vw, 4000)],
+                (1200, 760),
+            ),
+        ),
+    ];
+    for (i, (w, what)) in zoom_windows(r).into_iter().take(3).enumerate() {
+        if let Some(f) = zoom(r, &c, &panels, preset, i, w, what) {
+            out.push((format!("zoom-{}", i + 1), f));
         }
-        top.below = panels;
-        top
-    };
-    let mut out = vec![];
-    out.push((
-        "fit".to_string(),
-        stack(
-            format!("Measured vs nominal vs fitted (output 1): {sel}"),
-            vec![record(all, &pw, val, 4000), residual(all, &pw, val, 4000)],
-            (1200, 760),
-        ),
-    ));
-    out.push((
-        "residual".to_string(),
-        stack(
-            "Residuals (output 1), each with its located windows shaded".to_string(),
-            vec![residual(all, &pw, val, 4000), vresidual(all, &vw, val, 4000)],
-            (1200, 760),
-        ),
-    ));
-    // the top windows: position windows first, then velocity windows that overlap none
+    }
+    out
+}
+
+/// The panels of the diagnosis figures (record, residual, velocity residual) with the data
+/// they share: output 1's curves and residuals, its units and the validation mark.
+struct Panels<'c> {
+    c: &'c Curves,
+    unit: String,
+    vunit: String,
+    /// Residuals of the nominal and fitted models, of the output and of its derived velocity.
+    en: Vec<f64>,
+    ef: Vec<f64>,
+    ven: Vec<f64>,
+    vef: Vec<f64>,
+    fitted_label: String,
+    validation: Option<(f64, &'static str)>,
+}
+
+const NOMINAL_COLOUR: RGBColor = canvas::ORANGE;
+const FITTED_COLOUR: RGBColor = canvas::BLUE;
+
+impl<'c> Panels<'c> {
+    fn of(r: &Report, c: &'c Curves) -> Self {
+        let unit = r.units.first().cloned().unwrap_or_default();
+        let vunit = if unit.is_empty() { String::new() } else { discovery::metrics::per_second(&unit) };
+        Panels {
+            c,
+            en: diff(&c.y, &c.nominal),
+            ef: diff(&c.y, &c.fitted),
+            ven: diff(&c.v, &c.v_nominal),
+            vef: diff(&c.v, &c.v_fitted),
+            unit,
+            vunit,
+            fitted_label: format!("fitted ({})", r.selected()),
+            validation: Some((r.validation_segment[0], "validation from here")),
+        }
+    }
+
+    /// Measured, nominal and fitted output over samples `k`, windows `shade` shaded.
+    fn record(&self, k: (usize, usize), shade: &[(f64, f64)], max: usize) -> Figure {
+        let c = self.c;
+        let curves = [
+            ("measured", &c.y[..], MEASURED, false),
+            ("nominal", &c.nominal[..], NOMINAL_COLOUR, true),
+            (&self.fitted_label[..], &c.fitted[..], FITTED_COLOUR, false),
+        ];
+        self.panel("y", &self.unit, k, &curves, shade, max)
+    }
+
+    /// The nominal and fitted models' output residuals.
+    fn residual(&self, k: (usize, usize), shade: &[(f64, f64)], max: usize) -> Figure {
+        let curves = [("nominal", &self.en[..], NOMINAL_COLOUR, true), ("fitted", &self.ef[..], FITTED_COLOUR, false)];
+        self.panel("residual y − ŷ", &self.unit, k, &curves, shade, max)
+    }
+
+    /// The nominal and fitted models' residuals of the derived velocity.
+    fn velocity_residual(&self, k: (usize, usize), shade: &[(f64, f64)], max: usize) -> Figure {
+        let curves =
+            [("nominal", &self.ven[..], NOMINAL_COLOUR, true), ("fitted", &self.vef[..], FITTED_COLOUR, false)];
+        self.panel("velocity residual", &self.vunit, k, &curves, shade, max)
+    }
+
+    fn panel(
+        &self,
+        name: &str,
+        unit: &str,
+        k: (usize, usize),
+        curves: &[(&str, &[f64], RGBColor, bool)],
+        shade: &[(f64, f64)],
+        max: usize,
+    ) -> Figure {
+        panel(name, unit, &self.c.t, k, curves, shade, "located window", self.validation, max)
+    }
+}
+
+/// Panels stacked under the first, which carries `title`; all at `size`, or at the preset's
+/// stack size.
+fn stack(preset: Option<SizePreset>, title: String, mut panels: Vec<Figure>, size: (u32, u32)) -> Figure {
+    let size = preset.map_or(size, |p| stack_size(p, panels.len()));
+    let mut top = panels.remove(0);
+    top.title = title;
+    top.size = size;
+    for p in &mut panels {
+        p.size = size;
+    }
+    top.below = panels;
+    top
+}
+
+/// The located windows to zoom into: position windows first, then velocity windows that
+/// overlap none.
+fn zoom_windows(r: &Report) -> Vec<(&discovery::localise::Window, &'static str)> {
     let mut zooms: Vec<(&discovery::localise::Window, &str)> = r.windows.iter().map(|w| (w, "position")).collect();
     for w in &r.velocity_windows {
         if !zooms.iter().any(|(z, _)| w.t_start <= z.t_end && z.t_start <= w.t_end) {
             zooms.push((w, "velocity"));
         }
     }
+    zooms
+}
+
+/// The `i`-th zoom: window `w` (of the `what` residual) padded by three quarters of its width
+/// (at least 25 samples) on each side; `None` where fewer than 2 samples fall in it.
+fn zoom(
+    r: &Report,
+    c: &Curves,
+    panels: &Panels,
+    preset: Option<SizePreset>,
+    i: usize,
+    w: &discovery::localise::Window,
+    what: &str,
+) -> Option<Figure> {
+    let n = c.t.len();
     let k_of = |t: f64| c.t.partition_point(|x| *x < t).min(n - 1);
-    for (i, (w, what)) in zooms.into_iter().take(3).enumerate() {
-        let width = (w.t_end - w.t_start).max(r.dt);
-        let pad = (0.75 * width).max(25.0 * r.dt);
-        let (k0, k1) = (k_of(w.t_start - pad), (k_of(w.t_end + pad) + 1).min(n));
-        if k1 < k0 + 2 {
-            continue;
-        }
-        let shade = [(w.t_start, w.t_end)];
-        let title = format!(
-            "Window {}: t = {:.3} - {:.3} s, {:.0} % of the {what} residual energy in {:.1} % of the time{}",
-            i + 1,
-            w.t_start,
-            w.t_end,
-            100.0 * w.share_energy,
-            100.0 * w.share_time,
-            if w.dominant_regime == "none" { String::new() } else { format!(" ({})", w.dominant_regime) }
-        );
-        let k = (k0, k1);
-        out.push((
-            format!("zoom-{}", i + 1),
-            stack(
-                title,
-                vec![record(k, &shade, val, 3000), residual(k, &shade, val, 3000), vresidual(k, &shade, val, 3000)],
-                (1100, 900),
-            ),
-        ));
+    let width = (w.t_end - w.t_start).max(r.dt);
+    let pad = (0.75 * width).max(25.0 * r.dt);
+    let (k0, k1) = (k_of(w.t_start - pad), (k_of(w.t_end + pad) + 1).min(n));
+    if k1 < k0 + 2 {
+        return None;
     }
-    out
+    let shade = [(w.t_start, w.t_end)];
+    let title = format!(
+        "Window {}: t = {:.3} - {:.3} s, {:.0} % of the {what} residual energy in {:.1} % of the time{}",
+        i + 1,
+        w.t_start,
+        w.t_end,
+        100.0 * w.share_energy,
+        100.0 * w.share_time,
+        if w.dominant_regime == "none" { String::new() } else { format!(" ({})", w.dominant_regime) }
+    );
+    let k = (k0, k1);
+    Some(stack(
+        preset,
+        title,
+        vec![
+            panels.record(k, &shade, 3000),
+            panels.residual(k, &shade, 3000),
+            panels.velocity_residual(k, &shade, 3000),
+        ],
+        (1100, 900),
+    ))
 }
