@@ -209,19 +209,7 @@ pub fn diagnose_recordings(
     };
     // 5. The selected model fitted on every recording, checked on those validated on.
     let adopted = best.and_then(|(ci, _)| {
-        let sh = if n_fit >= 2 { fit_on(&data, &fit_idx, &cands[ci], &base, free.as_ref(), s) } else { cands[ci].start.clone() };
-        let judged: Vec<Judged> =
-            data.iter().enumerate().map(|(j, d)| judge(d, &cands[ci], &sh, &base[j].x0, free.as_ref(), s)).collect();
-        let worse: Vec<usize> = (n_fit..all.len()).filter(|&j| judged[j].ms > base[j].ms).collect();
-        if worse.is_empty() {
-            return Some((ci, sh, judged));
-        }
-        notes.push(format!(
-            "{} fitted on the recordings worsens the recording(s) validated on ({}): not adopted, the nominal model stands.",
-            cands[ci].label,
-            worse.iter().map(|&j| format!("{} {} -> {}", all[j].source, fmt_units(&base[j].rmse, &units), fmt_units(&judged[j].rmse, &units))).collect::<Vec<_>>().join("; ")
-        ));
-        None
+        adopt(&data, &all, n_fit, &cands[ci], &base, free.as_ref(), &units, s, &mut notes).map(|(sh, j)| (ci, sh, j))
     });
     let selected = adopted.as_ref().map(|a| a.0);
     let (final_cand, final_shared, final_judged): (&Candidate, Shared, &[Judged]) = match &adopted {
@@ -262,6 +250,43 @@ pub fn diagnose_recordings(
         per_recording: singles.iter().map(|(r, _)| (r.recording.clone(), r.verdict.clone())).collect(),
         fitted_model: Some(fitted_model),
     })
+}
+
+/// Candidate `cand` fitted on the first `n_fit` recordings of `all` (the one recording's own
+/// estimate where there is one) and judged on each: its shared parameters and judgements where
+/// it worsens none of the recordings validated on (those after `n_fit`), else `None` with a
+/// note naming the recordings it worsens.
+#[allow(clippy::too_many_arguments)]
+fn adopt(
+    data: &[Rec],
+    all: &[&Recording],
+    n_fit: usize,
+    cand: &Candidate,
+    base: &[Judged],
+    free: Option<&FreeNominal>,
+    units: &[String],
+    s: &DiagnoseSettings,
+    notes: &mut Vec<String>,
+) -> Option<(Shared, Vec<Judged>)> {
+    let fit_idx: Vec<usize> = (0..n_fit).collect();
+    let sh = if n_fit >= 2 { fit_on(data, &fit_idx, cand, base, free, s) } else { cand.start.clone() };
+    let judged: Vec<Judged> = data.iter().enumerate().map(|(j, d)| judge(d, cand, &sh, &base[j].x0, free, s)).collect();
+    let worse: Vec<usize> = (n_fit..all.len()).filter(|&j| judged[j].ms > base[j].ms).collect();
+    if worse.is_empty() {
+        return Some((sh, judged));
+    }
+    let which: Vec<String> = worse
+        .iter()
+        .map(|&j| {
+            format!("{} {} -> {}", all[j].source, fmt_units(&base[j].rmse, units), fmt_units(&judged[j].rmse, units))
+        })
+        .collect();
+    notes.push(format!(
+        "{} fitted on the recordings worsens the recording(s) validated on ({}): not adopted, the nominal model stands.",
+        cand.label,
+        which.join("; ")
+    ));
+    None
 }
 
 /// The first recording, once every recording has the first's signals and passes the
