@@ -248,80 +248,20 @@ fn measure_once(
         Some((x, z)) => (x.to_vec(), z.to_vec()),
         None => (sys.x0.as_slice().to_vec(), sys.z0.as_slice().to_vec()),
     };
-    let (n, p) = (sys.n(), sys.p());
-    let pi = settings.pi.as_ref();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
-    let np = settings.pairs;
-    let mut state = EnsembleState::zeros(n, p, np + 1);
+    let mut state = EnsembleState::zeros(sys.n(), sys.p(), settings.pairs + 1);
     state.set(0, &x0, &z0);
-    let mut log_v = Vec::with_capacity(np);
-    let mut starts = Vec::with_capacity(np);
-    for pair in 0..np {
-        // second state: x2 = x0 + d, q2 = P_Theta(q0 + e), scaled so that sqrt V = separation
-        let dx: Vec<f64> = (0..n).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
-        let dq: Vec<f64> = (0..p).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
-        let (mut x2, mut z2) = perturbed(sys, &x0, &z0, &dx, &dq, 1.0);
-        let v = lyapunov_v(sys, pi, &x0, &z0, &x2, &z2);
-        if v > 0.0 {
-            let s = settings.separation / v.sqrt();
-            (x2, z2) = rescale(sys, &x0, &z0, &x2, &z2, s);
-        }
-        state.set(pair + 1, &x2, &z2);
-        log_v.push(vec![lyapunov_v(sys, pi, &x0, &z0, &x2, &z2).ln()]);
-        starts.push(difference(sys, &x0, &z0, &x2, &z2));
-    }
-    let mut transitions: Vec<Vec<Transition>> = vec![Vec::new(); np];
+    let mut pairs = Pairs::seed(sys, settings, &x0, &z0, &mut state);
     let mut ens = Ensemble::new(sys, &cu)?;
-    let mut offset = vec![0.0; np];
-    let mut renorms = vec![0; np];
-    let mut collapsed = vec![false; np];
     let mut path = PathStats::new();
-    let mut zbuf = vec![0.0; p];
     for j in 0..settings.periods {
         let t0 = j as f64 * T;
-        for (i, z) in zbuf.iter_mut().enumerate() {
-            *z = state.z_component(i)[0];
-        }
-        let mut acc = PathAccumulator::start(&zbuf);
-        ens.run_observed(t0, &mut state, N, |_, _, s| {
-            for (i, z) in zbuf.iter_mut().enumerate() {
-                *z = s.z_component(i)[0];
-            }
-            acc.observe(&zbuf, h);
-        });
-        path.per_period.push(acc.length);
-        path.max_speed_per_period.push(acc.max_speed);
+        run_period(&mut ens, &mut state, t0, N, h, &mut path);
         if !state.all_finite() {
             return Err(DynamicsError::NonFinite { t: t0 + T });
         }
-        let (x1, z1) = (state.x_of(0), state.z_of(0));
-        for pair in 0..np {
-            if collapsed[pair] {
-                continue;
-            }
-            let (x2, z2) = (state.x_of(pair + 1), state.z_of(pair + 1));
-            let v = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
-            if v == 0.0 {
-                collapsed[pair] = true;
-                continue;
-            }
-            log_v[pair].push(v.ln() + offset[pair]);
-            let end = difference(sys, &x1, &z1, &x2, &z2);
-            let start = std::mem::replace(&mut starts[pair], end.clone());
-            if j >= settings.transient_periods {
-                transitions[pair].push(Transition { start, end });
-            }
-            if v.sqrt() < settings.renorm_below * settings.separation {
-                let s = settings.separation / v.sqrt();
-                let (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
-                let v_new = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
-                offset[pair] += v.ln() - v_new.ln();
-                renorms[pair] += 1;
-                starts[pair] = difference(sys, &x1, &z1, &x2, &z2);
-                state.set(pair + 1, &x2, &z2);
-            }
-        }
+        pairs.after_period(sys, settings, j, &mut state);
     }
+    let Pairs { log_v, transitions, renorms, collapsed, .. } = pairs;
     let pairs = pair_rates(log_v, &renorms, &collapsed, settings, T);
     let live: Vec<Vec<Transition>> =
         transitions.into_iter().zip(&collapsed).filter(|(_, &c)| !c).map(|(t, _)| t).collect();
@@ -344,6 +284,104 @@ fn measure_once(
         step_error: None,
         separation_error: None,
     })
+}
+
+/// One period of `N` steps of `h` from `t0`, the reference backlash output's path length and
+/// largest speed over it appended to `path`.
+fn run_period(ens: &mut Ensemble, state: &mut EnsembleState, t0: f64, N: usize, h: f64, path: &mut PathStats) {
+    let mut zbuf: Vec<f64> = (0..state.p()).map(|i| state.z_component(i)[0]).collect();
+    let mut acc = PathAccumulator::start(&zbuf);
+    ens.run_observed(t0, state, N, |_, _, s| {
+        for (i, z) in zbuf.iter_mut().enumerate() {
+            *z = s.z_component(i)[0];
+        }
+        acc.observe(&zbuf, h);
+    });
+    path.per_period.push(acc.length);
+    path.max_speed_per_period.push(acc.max_speed);
+}
+
+/// The perturbed states (ensemble slots `1..=pairs`, the reference in slot 0) and what each
+/// pair's separation did, period by period.
+struct Pairs {
+    /// `ln V` of each pair at each period's end (plus the renormalisations' offset).
+    log_v: Vec<Vec<f64>>,
+    /// The difference at the start of the current period.
+    starts: Vec<DVector<f64>>,
+    /// Each period's (start, end) difference after the transient.
+    transitions: Vec<Vec<Transition>>,
+    /// `ln` of the factors the separation was rescaled by so far.
+    offset: Vec<f64>,
+    renorms: Vec<usize>,
+    /// `V` reached 0: the pair merged with the reference.
+    collapsed: Vec<bool>,
+}
+
+impl Pairs {
+    /// Each pair's second state: `x2 = x0 + d`, `q2 = P_Theta(q0 + e)` for random directions
+    /// (the settings' seed), scaled so that `sqrt V` is the settings' separation; set in
+    /// `state`.
+    fn seed(sys: &System, settings: &RateSettings, x0: &[f64], z0: &[f64], state: &mut EnsembleState) -> Self {
+        let (n, p, np) = (sys.n(), sys.p(), settings.pairs);
+        let pi = settings.pi.as_ref();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
+        let mut log_v = Vec::with_capacity(np);
+        let mut starts = Vec::with_capacity(np);
+        for pair in 0..np {
+            let dx: Vec<f64> = (0..n).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
+            let dq: Vec<f64> = (0..p).map(|_| rng.random::<f64>() * 2.0 - 1.0).collect();
+            let (mut x2, mut z2) = perturbed(sys, x0, z0, &dx, &dq, 1.0);
+            let v = lyapunov_v(sys, pi, x0, z0, &x2, &z2);
+            if v > 0.0 {
+                let s = settings.separation / v.sqrt();
+                (x2, z2) = rescale(sys, x0, z0, &x2, &z2, s);
+            }
+            state.set(pair + 1, &x2, &z2);
+            log_v.push(vec![lyapunov_v(sys, pi, x0, z0, &x2, &z2).ln()]);
+            starts.push(difference(sys, x0, z0, &x2, &z2));
+        }
+        Pairs {
+            log_v,
+            starts,
+            transitions: vec![Vec::new(); np],
+            offset: vec![0.0; np],
+            renorms: vec![0; np],
+            collapsed: vec![false; np],
+        }
+    }
+
+    /// At the end of period `j`: each live pair's `ln V` and difference recorded, and its
+    /// separation rescaled to the settings' where it fell below `renorm_below` of it.
+    fn after_period(&mut self, sys: &System, settings: &RateSettings, j: usize, state: &mut EnsembleState) {
+        let pi = settings.pi.as_ref();
+        let (x1, z1) = (state.x_of(0), state.z_of(0));
+        for pair in 0..self.log_v.len() {
+            if self.collapsed[pair] {
+                continue;
+            }
+            let (x2, z2) = (state.x_of(pair + 1), state.z_of(pair + 1));
+            let v = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
+            if v == 0.0 {
+                self.collapsed[pair] = true;
+                continue;
+            }
+            self.log_v[pair].push(v.ln() + self.offset[pair]);
+            let end = difference(sys, &x1, &z1, &x2, &z2);
+            let start = std::mem::replace(&mut self.starts[pair], end.clone());
+            if j >= settings.transient_periods {
+                self.transitions[pair].push(Transition { start, end });
+            }
+            if v.sqrt() < settings.renorm_below * settings.separation {
+                let s = settings.separation / v.sqrt();
+                let (x2, z2) = rescale(sys, &x1, &z1, &x2, &z2, s);
+                let v_new = lyapunov_v(sys, pi, &x1, &z1, &x2, &z2);
+                self.offset[pair] += v.ln() - v_new.ln();
+                self.renorms[pair] += 1;
+                self.starts[pair] = difference(sys, &x1, &z1, &x2, &z2);
+                state.set(pair + 1, &x2, &z2);
+            }
+        }
+    }
 }
 
 /// The regression of each pair's `ln V` over the window after the transient.
