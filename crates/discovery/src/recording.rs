@@ -107,6 +107,76 @@ fn col_names(prefix: &str, header: &[String]) -> Vec<usize> {
     (1..).map_while(|k| numbered.get(&k).copied()).collect()
 }
 
+/// Where a recording's columns are in its header: the time, the inputs `w*`, the outputs
+/// `y*`, the backlash outputs `z*` (optional) and every other column (kept as an extra column
+/// while each of its values parses as a finite number).
+struct Columns {
+    t: usize,
+    w: Vec<usize>,
+    y: Vec<usize>,
+    z: Vec<usize>,
+    extra: Vec<usize>,
+}
+
+impl Columns {
+    /// The columns of `header`; an error naming the first of `t`, `w`, `y` it lacks.
+    fn of(header: &[String], path: &str) -> Result<Self, DiscoveryError> {
+        let missing = |c: &str| DiscoveryError::MissingColumn {
+            path: path.to_string(),
+            column: c.into(),
+            header: header.to_vec(),
+        };
+        let t = header.iter().position(|h| h == "t").ok_or_else(|| missing("t"))?;
+        let w = col_names("w", header);
+        if w.is_empty() {
+            return Err(missing("w"));
+        }
+        let y = col_names("y", header);
+        if y.is_empty() {
+            return Err(missing("y"));
+        }
+        let z = col_names("z", header);
+        let extra =
+            (0..header.len()).filter(|i| *i != t && !w.contains(i) && !y.contains(i) && !z.contains(i)).collect();
+        Ok(Columns { t, w, y, z, extra })
+    }
+}
+
+/// At least [`MIN_SAMPLES`] time stamps, and no step longer than [`MAX_GAP_RATIO`] times
+/// their median step (an error naming the row after the gap).
+fn check_time_grid(path: &str, t: &[f64]) -> Result<(), DiscoveryError> {
+    if t.len() < MIN_SAMPLES {
+        return Err(DiscoveryError::TooFewSamples { path: path.to_string(), rows: t.len(), min: MIN_SAMPLES });
+    }
+    let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
+    d.sort_by(f64::total_cmp);
+    let median = d[d.len() / 2];
+    if let Some(k) = t.windows(2).position(|p| p[1] - p[0] > MAX_GAP_RATIO * median) {
+        let gap = t[k + 1] - t[k];
+        return Err(DiscoveryError::TimeGap {
+            path: path.to_string(),
+            row: k + 3, // row of t[k + 1]: 1-based, header is row 1
+            gap,
+            median,
+            ratio: gap / median,
+            max_ratio: MAX_GAP_RATIO,
+        });
+    }
+    Ok(())
+}
+
+/// Every input column (`iw`, at rows of `w`) varies: a constant input excites nothing.
+fn check_inputs_vary(path: &str, header: &[String], iw: &[usize], w: &[Vec<f64>]) -> Result<(), DiscoveryError> {
+    for (j, &i) in iw.iter().enumerate() {
+        let v0 = w[0][j];
+        let scale = w.iter().map(|r| r[j].abs()).fold(0.0, f64::max).max(1e-300);
+        if w.iter().all(|r| (r[j] - v0).abs() <= 1e-12 * scale) {
+            return Err(DiscoveryError::ConstantInput { path: path.to_string(), column: header[i].clone(), value: v0 });
+        }
+    }
+    Ok(())
+}
+
 impl Recording {
     pub fn m(&self) -> usize {
         self.w[0].len()
@@ -173,21 +243,7 @@ impl Recording {
             .iter()
             .map(|s| s.to_string())
             .collect();
-        let missing =
-            |c: &str| DiscoveryError::MissingColumn { path: path.clone(), column: c.into(), header: header.clone() };
-        let it = header.iter().position(|h| h == "t").ok_or_else(|| missing("t"))?;
-        let iw = col_names("w", &header);
-        if iw.is_empty() {
-            return Err(missing("w"));
-        }
-        let iy = col_names("y", &header);
-        if iy.is_empty() {
-            return Err(missing("y"));
-        }
-        let iz = col_names("z", &header);
-        // Extra columns: everything else, kept while every value parses as a finite number.
-        let mut ix: Vec<usize> =
-            (0..header.len()).filter(|i| *i != it && !iw.contains(i) && !iy.contains(i) && !iz.contains(i)).collect();
+        let Columns { t: it, w: iw, y: iy, z: iz, extra: mut ix } = Columns::of(&header, &path)?;
         let mut xcols: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
         let mut t = Vec::new();
         let mut w = Vec::new();
@@ -236,30 +292,8 @@ impl Recording {
                 _ => false,
             });
         }
-        if t.len() < MIN_SAMPLES {
-            return Err(DiscoveryError::TooFewSamples { path, rows: t.len(), min: MIN_SAMPLES });
-        }
-        let mut d: Vec<f64> = t.windows(2).map(|p| p[1] - p[0]).collect();
-        d.sort_by(f64::total_cmp);
-        let median = d[d.len() / 2];
-        if let Some(k) = t.windows(2).position(|p| p[1] - p[0] > MAX_GAP_RATIO * median) {
-            let gap = t[k + 1] - t[k];
-            return Err(DiscoveryError::TimeGap {
-                path,
-                row: k + 3, // row of t[k + 1]: 1-based, header is row 1
-                gap,
-                median,
-                ratio: gap / median,
-                max_ratio: MAX_GAP_RATIO,
-            });
-        }
-        for (j, &i) in iw.iter().enumerate() {
-            let v0 = w[0][j];
-            let scale = w.iter().map(|r| r[j].abs()).fold(0.0, f64::max).max(1e-300);
-            if w.iter().all(|r| (r[j] - v0).abs() <= 1e-12 * scale) {
-                return Err(DiscoveryError::ConstantInput { path, column: header[i].clone(), value: v0 });
-            }
-        }
+        check_time_grid(&path, &t)?;
+        check_inputs_vary(&path, &header, &iw, &w)?;
         let z = if iz.is_empty() { None } else { Some(z) };
         let extra: Vec<(String, Vec<f64>)> =
             ix.iter().map(|&i| (header[i].clone(), std::mem::take(&mut xcols[i]))).collect();
