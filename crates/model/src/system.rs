@@ -205,6 +205,119 @@ pub fn check_step(dt: f64, period: Option<f64>, t_end: Option<f64>, key: &str) -
     Ok(())
 }
 
+/// The plant's dimensions `(n, p)`: `A` square, `B` with `n` rows, `C` with `n` columns, `E`
+/// `n x p`, every entry finite.
+fn plant_dimensions(
+    A: &DMatrix<f64>,
+    B: &DMatrix<f64>,
+    C: &DMatrix<f64>,
+    E: &DMatrix<f64>,
+) -> Result<(usize, usize), ModelError> {
+    let n = A.nrows();
+    if A.ncols() != n || n == 0 {
+        return Err(dim_err("plant.A", "a square n x n matrix".into(), A));
+    }
+    if B.nrows() != n {
+        return Err(dim_err("plant.B", format!("{n} rows (n)"), B));
+    }
+    if C.ncols() != n {
+        return Err(dim_err("plant.C", format!("{n} columns (n)"), C));
+    }
+    let p = C.nrows();
+    if E.nrows() != n || E.ncols() != p {
+        return Err(dim_err("plant.E", format!("{n}x{p} (n x p)"), E));
+    }
+    for (k, m) in [("plant.A", A), ("plant.B", B), ("plant.C", C), ("plant.E", E)] {
+        if let Some(&value) = m.iter().find(|x| !x.is_finite()) {
+            return Err(ModelError::NotFinite { key: k.into(), value });
+        }
+    }
+    Ok((n, p))
+}
+
+/// `Theta` in R^p, the input with `m` (columns of `B`) components, `x0` in R^n, `z0` in R^p.
+fn initial_dimensions(
+    theta: &Shape,
+    input: &Input,
+    m: usize,
+    x0: &DVector<f64>,
+    z0: &DVector<f64>,
+    n: usize,
+    p: usize,
+) -> Result<(), ModelError> {
+    if theta.dim() != p {
+        return Err(ModelError::Dimension {
+            key: "theta".into(),
+            expected: format!("a set in R^{p} (p = rows of C)"),
+            got: format!("a set in R^{}", theta.dim()),
+        });
+    }
+    if input.m() != m {
+        return Err(ModelError::Dimension {
+            key: "input".into(),
+            expected: format!("m = {m} components (columns of B)"),
+            got: format!("{}", input.m()),
+        });
+    }
+    if x0.len() != n {
+        return Err(ModelError::Dimension {
+            key: "initial.x0".into(),
+            expected: format!("length n = {n}"),
+            got: format!("length {}", x0.len()),
+        });
+    }
+    if z0.len() != p {
+        return Err(ModelError::Dimension {
+            key: "initial.z0".into(),
+            expected: format!("length p = {p}"),
+            got: format!("length {}", z0.len()),
+        });
+    }
+    Ok(())
+}
+
+/// `Theta` contains 0 (to `1e-12` relative) and `z0 - C x0` (to `1e-9` relative); each error
+/// gives the distance.
+fn theta_holds_initial(
+    theta: &Shape,
+    C: &DMatrix<f64>,
+    x0: &DVector<f64>,
+    z0: &DVector<f64>,
+) -> Result<(), ModelError> {
+    let scale = 1.0 + theta.deviation_from_origin().upper;
+    let zero = vec![0.0; C.nrows()];
+    if !theta.contains(&zero, 1e-12 * scale) {
+        let proj = geometry::convex_set::project_vec(theta, &zero);
+        return Err(ModelError::ThetaMissesOrigin { distance: geometry::linalg::norm(&proj), theta: theta.describe() });
+    }
+    let q0: Vec<f64> = (z0 - C * x0).iter().copied().collect();
+    let tol = 1e-9 * (scale + geometry::linalg::norm(&q0));
+    if !theta.contains(&q0, tol) {
+        let proj = geometry::convex_set::project_vec(theta, &q0);
+        return Err(ModelError::InitialOutsideTheta { distance: geometry::linalg::dist(&q0, &proj), q0 });
+    }
+    Ok(())
+}
+
+/// The simulation defaults: a positive finite step, at least one period.
+fn sim_checked(sim: &SimDefaults) -> Result<(), ModelError> {
+    if !(sim.dt > 0.0 && sim.dt.is_finite()) {
+        return Err(ModelError::OutOfRange {
+            key: "simulation.dt".into(),
+            value: sim.dt,
+            reason: "must be positive and finite",
+        });
+    }
+    if sim.periods == 0 {
+        return Err(ModelError::OutOfRange {
+            key: "simulation.periods".into(),
+            value: 0.0,
+            reason: "must be at least 1",
+        });
+    }
+    Ok(())
+}
+
 impl System {
     /// Named-field construction ([`SystemBuilder`]).
     pub fn builder() -> SystemBuilder {
@@ -227,82 +340,10 @@ impl System {
         sim: SimDefaults,
         effects: Effects,
     ) -> Result<Self, ModelError> {
-        let n = A.nrows();
-        if A.ncols() != n || n == 0 {
-            return Err(dim_err("plant.A", "a square n x n matrix".into(), &A));
-        }
-        if B.nrows() != n {
-            return Err(dim_err("plant.B", format!("{n} rows (n)"), &B));
-        }
-        if C.ncols() != n {
-            return Err(dim_err("plant.C", format!("{n} columns (n)"), &C));
-        }
-        let p = C.nrows();
-        if E.nrows() != n || E.ncols() != p {
-            return Err(dim_err("plant.E", format!("{n}x{p} (n x p)"), &E));
-        }
-        for (k, m) in [("plant.A", &A), ("plant.B", &B), ("plant.C", &C), ("plant.E", &E)] {
-            if let Some(&value) = m.iter().find(|x| !x.is_finite()) {
-                return Err(ModelError::NotFinite { key: k.into(), value });
-            }
-        }
-        if theta.dim() != p {
-            return Err(ModelError::Dimension {
-                key: "theta".into(),
-                expected: format!("a set in R^{p} (p = rows of C)"),
-                got: format!("a set in R^{}", theta.dim()),
-            });
-        }
-        if input.m() != B.ncols() {
-            return Err(ModelError::Dimension {
-                key: "input".into(),
-                expected: format!("m = {} components (columns of B)", B.ncols()),
-                got: format!("{}", input.m()),
-            });
-        }
-        if x0.len() != n {
-            return Err(ModelError::Dimension {
-                key: "initial.x0".into(),
-                expected: format!("length n = {n}"),
-                got: format!("length {}", x0.len()),
-            });
-        }
-        if z0.len() != p {
-            return Err(ModelError::Dimension {
-                key: "initial.z0".into(),
-                expected: format!("length p = {p}"),
-                got: format!("length {}", z0.len()),
-            });
-        }
-        let scale = 1.0 + theta.deviation_from_origin().upper;
-        let zero = vec![0.0; p];
-        if !theta.contains(&zero, 1e-12 * scale) {
-            let proj = geometry::convex_set::project_vec(&theta, &zero);
-            return Err(ModelError::ThetaMissesOrigin {
-                distance: geometry::linalg::norm(&proj),
-                theta: theta.describe(),
-            });
-        }
-        let q0: Vec<f64> = (&z0 - &C * &x0).iter().copied().collect();
-        let tol = 1e-9 * (scale + geometry::linalg::norm(&q0));
-        if !theta.contains(&q0, tol) {
-            let proj = geometry::convex_set::project_vec(&theta, &q0);
-            return Err(ModelError::InitialOutsideTheta { distance: geometry::linalg::dist(&q0, &proj), q0 });
-        }
-        if !(sim.dt > 0.0 && sim.dt.is_finite()) {
-            return Err(ModelError::OutOfRange {
-                key: "simulation.dt".into(),
-                value: sim.dt,
-                reason: "must be positive and finite",
-            });
-        }
-        if sim.periods == 0 {
-            return Err(ModelError::OutOfRange {
-                key: "simulation.periods".into(),
-                value: 0.0,
-                reason: "must be at least 1",
-            });
-        }
+        let (n, p) = plant_dimensions(&A, &B, &C, &E)?;
+        initial_dimensions(&theta, &input, B.ncols(), &x0, &z0, n, p)?;
+        theta_holds_initial(&theta, &C, &x0, &z0)?;
+        sim_checked(&sim)?;
         Ok(Self {
             name: name.into(),
             A,
