@@ -33,6 +33,49 @@ pub struct MeasuredSide {
     pub separation_error: Option<f64>,
 }
 
+/// The rows of the stationary set's check (eq. (stat1)): `Phi`'s first singular time and the
+/// slack.
+fn stationary_rows(s: &RestSet) -> Vec<Quantity> {
+    use crate::report::defs::*;
+    vec![
+        PHI_FIRST_SINGULAR
+            .with(s.phi.first_singular.unwrap_or(f64::NAN), false)
+            .note(format!("min sigma(Phi) on [0,T] = {:.3e}", s.phi.min_sigma)),
+        // The grid relaxes (stat1), so its slack bounds the continuous one from below.
+        STATIONARY_SLACK
+            .with(s.slack, s.verified)
+            .kind(if s.verified { BoundKind::Lower } else { BoundKind::Estimate })
+            .note(format!(
+                "{} -> {}",
+                s.method,
+                match s.empty {
+                    Some(true) => "empty",
+                    Some(false) => "nonempty",
+                    None => "undecided",
+                }
+            )),
+    ]
+}
+
+/// The rows of the measurement (estimates, never verified): the exponent, the dominant
+/// multiplier where found, the path length per period and the largest backlash speed.
+fn measured_rows(m: &MeasuredSide) -> Vec<Quantity> {
+    use crate::report::defs::*;
+    let mut q = vec![MEASURED_RATE.with(m.rate, false).note(format!(
+        "95% CI [{:.4}, {:.4}], {} periods{}",
+        m.ci_low,
+        m.ci_high,
+        m.periods,
+        step_note(m)
+    ))];
+    if let Some([e, lo, hi]) = m.multiplier {
+        q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]{}", step_note(m))));
+    }
+    q.push(PATH_MEASURED.with(m.path_length_per_period, false));
+    q.push(ZDOT_MEASURED.with(m.limsup_zdot, false));
+    q
+}
+
 /// What a measured interval says about the stepping error.
 fn step_note(m: &MeasuredSide) -> String {
     match (m.step_error, m.separation_error) {
@@ -239,40 +282,10 @@ impl ThetaReport {
                 .note(format!("greedy packing, eps = {:.4}, N = {}", self.path2.eps, self.path2.count)),
         ];
         if let Some(s) = &self.stationary {
-            q.push(
-                PHI_FIRST_SINGULAR
-                    .with(s.phi.first_singular.unwrap_or(f64::NAN), false)
-                    .note(format!("min sigma(Phi) on [0,T] = {:.3e}", s.phi.min_sigma)),
-            );
-            // The grid relaxes (stat1), so its slack bounds the continuous one from below.
-            q.push(
-                STATIONARY_SLACK
-                    .with(s.slack, s.verified)
-                    .kind(if s.verified { BoundKind::Lower } else { BoundKind::Estimate })
-                    .note(format!(
-                        "{} -> {}",
-                        s.method,
-                        match s.empty {
-                            Some(true) => "empty",
-                            Some(false) => "nonempty",
-                            None => "undecided",
-                        }
-                    )),
-            );
+            q.extend(stationary_rows(s));
         }
         if let Some(m) = &self.measured {
-            q.push(MEASURED_RATE.with(m.rate, false).note(format!(
-                "95% CI [{:.4}, {:.4}], {} periods{}",
-                m.ci_low,
-                m.ci_high,
-                m.periods,
-                step_note(m)
-            )));
-            if let Some([e, lo, hi]) = m.multiplier {
-                q.push(MEASURED_MULTIPLIER.with(e, false).note(format!("95% CI [{lo:.5}, {hi:.5}]{}", step_note(m))));
-            }
-            q.push(PATH_MEASURED.with(m.path_length_per_period, false));
-            q.push(ZDOT_MEASURED.with(m.limsup_zdot, false));
+            q.extend(measured_rows(m));
         }
         q
     }
