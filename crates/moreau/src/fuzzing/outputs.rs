@@ -113,119 +113,157 @@ pub fn write_output(data: &[u8]) {
     let (name, content) = rest.split_at(len.min(rest.len()));
     let content = &content[..content.len().min(MAX_CONTENT)];
     let kind = Kind::of(k, depth);
+    if kind == Kind::DevNull {
+        return write_dev_null(Path::new("/dev/null"), content);
+    }
     let Ok(root) = super::scratch() else { return };
-    let (fx, d) = (root.path().join("fx"), root.path().join("d"));
-    if std::fs::create_dir(&fx).is_err() || std::fs::create_dir(&d).is_err() {
+    let scene =
+        Scene { fx: root.path().join("fx"), d: root.path().join("d"), target: PathBuf::new(), real: PathBuf::new() };
+    if std::fs::create_dir(&scene.fx).is_err() || std::fs::create_dir(&scene.d).is_err() {
         return;
     }
-    let target = d.join(file_name(name));
-    let real = fx.join("real");
-    let old = b"old content".as_slice();
-    let mut reader = None;
-    let mut _listener = None;
-    let set_up = match kind {
-        Kind::Nothing => Ok(()),
-        Kind::File | Kind::BelowFile => std::fs::write(&target, old),
-        Kind::LinkToFile => std::fs::write(&real, old).and_then(|_| symlink("../fx/real", &target)),
-        Kind::Dangling => symlink("../fx/made", &target),
-        Kind::LinkLoop => symlink("../fx/b", &target)
-            .and_then(|_| symlink("c", fx.join("b")))
-            .and_then(|_| symlink("b", fx.join("c"))),
-        Kind::LinkChain(n) => {
-            // target -> fx/l1 -> fx/l2 -> ... -> fx/l(n-1) -> fx/real: n links
-            let first = if n == 1 { "../fx/real".to_string() } else { "../fx/l1".to_string() };
-            let mut r = std::fs::write(&real, old).and_then(|_| symlink(first, &target));
-            for i in 1..n {
-                let to = if i + 1 == n { "real".to_string() } else { format!("l{}", i + 1) };
-                r = r.and_then(|_| symlink(&to, fx.join(format!("l{i}"))));
-            }
-            r
-        }
-        Kind::Directory => std::fs::create_dir(&target).and_then(|_| std::fs::write(target.join("keep"), old)),
-        Kind::LinkToDirectory => std::fs::create_dir(fx.join("dir")).and_then(|_| symlink("../fx/dir", &target)),
-        Kind::Fifo => {
-            let made = std::process::Command::new("mkfifo").arg(&target).status().is_ok_and(|s| s.success());
-            if !made {
-                return; // no mkfifo here
-            }
-            std::fs::OpenOptions::new().read(true).custom_flags(O_NONBLOCK).open(&target).map(|r| reader = Some(r))
-        }
-        Kind::Socket => std::os::unix::net::UnixListener::bind(&target).map(|l| _listener = Some(l)),
-        Kind::Input => std::fs::write(&target, old).map(|_| register_input(&target)),
-        Kind::LinkToInput => {
-            std::fs::write(&real, old).and_then(|_| symlink("../fx/real", &target)).map(|_| register_input(&real))
-        }
-        Kind::DevNull => return write_dev_null(Path::new("/dev/null"), content),
-        Kind::LinkToDevNull => symlink("/dev/null", &target),
-    };
-    if set_up.is_err() {
+    let scene = Scene { target: scene.d.join(file_name(name)), real: scene.fx.join("real"), ..scene };
+    let Some(held) = scene.arrange(kind) else {
         forget_inputs();
-        return; // e.g. a socket path longer than sun_path
-    }
-    let path = if kind == Kind::BelowFile { target.join("out") } else { target.clone() };
-    let before = kind_of(&target);
+        return; // e.g. a socket path longer than sun_path, or no mkfifo here
+    };
+    let path = if kind == Kind::BelowFile { scene.target.join("out") } else { scene.target.clone() };
+    let before = kind_of(&scene.target);
     let r = write_atomic(&path, content);
     forget_inputs();
-    let after = kind_of(&target);
     let what = format!("{kind:?} target {}: {r:?}", path.display());
-    // the target keeps its kind (a new file appears only where there was nothing)
-    match kind {
-        Kind::Nothing => assert_eq!(after, Some("file"), "{what}"),
-        _ => assert_eq!(after, before, "{what}: the target changed kind"),
-    }
-    // nothing else is left beside it
-    assert_eq!(names(&d), vec![PathBuf::from(target.file_name().unwrap_or_default())], "{what}: files left");
-    let read = |p: &Path| std::fs::read(p).unwrap_or_default();
-    match kind {
-        Kind::Nothing | Kind::File => {
-            assert!(r.is_ok(), "{what}");
-            assert_eq!(read(&target), content, "{what}");
-        }
-        Kind::LinkToFile => {
-            assert!(r.is_ok(), "{what}");
-            assert_eq!(read(&real), content, "{what}");
-        }
-        Kind::Dangling => {
-            assert!(r.is_ok(), "{what}");
-            assert_eq!(read(&fx.join("made")), content, "{what}");
-        }
-        Kind::LinkChain(n) if n <= 40 => {
-            assert!(r.is_ok(), "{what}");
-            assert_eq!(read(&real), content, "{what}");
-        }
-        Kind::LinkChain(_) => {
-            assert!(r.is_err(), "{what}: a chain of more than 40 links must be refused");
-            assert_eq!(read(&real), old, "{what}");
-        }
-        Kind::LinkLoop | Kind::Socket | Kind::LinkToDirectory | Kind::BelowFile => {
-            assert!(r.is_err(), "{what}");
-        }
-        Kind::Directory => {
-            assert!(r.is_err(), "{what}");
-            assert_eq!(names(&target), vec![PathBuf::from("keep")], "{what}");
-            assert_eq!(read(&target.join("keep")), old, "{what}");
-        }
-        Kind::Fifo => {
-            assert!(r.is_ok(), "{what}");
-            let mut got = Vec::new();
-            if let Some(mut rd) = reader {
-                let _ = rd.read_to_end(&mut got);
+    scene.check(kind, before, &r, content, held, &what);
+}
+
+/// The content a target holds before the write.
+const OLD: &[u8] = b"old content";
+
+/// The scratch layout of one case: the output's directory `d` holding only `target`, and
+/// `fx` holding what links point to (`real`, the end of a chain).
+struct Scene {
+    fx: PathBuf,
+    d: PathBuf,
+    target: PathBuf,
+    real: PathBuf,
+}
+
+/// What a case keeps open while the output is written: a FIFO's reader, a socket's listener.
+struct Held {
+    reader: Option<std::fs::File>,
+    _listener: Option<std::os::unix::net::UnixListener>,
+}
+
+impl Scene {
+    /// Puts a target of `kind` in place; `None` where the system refuses it.
+    fn arrange(&self, kind: Kind) -> Option<Held> {
+        let (fx, target, real) = (&self.fx, &self.target, &self.real);
+        let mut held = Held { reader: None, _listener: None };
+        let set_up = match kind {
+            Kind::Nothing => Ok(()),
+            Kind::File | Kind::BelowFile => std::fs::write(target, OLD),
+            Kind::LinkToFile => std::fs::write(real, OLD).and_then(|_| symlink("../fx/real", target)),
+            Kind::Dangling => symlink("../fx/made", target),
+            Kind::LinkLoop => symlink("../fx/b", target)
+                .and_then(|_| symlink("c", fx.join("b")))
+                .and_then(|_| symlink("b", fx.join("c"))),
+            Kind::LinkChain(n) => {
+                // target -> fx/l1 -> fx/l2 -> ... -> fx/l(n-1) -> fx/real: n links
+                let first = if n == 1 { "../fx/real".to_string() } else { "../fx/l1".to_string() };
+                let mut r = std::fs::write(real, OLD).and_then(|_| symlink(first, target));
+                for i in 1..n {
+                    let to = if i + 1 == n { "real".to_string() } else { format!("l{}", i + 1) };
+                    r = r.and_then(|_| symlink(&to, fx.join(format!("l{i}"))));
+                }
+                r
             }
-            assert_eq!(got, content, "{what}: the reader of the FIFO");
+            Kind::Directory => std::fs::create_dir(target).and_then(|_| std::fs::write(target.join("keep"), OLD)),
+            Kind::LinkToDirectory => std::fs::create_dir(fx.join("dir")).and_then(|_| symlink("../fx/dir", target)),
+            Kind::Fifo => {
+                let made = std::process::Command::new("mkfifo").arg(target).status().is_ok_and(|s| s.success());
+                if !made {
+                    return None;
+                }
+                std::fs::OpenOptions::new()
+                    .read(true)
+                    .custom_flags(O_NONBLOCK)
+                    .open(target)
+                    .map(|r| held.reader = Some(r))
+            }
+            Kind::Socket => std::os::unix::net::UnixListener::bind(target).map(|l| held._listener = Some(l)),
+            Kind::Input => std::fs::write(target, OLD).map(|_| register_input(target)),
+            Kind::LinkToInput => {
+                std::fs::write(real, OLD).and_then(|_| symlink("../fx/real", target)).map(|_| register_input(real))
+            }
+            Kind::LinkToDevNull => symlink("/dev/null", target),
+            Kind::DevNull => unreachable!("written through by write_dev_null"),
+        };
+        set_up.ok().map(|_| held)
+    }
+
+    /// What the write `r` of `content` must have done to a target of `kind` (of file kind
+    /// `before`): the target keeps its kind (a new file appears only where there was nothing),
+    /// nothing else is left beside it, and the content went where the kind says, or the write
+    /// was refused.
+    fn check(&self, kind: Kind, before: Option<&str>, r: &anyhow::Result<()>, content: &[u8], held: Held, what: &str) {
+        let (fx, target, real) = (&self.fx, &self.target, &self.real);
+        let after = kind_of(target);
+        match kind {
+            Kind::Nothing => assert_eq!(after, Some("file"), "{what}"),
+            _ => assert_eq!(after, before, "{what}: the target changed kind"),
         }
-        Kind::Input => {
-            assert!(r.is_err(), "{what}: an input must not be overwritten");
-            assert_eq!(read(&target), old, "{what}");
+        assert_eq!(names(&self.d), vec![PathBuf::from(target.file_name().unwrap_or_default())], "{what}: files left");
+        let read = |p: &Path| std::fs::read(p).unwrap_or_default();
+        match kind {
+            Kind::Nothing | Kind::File => {
+                assert!(r.is_ok(), "{what}");
+                assert_eq!(read(target), content, "{what}");
+            }
+            Kind::LinkToFile => {
+                assert!(r.is_ok(), "{what}");
+                assert_eq!(read(real), content, "{what}");
+            }
+            Kind::Dangling => {
+                assert!(r.is_ok(), "{what}");
+                assert_eq!(read(&fx.join("made")), content, "{what}");
+            }
+            Kind::LinkChain(n) if n <= 40 => {
+                assert!(r.is_ok(), "{what}");
+                assert_eq!(read(real), content, "{what}");
+            }
+            Kind::LinkChain(_) => {
+                assert!(r.is_err(), "{what}: a chain of more than 40 links must be refused");
+                assert_eq!(read(real), OLD, "{what}");
+            }
+            Kind::LinkLoop | Kind::Socket | Kind::LinkToDirectory | Kind::BelowFile => {
+                assert!(r.is_err(), "{what}");
+            }
+            Kind::Directory => {
+                assert!(r.is_err(), "{what}");
+                assert_eq!(names(target), vec![PathBuf::from("keep")], "{what}");
+                assert_eq!(read(&target.join("keep")), OLD, "{what}");
+            }
+            Kind::Fifo => {
+                assert!(r.is_ok(), "{what}");
+                let mut got = Vec::new();
+                if let Some(mut rd) = held.reader {
+                    let _ = rd.read_to_end(&mut got);
+                }
+                assert_eq!(got, content, "{what}: the reader of the FIFO");
+            }
+            Kind::Input => {
+                assert!(r.is_err(), "{what}: an input must not be overwritten");
+                assert_eq!(read(target), OLD, "{what}");
+            }
+            Kind::LinkToInput => {
+                assert!(r.is_err(), "{what}: an input must not be overwritten through a link");
+                assert_eq!(read(real), OLD, "{what}");
+            }
+            Kind::LinkToDevNull => {
+                assert!(r.is_ok(), "{what}");
+                assert_eq!(kind_of(Path::new("/dev/null")), Some("char device"), "{what}");
+            }
+            Kind::DevNull => unreachable!("written through by write_dev_null"),
         }
-        Kind::LinkToInput => {
-            assert!(r.is_err(), "{what}: an input must not be overwritten through a link");
-            assert_eq!(read(&real), old, "{what}");
-        }
-        Kind::LinkToDevNull => {
-            assert!(r.is_ok(), "{what}");
-            assert_eq!(kind_of(Path::new("/dev/null")), Some("char device"), "{what}");
-        }
-        Kind::DevNull => unreachable!("returned above"),
     }
 }
 
