@@ -629,12 +629,7 @@ fn generate_classes(
     input: Option<ForcedInput>,
 ) -> Case {
     let class = classes[0];
-    let class_index = all_classes().iter().position(|c| *c == class).unwrap_or(0);
-    let mut mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
-    if let Some(&second) = classes.get(1) {
-        let i2 = all_classes().iter().position(|c| *c == second).unwrap_or(0);
-        mix ^= (i2 as u64 + 1) << 48;
-    }
+    let mix = case_mix(classes, seed, index);
     let has = |c: &str| classes.contains(&c);
     let mut rng = ChaCha8Rng::seed_from_u64(mix);
     let mut fshape = FrictionShape::draw(mix);
@@ -684,25 +679,8 @@ fn generate_classes(
             .map(|(a, b)| a + b)
             .collect()
     };
-    // Each class's magnitude alone (the second of a pair: target and sign of its own stream).
-    let mut r2 = ChaCha8Rng::seed_from_u64(mix ^ 0x7A1B_0000_0000_0027);
-    let truths: Vec<Effect> = classes
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &c)| {
-            let (target, sign) = if i == 0 {
-                (target, sign)
-            } else {
-                (r2.random_range(86.0..94.0), if r2.random::<bool>() { 1.0 } else { -1.0 })
-            };
-            let fit_at = |a: f64| {
-                let e = effect_at(c, a, sign, wmax, plant.vel, &fshape);
-                fit_percent(&measure_all(e.iter().collect::<Vec<_>>().as_slice()), &clean_nom)
-            };
-            let a = if c == NONE { 0.0 } else { truth_magnitude(c, fit_at, target, period, ystd) };
-            effect_at(c, a, sign, wmax, plant.vel, &fshape)
-        })
-        .collect();
+    let truths =
+        true_effects(classes, mix, (target, sign), wmax, plant.vel, &fshape, &measure_all, &clean_nom, period, ystd);
     let truth = truths.first().cloned();
     let effs: Vec<&Effect> = truths.iter().collect();
     let clean = if converged_truth() {
@@ -732,6 +710,55 @@ fn generate_classes(
         conditions.short()
     );
     Case { class, nominal, truth, truths, classes: classes.to_vec(), recording, nominal_fit, description, conditions }
+}
+
+/// The seed of case `index` of `classes` from `seed`: one class draws what it always did; the
+/// second of a pair is mixed in above bit 48.
+fn case_mix(classes: &[&'static str], seed: u64, index: usize) -> u64 {
+    let class_index = all_classes().iter().position(|c| *c == classes[0]).unwrap_or(0);
+    let mut mix = seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index as u64 + 1)) ^ (class_index as u64) << 40;
+    if let Some(&second) = classes.get(1) {
+        let i2 = all_classes().iter().position(|c| *c == second).unwrap_or(0);
+        mix ^= (i2 as u64 + 1) << 48;
+    }
+    mix
+}
+
+/// Each class's true effect, its magnitude set alone so that the nominal model fits the noisy
+/// recording to the class's target (the first class's `(target, sign)` as drawn; the second of
+/// a pair draws its own from a stream of its own). `measure_all` simulates the plant with the
+/// given effects and adds the noise; `clean_nom` is the nominal model's clean output.
+#[allow(clippy::too_many_arguments)]
+fn true_effects(
+    classes: &[&'static str],
+    mix: u64,
+    (target, sign): (f64, f64),
+    wmax: f64,
+    vel: usize,
+    fshape: &FrictionShape,
+    measure_all: &dyn Fn(&[&Effect]) -> Vec<f64>,
+    clean_nom: &[f64],
+    period: f64,
+    ystd: f64,
+) -> Vec<Effect> {
+    let mut r2 = ChaCha8Rng::seed_from_u64(mix ^ 0x7A1B_0000_0000_0027);
+    classes
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &c)| {
+            let (target, sign) = if i == 0 {
+                (target, sign)
+            } else {
+                (r2.random_range(86.0..94.0), if r2.random::<bool>() { 1.0 } else { -1.0 })
+            };
+            let fit_at = |a: f64| {
+                let e = effect_at(c, a, sign, wmax, vel, fshape);
+                fit_percent(&measure_all(e.iter().collect::<Vec<_>>().as_slice()), clean_nom)
+            };
+            let a = if c == NONE { 0.0 } else { truth_magnitude(c, fit_at, target, period, ystd) };
+            effect_at(c, a, sign, wmax, vel, fshape)
+        })
+        .collect()
 }
 
 /// The slowest time constant of the plant with the play closed (`1 / |max Re eig(A + E C)|`).
