@@ -177,15 +177,11 @@ fn print_truth_ceiling(
 /// Development aid (`BENCH_PAIRS_RANKING` set): the case diagnosed again, its ranking printed.
 fn print_ranking(p: [&'static str; 2], seed: u64, i: usize, profile: discovery::bench_gen::Profile) {
     let case = discovery::bench_gen::generate_pair(p, seed, i, profile).expect("a pair that can co-occur");
-    let s = discovery::DiagnoseSettings {
-        initial_state: Some(discovery::InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        estimate_x0: estimate_x0(),
-        ..Default::default()
+    let s = discovery::DiagnoseSettings { estimate_x0: estimate_x0(), ..Default::default() };
+    let Ok(rep) = discovery::diagnose(&case.nominal, &case.recording, &discovery::bench::with_case_start(&case, &s))
+    else {
+        return;
     };
-    let Ok(rep) = discovery::diagnose(&case.nominal, &case.recording, &s) else { return };
     for r in &rep.ranking {
         println!("    {:<50} dBIC {:>9.1} {:?} {}", r.label, r.delta_bic, r.status, r.evidence);
     }

@@ -2,10 +2,11 @@
 //! along the true effect's main parameter (initial state refitted at each point).
 //! Usage: `[HOLD=zoh|foh] [SUB=N] cargo run --release -p discovery --example probe backlash_inertia 1 3 [classic|digital|mixed] [profile]`
 //! (`CLASS` may be a pair `a+b` of the pair benchmark).
-use discovery::bench_gen;
+use discovery::bench_gen::{self, Case};
 use discovery::fit::{self, FitSettings, Problem};
 use discovery::hypothesis::Scales;
-use dynamics::extended::StepMaps;
+use discovery::Report;
+use dynamics::extended::{InputHold, StepMaps};
 use model::effects::Effect;
 
 fn main() {
@@ -26,20 +27,30 @@ fn main() {
         None => bench_gen::generate_profile(class, seed, idx, profile),
     };
     println!("{} truth {:?}", case.description, case.truths);
+    let hold = requested_hold();
     let s = discovery::DiagnoseSettings {
-        initial_state: Some(discovery::InitialState {
-            x0: case.nominal.x0.iter().copied().collect(),
-            z0: Some(case.nominal.z0.iter().copied().collect()),
-        }),
-        // HOLD=zoh|foh: the hold given instead of chosen from the data
-        input_hold: match std::env::var("HOLD").as_deref() {
-            Ok("zoh") => discovery::HoldChoice::Fixed(dynamics::extended::InputHold::Zoh),
-            Ok("foh") => discovery::HoldChoice::Fixed(dynamics::extended::InputHold::Foh),
-            _ => discovery::HoldChoice::Auto,
-        },
+        input_hold: hold.map_or(discovery::HoldChoice::Auto, discovery::HoldChoice::Fixed),
         ..Default::default()
     };
-    let rep = discovery::diagnose(&case.nominal, &case.recording, &s).unwrap();
+    let rep =
+        discovery::diagnose(&case.nominal, &case.recording, &discovery::bench::with_case_start(&case, &s)).unwrap();
+    print_report(&rep);
+    if a.len() > 5 {
+        print_profile(&case, hold.unwrap_or(InputHold::Foh));
+    }
+}
+
+/// `HOLD=zoh|foh`: the hold given instead of chosen from the data.
+fn requested_hold() -> Option<InputHold> {
+    match std::env::var("HOLD").as_deref() {
+        Ok("zoh") => Some(InputHold::Zoh),
+        Ok("foh") => Some(InputHold::Foh),
+        _ => None,
+    }
+}
+
+/// The selection, hold, stepping, residual, notes, effects and the ranking's first 40 rows.
+fn print_report(rep: &Report) {
     println!("selected {} ties {:?}; verdict {}", rep.selected(), rep.ties, rep.verdict);
     println!(
         "hold {:?}; substeps {} ladder {:?} err {:.3e} tol {:.3e}; final {:?}; dBIC_disc {:.1}; noise {:?}; x0 {:?}",
@@ -79,88 +90,95 @@ fn main() {
             r.cv.as_ref().map(|c| (c.ratio, c.max_fold_share, c.status))
         );
     }
-    if a.len() > 5 {
-        // Profile: scale factors of the truth.
-        let sys = &case.nominal;
-        let rec = &case.recording;
-        let n = rec.len();
-        let w: Vec<f64> = rec.w.iter().flatten().copied().collect();
-        let y: Vec<f64> = rec.y.iter().flatten().copied().collect();
-        let k_est = (n as f64 * 0.7).round() as usize;
-        let mean = y.iter().sum::<f64>() / n as f64;
-        let sd = (y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
-        let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
-        let sub = std::env::var("SUB")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(((rec.dt * fast * 10.0).ceil() as usize).clamp(1, 8));
-        println!("substeps {sub}");
-        let maps = StepMaps::new(&sys.F(), &sys.B, &sys.E, rec.dt / sub as f64);
-        let sc = Scales {
-            y_range: vec![1.0],
-            w_range: vec![1.0],
-            w_absmax: 1.0,
-            tau_slow: 1.0,
-            dt: rec.dt,
-            duration: rec.duration(),
-            ..Default::default()
-        };
-        let truth = case.truth.clone().unwrap();
-        let x0: Vec<f64> = sys.x0.iter().copied().collect();
-        let xs: Vec<f64> = x0.iter().map(|_| 0.1).collect();
-        for f in [0.0, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 1.8, 2.0, 2.5] {
-            let e = match &truth {
-                Effect::BacklashInertia { mass, damping } => {
-                    Effect::BacklashInertia { mass: mass * f, damping: *damping }
-                }
-                Effect::GapWidth { relative_change } => Effect::GapWidth { relative_change: relative_change * f },
-                // the static excess over the sliding level scaled (f = 0: Coulomb friction)
-                Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } => {
-                    Effect::StribeckFriction {
-                        state: *state,
-                        level: *level,
-                        static_level: level + (static_level - level) * (f - 0.5) * 2.0,
-                        stribeck_velocity: *stribeck_velocity,
-                        viscous: *viscous,
-                    }
-                }
-                Effect::CoulombFriction { state, level } => Effect::CoulombFriction { state: *state, level: level * f },
-                // the asymmetry scaled about the mean level (f = 0: Coulomb friction)
-                Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
-                    let mean = 0.5 * (level_positive + level_negative);
-                    Effect::AsymmetricCoulomb {
-                        state: *state,
-                        level_positive: mean + (level_positive - mean) * f,
-                        level_negative: mean + (level_negative - mean) * f,
-                    }
-                }
-                _ => panic!("no profile for {truth:?}"),
-            };
-            let pb = Problem {
-                sys,
-                fixed: vec![e],
-                parts: vec![],
-                scales: &sc,
-                w: &w,
-                y: &y,
-                m: 1,
-                p: 1,
-                dt: rec.dt,
-                k_est,
-                weights: vec![1.0 / sd],
-                maps: maps.clone(),
-                substeps: sub,
-                hold: if std::env::var("HOLD").as_deref() == Ok("zoh") {
-                    dynamics::extended::InputHold::Zoh
-                } else {
-                    dynamics::extended::InputHold::Foh
-                },
-                z0: None,
-                exclude: None,
-                refit: None,
-            };
-            let r = fit::fit(&pb, &x0, &xs, None, &FitSettings::default());
-            println!("  f {f:.2}: sse {:.4}", r.sse);
+}
+
+/// The true effect scaled by `f` along its main parameter (`None` where that makes no valid
+/// effect, or the class has no profile).
+fn scaled(truth: &Effect, f: f64) -> Option<Effect> {
+    Some(match truth {
+        Effect::BacklashInertia { mass, damping } => Effect::BacklashInertia { mass: mass * f, damping: *damping },
+        Effect::GapWidth { relative_change } => Effect::GapWidth { relative_change: relative_change * f },
+        // the static excess over the sliding level scaled (f = 0.5: Coulomb friction; below,
+        // the breakaway would fall under the sliding level)
+        Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous } if f >= 0.5 => {
+            Effect::StribeckFriction {
+                state: *state,
+                level: *level,
+                static_level: level + (static_level - level) * (f - 0.5) * 2.0,
+                stribeck_velocity: *stribeck_velocity,
+                viscous: *viscous,
+            }
         }
+        Effect::CoulombFriction { state, level } => Effect::CoulombFriction { state: *state, level: level * f },
+        // the asymmetry scaled about the mean level (f = 0: Coulomb friction)
+        Effect::AsymmetricCoulomb { state, level_positive, level_negative } => {
+            let mean = 0.5 * (level_positive + level_negative);
+            Effect::AsymmetricCoulomb {
+                state: *state,
+                level_positive: mean + (level_positive - mean) * f,
+                level_negative: mean + (level_negative - mean) * f,
+            }
+        }
+        _ => return None,
+    })
+}
+
+/// The estimation SSE with the true effect scaled by each factor of a grid (`SUB=N` sub-steps,
+/// else enough for the plant's fastest mode, at most 8), the initial state refitted.
+fn print_profile(case: &Case, hold: InputHold) {
+    let sys = &case.nominal;
+    let rec = &case.recording;
+    let n = rec.len();
+    let w: Vec<f64> = rec.w.iter().flatten().copied().collect();
+    let y: Vec<f64> = rec.y.iter().flatten().copied().collect();
+    let k_est = (n as f64 * 0.7).round() as usize;
+    let mean = y.iter().sum::<f64>() / n as f64;
+    let sd = (y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
+    let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
+    let sub = std::env::var("SUB")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(((rec.dt * fast * 10.0).ceil() as usize).clamp(1, 8));
+    println!("substeps {sub}");
+    let maps = StepMaps::new(&sys.F(), &sys.B, &sys.E, rec.dt / sub as f64);
+    let sc = Scales {
+        y_range: vec![1.0],
+        w_range: vec![1.0],
+        w_absmax: 1.0,
+        tau_slow: 1.0,
+        dt: rec.dt,
+        duration: rec.duration(),
+        ..Default::default()
+    };
+    let truth = case.truth.clone().unwrap();
+    if scaled(&truth, 1.0).is_none() {
+        eprintln!("no profile for {truth:?}");
+        return;
+    }
+    let x0: Vec<f64> = sys.x0.iter().copied().collect();
+    let xs: Vec<f64> = x0.iter().map(|_| 0.1).collect();
+    for f in [0.0, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 1.8, 2.0, 2.5] {
+        let Some(e) = scaled(&truth, f) else { continue };
+        let pb = Problem {
+            sys,
+            fixed: vec![e],
+            parts: vec![],
+            scales: &sc,
+            w: &w,
+            y: &y,
+            m: 1,
+            p: 1,
+            dt: rec.dt,
+            k_est,
+            weights: vec![1.0 / sd],
+            maps: maps.clone(),
+            substeps: sub,
+            hold,
+            z0: None,
+            exclude: None,
+            refit: None,
+        };
+        let r = fit::fit(&pb, &x0, &xs, None, &FitSettings::default());
+        println!("  f {f:.2}: sse {:.4}", r.sse);
     }
 }

@@ -297,13 +297,7 @@ impl Controller {
                 if Cc.nrows() != m || Cc.ncols() != nc {
                     return Err(dim("Cc", format!("{m}x{nc} (m x nc: one row per plant input)"), Cc));
                 }
-                if x0.len() != nc {
-                    return Err(ModelError::Dimension {
-                        key: "controller.x0".into(),
-                        expected: format!("length nc = {nc}"),
-                        got: format!("length {}", x0.len()),
-                    });
-                }
+                ModelError::check_length("controller.x0", x0.len(), "nc", nc)?;
             }
         }
         Ok(())

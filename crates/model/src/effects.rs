@@ -178,9 +178,7 @@ impl Effect {
             names::SENSOR_OFFSET => {
                 check_keys(t, &prefix, "kind, offset")?;
                 let o = vec_at(t, &prefix, "offset")?;
-                if o.len() != p {
-                    return Err(ModelError::Dimension { key: key(&prefix, "offset"), expected: format!("length p = {p}"), got: format!("length {}", o.len()) });
-                }
+                ModelError::check_length(key(&prefix, "offset"), o.len(), "p", p)?;
                 Effect::SensorOffset { offset: o }
             }
             names::STRIBECK_FRICTION => {

@@ -55,6 +55,21 @@ pub enum ModelError {
     UnknownParameter { name: String, known: String },
 }
 
+impl ModelError {
+    /// `Ok` where a vector at `key` has the `expected` length `dim` (`dim` names it: `n`, `p`,
+    /// `nc`), else the [`ModelError::Dimension`] naming both lengths.
+    pub fn check_length(key: impl Into<String>, len: usize, dim: &str, expected: usize) -> Result<(), ModelError> {
+        if len == expected {
+            return Ok(());
+        }
+        Err(ModelError::Dimension {
+            key: key.into(),
+            expected: format!("length {dim} = {expected}"),
+            got: format!("length {len}"),
+        })
+    }
+}
+
 /// Longest text (a key, a path, a value) an error message echoes in full.
 pub const MAX_ECHO: usize = 200;
 

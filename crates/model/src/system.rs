@@ -259,20 +259,8 @@ fn initial_dimensions(
             got: format!("{}", input.m()),
         });
     }
-    if x0.len() != n {
-        return Err(ModelError::Dimension {
-            key: "initial.x0".into(),
-            expected: format!("length n = {n}"),
-            got: format!("length {}", x0.len()),
-        });
-    }
-    if z0.len() != p {
-        return Err(ModelError::Dimension {
-            key: "initial.z0".into(),
-            expected: format!("length p = {p}"),
-            got: format!("length {}", z0.len()),
-        });
-    }
+    ModelError::check_length("initial.x0", x0.len(), "n", n)?;
+    ModelError::check_length("initial.z0", z0.len(), "p", p)?;
     Ok(())
 }
 

@@ -100,7 +100,7 @@ pub(super) fn orbit(sys: &System, T: f64, K: usize) -> Option<EtaOrbit> {
     let cond_F = sv.max() / sv.min().max(1e-300);
     let Finv = F.clone().try_inverse();
     let Some(Finv) = Finv else { return Some(unverified(sys, T, K, "F is singular")) };
-    let Some(closed) = Closed::solve(sys, &F, &Finv, pieces) else {
+    let Some(closed) = Closed::solve(sys, F, &Finv, pieces) else {
         return Some(unverified(sys, T, K, "I - e^{TF} is singular"));
     };
     let h = T / K as f64;
@@ -138,7 +138,7 @@ struct Closed<'s> {
 impl<'s> Closed<'s> {
     /// Solves for the periodic start `(I - Phi) xi = c` over the pieces; `None` where `I - Phi`
     /// is singular.
-    fn solve(sys: &'s System, F: &DMatrix<f64>, Finv: &DMatrix<f64>, pieces: Vec<Piece>) -> Option<Self> {
+    fn solve(sys: &'s System, F: DMatrix<f64>, Finv: &DMatrix<f64>, pieces: Vec<Piece>) -> Option<Self> {
         let n = sys.n();
         let B = &sys.B;
         // particular solutions and the composed step map
@@ -151,7 +151,7 @@ impl<'s> Closed<'s> {
         for p in &pieces {
             let b = -(Finv * (B * &p.r));
             let a = Finv * (&b - B * &p.u);
-            let (E, e) = expm_enclosure(&(F * p.len));
+            let (E, e) = expm_enclosure(&(&F * p.len));
             exp_err = exp_err.max(e / frobenius_up(&E).max(1e-300));
             // xi_{j+1} = E xi_j + (a + L b - E a)
             c = &E * &c + (&a + &b * p.len - &E * &a);
@@ -172,8 +172,8 @@ impl<'s> Closed<'s> {
             xi = &alpha[j] + &beta[j] * p.len + &steps[j] * (&xi - &alpha[j]);
         }
         let C = &sys.C;
-        let CF = C * F;
-        Some(Closed { C, F: F.clone(), CF, pieces, alpha, beta, starts, exp_err, cond_P })
+        let CF = C * &F;
+        Some(Closed { C, F, CF, pieces, alpha, beta, starts, exp_err, cond_P })
     }
 
     /// `(eta_T, eta_T', relative error of e^{sF})` at `s` into piece `j`.

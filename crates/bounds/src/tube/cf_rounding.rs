@@ -3,6 +3,7 @@
 //! ([`cf_support_error`]). Used by the paper's diameter `D(C(F Xi_inf + E Theta),{0})`
 //! ([`crate::tube::diameters`]) and by the pinned speed and engaged history beyond the paper
 //! ([`crate::beyond_paper::engaged_speed`]).
+use crate::tube::xi_support::perturbed_integral_excess;
 use crate::tube::SemigroupData;
 use dynamics::linear::expm::frobenius_up;
 use nalgebra::DMatrix;
@@ -34,6 +35,6 @@ pub fn cf_support_error(
 ) -> f64 {
     let Some(b) = sg.exp_norm() else { return f64::INFINITY };
     let i = b.integral;
-    let i_exact = if f_radius * i < 0.5 { i + f_radius * i * i / (1.0 - f_radius * i) } else { f64::INFINITY };
+    let i_exact = i + perturbed_integral_excess(i, f_radius);
     pad_up(d_theta * cf_error(C, F, f_radius) * frobenius_up(E) * i_exact * (1.0 + 1e-10), PAD)
 }

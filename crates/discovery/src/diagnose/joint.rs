@@ -209,7 +209,7 @@ pub fn diagnose_recordings(
     };
     // 5. The selected model fitted on every recording, checked on those validated on.
     let adopted = best.and_then(|(ci, _)| {
-        adopt(&data, &all, n_fit, &cands[ci], &base, free.as_ref(), &units, s, &mut notes).map(|(sh, j)| (ci, sh, j))
+        adopt(&data, &all, &fit_idx, &cands[ci], &base, free.as_ref(), &units, s, &mut notes).map(|(sh, j)| (ci, sh, j))
     });
     let selected = adopted.as_ref().map(|a| a.0);
     let (final_cand, final_shared, final_judged): (&Candidate, Shared, &[Judged]) = match &adopted {
@@ -252,15 +252,15 @@ pub fn diagnose_recordings(
     })
 }
 
-/// Candidate `cand` fitted on the first `n_fit` recordings of `all` (the one recording's own
-/// estimate where there is one) and judged on each: its shared parameters and judgements where
-/// it worsens none of the recordings validated on (those after `n_fit`), else `None` with a
-/// note naming the recordings it worsens.
+/// Candidate `cand` fitted on the recordings `fit_idx` (the first of `all`; the one
+/// recording's own estimate where there is one) and judged on each: its shared parameters and
+/// judgements where it worsens none of the recordings validated on (those after them), else
+/// `None` with a note naming the recordings it worsens.
 #[allow(clippy::too_many_arguments)]
 fn adopt(
     data: &[Rec],
     all: &[&Recording],
-    n_fit: usize,
+    fit_idx: &[usize],
     cand: &Candidate,
     base: &[Judged],
     free: Option<&FreeNominal>,
@@ -268,8 +268,8 @@ fn adopt(
     s: &DiagnoseSettings,
     notes: &mut Vec<String>,
 ) -> Option<(Shared, Vec<Judged>)> {
-    let fit_idx: Vec<usize> = (0..n_fit).collect();
-    let sh = if n_fit >= 2 { fit_on(data, &fit_idx, cand, base, free, s) } else { cand.start.clone() };
+    let n_fit = fit_idx.len();
+    let sh = if n_fit >= 2 { fit_on(data, fit_idx, cand, base, free, s) } else { cand.start.clone() };
     let judged: Vec<Judged> = data.iter().enumerate().map(|(j, d)| judge(d, cand, &sh, &base[j].x0, free, s)).collect();
     let worse: Vec<usize> = (n_fit..all.len()).filter(|&j| judged[j].ms > base[j].ms).collect();
     if worse.is_empty() {

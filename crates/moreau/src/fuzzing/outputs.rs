@@ -117,12 +117,7 @@ pub fn write_output(data: &[u8]) {
         return write_dev_null(Path::new("/dev/null"), content);
     }
     let Ok(root) = super::scratch() else { return };
-    let scene =
-        Scene { fx: root.path().join("fx"), d: root.path().join("d"), target: PathBuf::new(), real: PathBuf::new() };
-    if std::fs::create_dir(&scene.fx).is_err() || std::fs::create_dir(&scene.d).is_err() {
-        return;
-    }
-    let scene = Scene { target: scene.d.join(file_name(name)), real: scene.fx.join("real"), ..scene };
+    let Some(scene) = Scene::make(root.path(), name) else { return };
     let Some(held) = scene.arrange(kind) else {
         forget_inputs();
         return; // e.g. a socket path longer than sun_path, or no mkfifo here
@@ -154,6 +149,16 @@ struct Held {
 }
 
 impl Scene {
+    /// The layout under `root` with its two directories made (`None` where they cannot be),
+    /// the target named by the fuzz bytes `name` ([`file_name`]).
+    fn make(root: &Path, name: &[u8]) -> Option<Self> {
+        let (fx, d) = (root.join("fx"), root.join("d"));
+        if std::fs::create_dir(&fx).is_err() || std::fs::create_dir(&d).is_err() {
+            return None;
+        }
+        Some(Scene { target: d.join(file_name(name)), real: fx.join("real"), fx, d })
+    }
+
     /// Puts a target of `kind` in place; `None` where the system refuses it.
     fn arrange(&self, kind: Kind) -> Option<Held> {
         let (fx, target, real) = (&self.fx, &self.target, &self.real);

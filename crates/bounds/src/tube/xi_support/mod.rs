@@ -21,7 +21,9 @@ pub mod semigroup;
 mod tests;
 pub mod theta_support;
 
-pub use semigroup::{dxx_bound, exp_norm_bounds, exp_norm_integral, ExpNormBounds, SemigroupData};
+pub use semigroup::{
+    dxx_bound, exp_norm_bounds, exp_norm_integral, perturbed_integral_excess, ExpNormBounds, SemigroupData,
+};
 pub use theta_support::ThetaSupport;
 
 use crate::error::BoundsError;
@@ -193,7 +195,7 @@ impl TubeKernel {
         let LF = L * F;
         let LF2 = &LF * F;
         let tol = settings.tol_abs;
-        let Reach { s_max, tail_unit, msup, i_inf } = Self::reach(L, F, E, d_theta, sg, horizon, tol)?;
+        let Reach { s_max, tail_unit, msup, i_inf } = Self::reach(L, F, (nL, nE), d_theta, sg, horizon, tol)?;
         let f_term = Self::f_rounding_term(settings.f_radius, i_inf, horizon, msup, d_theta * nL * nE);
         // Cell widths: graded as h(s) = h0 e^{grade s} (the remainder per cell decays like
         // e^{mu s} h^3), capped at 1 / ||F||; h0 shrinks (remainder ~ h0^2) until the summed
@@ -250,19 +252,18 @@ impl TubeKernel {
         }
     }
 
-    /// Proven semigroup bounds over the horizon: its length `s_max` (for an infinite horizon,
+    /// Proven semigroup bounds over the horizon (`nL`, `nE` the Frobenius norms of `L`, `E`): its length `s_max` (for an infinite horizon,
     /// grown until the tail beyond it, `tail_unit`, is below `tol / 2`), `sup ||e^{sF}||` on it
     /// and `int_0^inf ||e^{sF}||` when `F` is Hurwitz.
     fn reach(
         L: &DMatrix<f64>,
         F: &DMatrix<f64>,
-        E: &DMatrix<f64>,
+        (nL, nE): (f64, f64),
         d_theta: f64,
         sg: &SemigroupData,
         horizon: Horizon,
         tol: f64,
     ) -> Result<Reach, BoundsError> {
-        let (nE, nL) = (frob(E), frob(L));
         Ok(match horizon {
             Horizon::Finite(t) => {
                 if !(t >= 0.0 && t.is_finite()) {
@@ -305,10 +306,7 @@ impl TubeKernel {
         if eps == 0.0 {
             return 0.0;
         }
-        let via_integral = match i_inf {
-            Some(i) if eps * i < 0.5 => eps * i * i / (1.0 - eps * i),
-            _ => f64::INFINITY,
-        };
+        let via_integral = i_inf.map_or(f64::INFINITY, |i| perturbed_integral_excess(i, eps));
         let via_gronwall = match horizon {
             Horizon::Finite(t) => 0.5 * t * t * msup * msup * eps * (msup * eps * t).exp(),
             Horizon::Infinite => f64::INFINITY,

@@ -253,6 +253,17 @@ pub fn dxx_bound(F: &DMatrix<f64>, E: &DMatrix<f64>, theta: &Shape, t: f64) -> R
     Ok(theta.deviation_from_origin().upper * frob(E) * (frob(&X) + err) * b.integral * (1.0 + 1e-10))
 }
 
+/// How much `int_0^inf ||e^{s F_exact}||` can exceed the proven integral `I` of the computed
+/// `F` when `||F_exact - F|| <= eps`: `eps I^2 / (1 - eps I)` (the perturbation series of the
+/// resolvent); `+inf` where `eps I >= 1/2`.
+pub fn perturbed_integral_excess(integral: f64, eps: f64) -> f64 {
+    if eps * integral < 0.5 {
+        eps * integral * integral / (1.0 - eps * integral)
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// What every kernel with the same `F` (resp. the same `Theta`) computes first: the spectral
 /// abscissa of `F`, its proven semigroup bounds ([`exp_norm_bounds`]) and `D(Theta, {0})` from
 /// above. Computed once by a caller that builds several kernels (the Theorem 2 and Lemma 2
