@@ -263,7 +263,7 @@ fn main() {
 
 /// Per-case times over the generator's classes and profiles (and, with the `hypotheses` section, binned by the single hypotheses fitted).
 fn print_cases(a: &Args, max_threads: usize) {
-    let runs = run_cases(&a, max_threads);
+    let runs = run_cases(a, max_threads);
     println!(
         "\n## Generator cases (seed {}, {} per class and profile, {max_threads} threads; load after: {})",
         a.seed,

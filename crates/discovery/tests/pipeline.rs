@@ -67,7 +67,7 @@ fn every_effect_at_zero_equals_the_nominal_model() {
         Effect::Cogging { state: 1, position_state: 0, amplitude: 0.0, period: 0.2, phase: 0.5 },
     ];
     for e in zeros {
-        let y = ExtendedModel::new(sys, &[e.clone()], dt, 2).unwrap().simulate(&w, dt, &x0).y;
+        let y = ExtendedModel::new(sys, std::slice::from_ref(&e), dt, 2).unwrap().simulate(&w, dt, &x0).y;
         let d = y.iter().zip(&nominal).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(d < 1e-12, "{e:?} at zero differs by {d}");
     }

@@ -140,6 +140,6 @@ fn the_closed_loop_decay_rate_is_that_of_the_simulation() {
     let hot = model::parse_str(&model_text(1, dt, 0.0).replace("kv = 300", "kv = 3000")).unwrap();
     assert!(dynamics::extended::closed_loop_mu(&hot).unwrap() > 0.0);
     // no controller: none
-    let plain = model::parse_str(&model_text(1, dt, 0.0).split("[controller]").next().unwrap()).unwrap();
+    let plain = model::parse_str(model_text(1, dt, 0.0).split("[controller]").next().unwrap()).unwrap();
     assert!(dynamics::extended::closed_loop_mu(&plain).is_none());
 }

@@ -56,6 +56,8 @@ fn pp_holds(px: &[f64], py: &[f64], x: &[f64], y: &[f64]) -> Result<(), TestCase
 
 /// Variational inequality characterising `P_S(x)`: `(x - P x)^T (s - P x) <= 0` for all
 /// `s in S`, checked at support points in many directions.
+// 0.7853 is near pi/4 on purpose: exact multiples of pi/4 would repeat eight directions.
+#[allow(clippy::approx_constant)]
 fn vi_holds(s: &Shape, x: &[f64], px: &[f64]) -> Result<(), TestCaseError> {
     let p = s.dim();
     let r: Vec<f64> = (0..p).map(|i| x[i] - px[i]).collect();

@@ -295,7 +295,7 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
             }
             let input = Input::from_csv(&dir.join(file), period, hold)?;
             if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
-                crate::input::check_period(per, t, &file)?;
+                crate::input::check_period(per, t, file)?;
             }
             input
         }

@@ -89,8 +89,11 @@ pub const MAX_EXPRESSION_BYTES: usize = 500;
 /// Names an expression cannot use for a parameter: the constants.
 const RESERVED: &[&str] = &["pi"];
 
+/// A function of one argument an expression may call.
+pub type UnaryFn = fn(f64) -> f64;
+
 /// The functions of one argument an expression may call.
-pub const FUNCTIONS: &[(&str, fn(f64) -> f64)] = &[
+pub const FUNCTIONS: &[(&str, UnaryFn)] = &[
     ("sqrt", f64::sqrt),
     ("exp", f64::exp),
     ("ln", f64::ln),

@@ -171,6 +171,7 @@ fn huge_names_and_keys_are_refused_in_a_short_message() {
 /// was found and what is expected; the exact headers and a period of one sample step beyond
 /// the data stay accepted (controls).
 #[test]
+#[allow(clippy::approx_constant)] // 6.28 is the data's span (100 steps of 0.0628), not 2 pi
 fn csv_inputs_need_the_exact_header_and_a_period_the_data_cover() {
     let d = tempfile::tempdir().unwrap();
     let e = csv_model(d.path(), "t,wfoo\n0,0\n1,1\n", None).unwrap_err().to_string();

@@ -17,7 +17,7 @@ fn mat_v5(vars: &[(&str, usize, usize, Vec<f64>)]) -> Vec<u8> {
     out.extend(0x0100u16.to_le_bytes());
     out.extend(b"IM");
     let pad8 = |v: &mut Vec<u8>| {
-        while v.len() % 8 != 0 {
+        while !v.len().is_multiple_of(8) {
             v.push(0)
         }
     };

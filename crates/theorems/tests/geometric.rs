@@ -116,7 +116,7 @@ fn psi0_claim_is_nearly_tight() {
         }
     }
     eprintln!("psi0: {positive} cases with alpha > 0, min beta / (alpha lambda) = {ratio:.4}");
-    assert!(positive > 100 && ratio >= 1.0 - 1e-9 && ratio < 4.0, "{positive} {ratio}");
+    assert!(positive > 100 && (1.0 - 1e-9..4.0).contains(&ratio), "{positive} {ratio}");
 }
 
 /// Lemma A2 is tight on balls: the minimum slack over balls is ~0, so a constant even 1%

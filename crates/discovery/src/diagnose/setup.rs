@@ -208,7 +208,7 @@ impl<'a> Setup<'a> {
             let o = ext.simulate_from(&self.w, dt, x0, self.z0.as_deref());
             o.finite.then_some(o.y)
         };
-        let chk = discretisation::converge(&sim, k_from, self.max_sub, &self.weights, self.tol);
+        let chk = discretisation::converge(sim, k_from, self.max_sub, &self.weights, self.tol);
         if chk.converged && chk.error_rms <= self.noise_w {
             return chk;
         }
@@ -223,7 +223,7 @@ impl<'a> Setup<'a> {
         if cap <= chk.substeps {
             return chk;
         }
-        let mut more = discretisation::converge(&sim, chk.substeps, cap, &self.weights, tol);
+        let mut more = discretisation::converge(sim, chk.substeps, cap, &self.weights, tol);
         let mut ladder = chk.ladder;
         ladder.extend(more.ladder.into_iter().skip(1));
         more.ladder = ladder;

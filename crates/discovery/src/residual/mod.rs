@@ -198,16 +198,16 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let e: Vec<f64> = (0..4000).map(|_| rng.random::<f64>() - 0.5).collect();
         let u: Vec<f64> = (0..4000).map(|k| (k as f64 * 0.05).sin()).collect();
-        let t = test(&e, &[u.clone()], 20, 1);
+        let t = test(&e, std::slice::from_ref(&u), 20, 1);
         assert!(t.white && t.uncorrelated, "{t:?}");
         // Negative controls: coloured residual, residual driven by the input.
         let mut f = vec![0.0; e.len()];
         for k in 1..e.len() {
             f[k] = 0.8 * f[k - 1] + e[k];
         }
-        assert!(!test(&f, &[u.clone()], 20, 1).white);
+        assert!(!test(&f, std::slice::from_ref(&u), 20, 1).white);
         let g: Vec<f64> = e.iter().zip(&u).map(|(a, b)| a + 0.3 * b).collect();
-        assert!(!test(&g, &[u.clone()], 20, 1).uncorrelated);
+        assert!(!test(&g, std::slice::from_ref(&u), 20, 1).uncorrelated);
         // A constant offset passes the centred tests but not the mean test.
         let o: Vec<f64> = e.iter().map(|a| a + 0.05).collect();
         let t = test(&o, &[u], 20, 1);

@@ -431,7 +431,7 @@ impl Selector<'_, '_> {
         let e: Vec<f64> = ctx.y.iter().zip(&sim.y).map(|(a, b)| a - b).collect();
         let test = |e: &[f64]| crate::residual::test_outputs(e, &ctx.w, ctx.n, ctx.m, ctx.p, lags, step).white;
         let (filtered, rho) = crate::residual::prewhiten_ar1(&e, ctx.n, ctx.p);
-        (!test(&e) && !(colour_exempt && test(&filtered)))
+        (!test(&e) && (!colour_exempt || !test(&filtered)))
             || crate::residual::mean_off_zero(&e, ctx.n, ctx.p, &rho, step)
     }
 

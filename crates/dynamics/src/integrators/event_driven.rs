@@ -149,7 +149,7 @@ impl<'a> Ev<'a> {
     fn w(&self, t: f64) -> DVector<f64> {
         &self.a * (self.omega * t + self.phase).sin()
     }
-    fn split<'b>(&self, s: &'b DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+    fn split(&self, s: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
         (s.rows(0, self.n).into_owned(), s.rows(self.n, self.p).into_owned())
     }
     /// `y' = C (A x + B w + E z)`.

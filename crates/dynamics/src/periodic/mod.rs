@@ -1,6 +1,7 @@
 //! The periodic regime for a `T`-periodic input.
 //! - [`poincare`]: fixed point of the Poincare map of the catching-up scheme, its residual.
 //! - [`linearised`]: `xi_T`, `eta_T = C xi_T` of the linearised system, eqs. (xT), (xiT), (etaT).
+//!
 //! (The check that the periodic state lies in the set (loc) uses the certified tube of
 //! `bounds::tube::localisation`.)
 pub mod linearised;

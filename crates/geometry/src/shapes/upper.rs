@@ -252,7 +252,7 @@ mod tests {
         let u = [0.3, 0.7];
         let rn = vec![1.0; 4];
         let b = polytope_support_upper(&normals, &rn, &offsets, &[1.0, 1.0], dev, &u);
-        assert!(b >= 1.0 && b <= 1.0 + 1e-14, "{b}");
+        assert!((1.0..=1.0 + 1e-14).contains(&b), "{b}");
         // A vertex that is not the maximiser: still an upper bound.
         let w = polytope_support_upper(&normals, &rn, &offsets, &[1.0, -1.0], dev, &u);
         assert!(w >= 1.0, "{w}");

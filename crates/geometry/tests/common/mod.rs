@@ -151,5 +151,5 @@ where
         cfg,
         proptest::test_runner::TestRng::deterministic_rng(proptest::test_runner::RngAlgorithm::ChaCha),
     );
-    runner.run(&strategy, |v| prop(v)).is_err()
+    runner.run(&strategy, prop).is_err()
 }

@@ -75,7 +75,7 @@ fn thinned(steps: usize, every: usize, max_rows: usize) -> String {
     let digits = steps.to_string();
     let mut grouped = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             grouped.push(',');
         }
         grouped.push(c);
