@@ -128,6 +128,63 @@ fn positive(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
     Ok(v)
 }
 
+/// A backlash's `location`: `"loop"` (the default) or `"input"`.
+fn play_location(t: &Table, prefix: &str) -> Result<PlayLocation, ModelError> {
+    match t.get("location").map(|l| l.as_str()) {
+        None | Some(Some("loop")) => Ok(PlayLocation::Loop),
+        Some(Some("input")) => Ok(PlayLocation::Input),
+        Some(_) => Err(ModelError::WrongType {
+            key: key(prefix, "location"),
+            expected: "\"loop\" or \"input\"",
+            found: describe(&t["location"]),
+        }),
+    }
+}
+
+/// A `stribeck_friction` table: the breakaway level is never below the sliding level, the
+/// viscous term is optional (0).
+fn stribeck(t: &Table, prefix: &str, n: usize) -> Result<Effect, ModelError> {
+    check_keys(t, prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
+    let state = state_index(t, prefix, n)?;
+    let level = nonneg(t, prefix, "level")?;
+    let static_level = nonneg(t, prefix, "static_level")?;
+    if static_level < level {
+        return Err(ModelError::Invalid {
+            key: key(prefix, "static_level"),
+            value: static_level,
+            reason: format!(
+                "must be at least `level` = {level} (the breakaway level is never below the sliding level)"
+            ),
+        });
+    }
+    let stribeck_velocity = positive(t, prefix, "stribeck_velocity")?;
+    let viscous = if opt_f64(t, prefix, "viscous")?.is_some() { nonneg(t, prefix, "viscous")? } else { 0.0 };
+    Ok(Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous })
+}
+
+/// A `cogging` table: the force acts on velocity state `state`, its period is in another state.
+fn cogging(t: &Table, prefix: &str, n: usize) -> Result<Effect, ModelError> {
+    check_keys(t, prefix, "kind, state, position_state, amplitude, period, phase")?;
+    let state = state_index(t, prefix, n)?;
+    let position_state = index_at(t, prefix, "position_state", n)?;
+    if position_state == state {
+        return Err(ModelError::Invalid {
+            key: key(prefix, "position_state"),
+            value: position_state as f64,
+            reason: format!(
+                "must differ from `state` = {state} (the force acts on the velocity, the period is in the position)"
+            ),
+        });
+    }
+    Ok(Effect::Cogging {
+        state,
+        position_state,
+        amplitude: f64_at(t, prefix, "amplitude")?,
+        period: positive(t, prefix, "period")?,
+        phase: opt_f64(t, prefix, "phase")?.unwrap_or(0.0),
+    })
+}
+
 impl Effect {
     /// One `[[effects]]` table at key `prefix` (e.g. `effects[2]`), checked.
     fn parse_one(t: &Table, prefix: &str, n: usize, p: usize) -> Result<Self, ModelError> {
@@ -136,12 +193,7 @@ impl Effect {
         let e = match kind {
             names::BACKLASH => {
                 check_keys(t, &prefix, "kind, width, location")?;
-                let location = match t.get("location").map(|l| l.as_str()) {
-                    None | Some(Some("loop")) => PlayLocation::Loop,
-                    Some(Some("input")) => PlayLocation::Input,
-                    Some(_) => return Err(ModelError::WrongType { key: key(&prefix, "location"), expected: "\"loop\" or \"input\"", found: describe(&t["location"]) }),
-                };
-                Effect::Backlash { width: nonneg(t, &prefix, "width")?, location }
+                Effect::Backlash { width: nonneg(t, &prefix, "width")?, location: play_location(t, &prefix)? }
             }
             names::GAP_WIDTH => {
                 check_keys(t, &prefix, "kind, relative_change")?;
@@ -169,11 +221,7 @@ impl Effect {
             }
             names::INPUT_SATURATION => {
                 check_keys(t, &prefix, "kind, limit")?;
-                let l = f64_at(t, &prefix, "limit")?;
-                if l <= 0.0 {
-                    return Err(ModelError::OutOfRange { key: key(&prefix, "limit"), value: l, reason: "must be positive" });
-                }
-                Effect::InputSaturation { limit: l }
+                Effect::InputSaturation { limit: positive(t, &prefix, "limit")? }
             }
             names::SENSOR_OFFSET => {
                 check_keys(t, &prefix, "kind, offset")?;
@@ -181,28 +229,7 @@ impl Effect {
                 ModelError::check_length(key(&prefix, "offset"), o.len(), "p", p)?;
                 Effect::SensorOffset { offset: o }
             }
-            names::STRIBECK_FRICTION => {
-                check_keys(t, &prefix, "kind, state, level, static_level, stribeck_velocity, viscous")?;
-                let state = state_index(t, &prefix, n)?;
-                let level = nonneg(t, &prefix, "level")?;
-                let static_level = nonneg(t, &prefix, "static_level")?;
-                if static_level < level {
-                    return Err(ModelError::Invalid {
-                        key: key(&prefix, "static_level"),
-                        value: static_level,
-                        reason: format!("must be at least `level` = {level} (the breakaway level is never below the sliding level)"),
-                    });
-                }
-                let stribeck_velocity = positive(t, &prefix, "stribeck_velocity")?;
-                let viscous = match opt_f64(t, &prefix, "viscous")? {
-                    None => 0.0,
-                    Some(v) if v < 0.0 => {
-                        return Err(ModelError::OutOfRange { key: key(&prefix, "viscous"), value: v, reason: "must be non-negative" })
-                    }
-                    Some(v) => v,
-                };
-                Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous }
-            }
+            names::STRIBECK_FRICTION => stribeck(t, &prefix, n)?,
             names::ASYMMETRIC_COULOMB => {
                 check_keys(t, &prefix, "kind, state, level_positive, level_negative")?;
                 Effect::AsymmetricCoulomb {
@@ -211,25 +238,7 @@ impl Effect {
                     level_negative: nonneg(t, &prefix, "level_negative")?,
                 }
             }
-            names::COGGING => {
-                check_keys(t, &prefix, "kind, state, position_state, amplitude, period, phase")?;
-                let state = state_index(t, &prefix, n)?;
-                let position_state = index_at(t, &prefix, "position_state", n)?;
-                if position_state == state {
-                    return Err(ModelError::Invalid {
-                        key: key(&prefix, "position_state"),
-                        value: position_state as f64,
-                        reason: format!("must differ from `state` = {state} (the force acts on the velocity, the period is in the position)"),
-                    });
-                }
-                Effect::Cogging {
-                    state,
-                    position_state,
-                    amplitude: f64_at(t, &prefix, "amplitude")?,
-                    period: positive(t, &prefix, "period")?,
-                    phase: opt_f64(t, &prefix, "phase")?.unwrap_or(0.0),
-                }
-            }
+            names::COGGING => cogging(t, &prefix, n)?,
             names::LOAD_FRICTION => {
                 check_keys(t, &prefix, "kind, state, level, load_coefficient")?;
                 Effect::LoadFriction {
