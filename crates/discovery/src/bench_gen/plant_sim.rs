@@ -219,40 +219,92 @@ fn simulate_fine(
     drive: Drive,
     fine: usize,
 ) -> Vec<f64> {
-    let n = pl.A.nrows();
-    let h = dt / fine as f64;
-    let Truth { hw, delay, sat, force, fric, tau, offset, lib, cog } = Truth::of(hw, effs);
-    let input = |t: f64| drive_at(sig, drive, dt, t - delay).clamp(-sat, sat);
-    let cy = |x: &[f64]| (0..n).map(|j| pl.C[(0, j)] * x[j]).sum::<f64>();
-    let deriv = |x: &[f64], w: f64, z: f64, out: &mut [f64]| {
-        for i in 0..n {
-            out[i] = (0..n).map(|j| pl.A[(i, j)] * x[j]).sum::<f64>() + pl.B[(i, 0)] * w + pl.E[(i, 0)] * z;
-        }
-        out[pl.vel] += force;
-        if let Some((a, k, ph, ip)) = cog {
-            out[pl.vel] += a * (k * x[ip] + ph).sin();
-        }
-    };
-    let mut x = x0.to_vec();
-    let mut z = cy(&x);
-    let mut vz = 0.0;
-    let (mut k1, mut xm, mut k2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let run = Fine::new(pl, Truth::of(hw, effs), sig, drive, dt, fine);
+    let mut s = FineState::start(x0, run.cy(x0));
     let mut out = Vec::with_capacity(ns);
     for k in 0..ns {
-        out.push(cy(&x) + offset);
+        out.push(run.cy(&s.x) + run.truth.offset);
         if k + 1 == ns {
             break;
         }
-        // The fine grid of this sample interval, with the delayed held input's switching
-        // instant added where it falls between grid points (the midpoint rule then sees a
-        // constant input on every piece: the delay is integrated exactly, not rounded to h).
-        let t_k = k as f64 * dt;
-        let mut pieces: Vec<(f64, f64)> = (0..fine).map(|jf| (t_k + jf as f64 * h, h)).collect();
-        // (A delayed linear hold has a kink there: split too, so each piece sees a line.)
-        let split = drive != Drive::Continuous && delay > 0.0;
+        for (t, h) in run.pieces(k) {
+            run.step(&mut s, t, h);
+        }
+    }
+    out
+}
+
+/// One run of [`simulate_fine`]: the plant, the truth's effects and the input the plant sees.
+struct Fine<'a> {
+    pl: &'a Plant,
+    truth: Truth,
+    sig: &'a Signal,
+    drive: Drive,
+    dt: f64,
+    fine: usize,
+    /// The fine step `dt / fine`.
+    h: f64,
+    /// A delayed held input: its switching instant splits a fine step.
+    split: bool,
+    zoh: bool,
+}
+
+/// The state [`Fine::step`] advances: the plant's `x`, the play's `z` and, with backlash
+/// inertia, the play's speed `vz`; the stage buffers of the midpoint rule.
+struct FineState {
+    x: Vec<f64>,
+    z: f64,
+    vz: f64,
+    k1: Vec<f64>,
+    xm: Vec<f64>,
+    k2: Vec<f64>,
+}
+
+impl FineState {
+    fn start(x0: &[f64], z0: f64) -> Self {
+        let n = x0.len();
+        FineState { x: x0.to_vec(), z: z0, vz: 0.0, k1: vec![0.0; n], xm: vec![0.0; n], k2: vec![0.0; n] }
+    }
+}
+
+impl<'a> Fine<'a> {
+    fn new(pl: &'a Plant, truth: Truth, sig: &'a Signal, drive: Drive, dt: f64, fine: usize) -> Self {
+        let split = drive != Drive::Continuous && truth.delay > 0.0;
         let zoh = drive == Drive::Held(InputHold::Zoh);
-        if split {
-            let off = (delay / dt).fract() * dt;
+        Fine { pl, truth, sig, drive, dt, fine, h: dt / fine as f64, split, zoh }
+    }
+
+    /// The input the plant sees at `t`: delayed, held as the drive says, saturated.
+    fn input(&self, t: f64) -> f64 {
+        drive_at(self.sig, self.drive, self.dt, t - self.truth.delay).clamp(-self.truth.sat, self.truth.sat)
+    }
+
+    fn cy(&self, x: &[f64]) -> f64 {
+        (0..x.len()).map(|j| self.pl.C[(0, j)] * x[j]).sum::<f64>()
+    }
+
+    /// `x' = A x + B w + E z`, the constant force and the cogging force on the velocity.
+    fn deriv(&self, x: &[f64], w: f64, z: f64, out: &mut [f64]) {
+        let (pl, n) = (self.pl, x.len());
+        for i in 0..n {
+            out[i] = (0..n).map(|j| pl.A[(i, j)] * x[j]).sum::<f64>() + pl.B[(i, 0)] * w + pl.E[(i, 0)] * z;
+        }
+        out[pl.vel] += self.truth.force;
+        if let Some((a, k, ph, ip)) = self.truth.cog {
+            out[pl.vel] += a * (k * x[ip] + ph).sin();
+        }
+    }
+
+    /// The fine grid of sample interval `k`, with the delayed held input's switching instant
+    /// added where it falls between grid points (the midpoint rule then sees a constant input
+    /// on every piece: the delay is integrated exactly, not rounded to h; a delayed linear hold
+    /// has a kink there: split too, so each piece sees a line).
+    fn pieces(&self, k: usize) -> Vec<(f64, f64)> {
+        let (fine, h) = (self.fine, self.h);
+        let t_k = k as f64 * self.dt;
+        let mut pieces: Vec<(f64, f64)> = (0..fine).map(|jf| (t_k + jf as f64 * h, h)).collect();
+        if self.split {
+            let off = (self.truth.delay / self.dt).fract() * self.dt;
             let j = ((off / h).floor() as usize).min(fine - 1);
             let a = off - j as f64 * h;
             if a > 1e-9 * h && a < h * (1.0 - 1e-9) {
@@ -260,61 +312,77 @@ fn simulate_fine(
                 pieces.splice(j..=j, [(t, a), (t + a, h - a)]);
             }
         }
-        for (t, h) in pieces {
-            // Held and delayed: the input is constant on each piece (its midpoint's value).
-            let u1 = if split && zoh { input(t + 0.5 * h) } else { input(t) };
-            deriv(&x, u1, z, &mut k1);
-            for i in 0..n {
-                xm[i] = x[i] + 0.5 * h * k1[i];
-            }
-            deriv(&xm, input(t + 0.5 * h), z, &mut k2);
-            let v_old = x[pl.vel];
-            for i in 0..n {
-                x[i] += h * k2[i];
-            }
-            if fric > 0.0 {
-                let v_free = x[pl.vel];
-                let dv = fric * h;
-                x[pl.vel] = if v_free.abs() <= dv && (v_old.abs() <= dv || v_old * v_free <= 0.0 || v_free.abs() <= dv)
-                {
-                    0.0
-                } else {
-                    v_free - dv * v_free.signum()
-                };
-            }
-            if let Some((up, down, excess, vs)) = lib {
-                // Stick unless the friction-free velocity change beats the static level (at
-                // rest or reversing within the step) or the Stribeck level at the old speed.
-                let v_free = x[pl.vel];
-                let dir = v_free.signum();
-                let base = if dir > 0.0 { up } else { down };
-                let level = if v_old == 0.0 || v_old * v_free <= 0.0 {
-                    base + excess
-                } else {
-                    base + excess * (-(v_old / vs).powi(2)).exp()
-                };
-                let dv = level * h;
-                x[pl.vel] = if v_free.abs() <= dv { 0.0 } else { v_free - dv * dir };
-            }
-            let y = cy(&x);
-            if hw > 0.0 {
-                if tau > 0.0 {
-                    vz -= h * vz / tau;
-                    let zp = z + h * vz;
-                    let zn = zp.clamp(y - hw, y + hw);
-                    if zn != zp {
-                        vz = (zn - z) / h;
-                    }
-                    z = zn;
-                } else {
-                    z = z.clamp(y - hw, y + hw);
-                }
+        pieces
+    }
+
+    /// One piece `[t, t + h]`: the midpoint rule on the linear part and the forces, then the
+    /// friction laws, then the play.
+    fn step(&self, s: &mut FineState, t: f64, h: f64) {
+        let (n, vel) = (s.x.len(), self.pl.vel);
+        // Held and delayed: the input is constant on each piece (its midpoint's value).
+        let u1 = if self.split && self.zoh { self.input(t + 0.5 * h) } else { self.input(t) };
+        self.deriv(&s.x, u1, s.z, &mut s.k1);
+        for i in 0..n {
+            s.xm[i] = s.x[i] + 0.5 * h * s.k1[i];
+        }
+        self.deriv(&s.xm, self.input(t + 0.5 * h), s.z, &mut s.k2);
+        let v_old = s.x[vel];
+        for i in 0..n {
+            s.x[i] += h * s.k2[i];
+        }
+        s.x[vel] = self.friction(v_old, s.x[vel], h);
+        self.play(s, h);
+    }
+
+    /// The velocity after Coulomb friction and the friction library over a step of `h`, from
+    /// the friction-free velocity `v_free` and the velocity `v_old` at the step's start.
+    fn friction(&self, v_old: f64, mut v_free: f64, h: f64) -> f64 {
+        let truth = &self.truth;
+        if truth.fric > 0.0 {
+            let dv = truth.fric * h;
+            v_free = if v_free.abs() <= dv && (v_old.abs() <= dv || v_old * v_free <= 0.0 || v_free.abs() <= dv) {
+                0.0
             } else {
-                z = y;
+                v_free - dv * v_free.signum()
+            };
+        }
+        if let Some((up, down, excess, vs)) = truth.lib {
+            // Stick unless the friction-free velocity change beats the static level (at rest
+            // or reversing within the step) or the Stribeck level at the old speed.
+            let dir = v_free.signum();
+            let base = if dir > 0.0 { up } else { down };
+            let level = if v_old == 0.0 || v_old * v_free <= 0.0 {
+                base + excess
+            } else {
+                base + excess * (-(v_old / vs).powi(2)).exp()
+            };
+            let dv = level * h;
+            v_free = if v_free.abs() <= dv { 0.0 } else { v_free - dv * dir };
+        }
+        v_free
+    }
+
+    /// The play after a step of `h`: `z` kept within `hw` of `y`, with backlash inertia a
+    /// damped speed `vz` that the play's edge stops.
+    fn play(&self, s: &mut FineState, h: f64) {
+        let (hw, tau) = (self.truth.hw, self.truth.tau);
+        let y = self.cy(&s.x);
+        if hw > 0.0 {
+            if tau > 0.0 {
+                s.vz -= h * s.vz / tau;
+                let zp = s.z + h * s.vz;
+                let zn = zp.clamp(y - hw, y + hw);
+                if zn != zp {
+                    s.vz = (zn - s.z) / h;
+                }
+                s.z = zn;
+            } else {
+                s.z = s.z.clamp(y - hw, y + hw);
             }
+        } else {
+            s.z = y;
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@ use super::nnls::nnls;
 use super::{EPS, M, MAX_CONE_DIM};
 use crate::sphere_max::ordered_by_ub;
 use crate::{Enclosure, SphereMaxSettings};
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, HashMap};
 
 /// A simplicial cone: `p` vertex ids (into the shared vertex list), its upper bound, the
 /// positions in `idx` of its longest edge and its depth in the subdivision.
@@ -146,107 +146,157 @@ struct Entry {
 }
 ordered_by_ub!(Entry);
 
-/// [`cones_max`] for a dimension known at compile time.
-fn cones_max_p<const P: usize>(mut g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Enclosure {
+/// [`cones_max`] for a dimension known at compile time: the `2^p` cones of the coordinate
+/// axes, then the open cone of largest bound split at its longest edge until the gap, the
+/// evaluations or the splits run out.
+fn cones_max_p<const P: usize>(g: impl FnMut(&[f64]) -> f64, s: &SphereMaxSettings) -> Enclosure {
     let p = P;
-    let mut verts: Vec<f64> = Vec::with_capacity(p * 4096);
-    let mut gval: Vec<f64> = Vec::with_capacity(4096);
-    let mut evals = 0usize;
-    let mut lower = f64::NEG_INFINITY;
-    // vertex 2i is +e_i, 2i+1 is -e_i
-    for i in 0..p {
-        for sgn in [1.0, -1.0] {
-            let start = verts.len();
-            verts.resize(start + p, 0.0);
-            verts[start + i] = sgn;
-            let x = g(&verts[start..]);
-            evals += 1;
-            lower = lower.max(x);
-            gval.push(x);
-        }
-    }
-    // cones live in an arena (slots of split cones are reused); the heap holds (bound, slot)
-    let mut arena: Vec<Cone> = Vec::with_capacity(1 << p);
-    let mut free: Vec<u32> = Vec::new();
-    let mut heap = BinaryHeap::with_capacity(1 << p);
-    let push = |cone: Cone, arena: &mut Vec<Cone>, free: &mut Vec<u32>, heap: &mut BinaryHeap<Entry>| {
-        let slot = match free.pop() {
-            Some(k) => {
-                arena[k as usize] = cone;
-                k
-            }
-            None => {
-                arena.push(cone);
-                (arena.len() - 1) as u32
-            }
-        };
-        heap.push(Entry { ub: cone.ub, slot });
-    };
+    let mut found = Vertices::axes(p, g);
+    let mut open = Open::with_capacity(1 << p);
     for mask in 0..1u32 << p {
         let mut idx = [0u32; M];
         for (i, x) in idx[..p].iter_mut().enumerate() {
             *x = 2 * i as u32 + (mask >> i & 1);
         }
-        let (ub, edge) = cone_bound_p::<P>(&verts, &gval, &idx[..p]);
-        push(Cone { ub, idx, edge, depth: 0 }, &mut arena, &mut free, &mut heap);
+        let (ub, edge) = cone_bound_p::<P>(&found.verts, &found.gval, &idx[..p]);
+        open.push(Cone { ub, idx, edge, depth: 0 });
     }
     // Splits may reuse cached midpoints without an evaluation (many do for larger p): cap them
     // too, scaled with the O(p^3) cost of a cone bound, and at 2e6 (about 100 MB of cones).
     let max_splits = (s.max_evals.max(64) * 4000 / p.pow(3)).min(2_000_000);
     let mut splits = 0usize;
     let mut max_depth = 0u16;
-    let mut mids = std::collections::HashMap::<(u32, u32), u32>::new();
-    let mut mbuf = vec![0.0; p];
-    while let Some(top) = heap.peek() {
+    while let Some(top) = open.heap.peek() {
         if top.ub.is_nan()
-            || top.ub - lower <= s.tol_abs.max(s.tol_rel * lower.abs())
-            || evals >= s.max_evals
+            || top.ub - found.lower <= s.tol_abs.max(s.tol_rel * found.lower.abs())
+            || found.evals >= s.max_evals
             || splits >= max_splits
         {
             break;
         }
-        let slot = heap.pop().expect("nonempty").slot;
-        let cone = arena[slot as usize];
-        free.push(slot);
+        let cone = open.pop();
         let (i, j) = (cone.edge.0 as usize, cone.edge.1 as usize);
-        let key = (cone.idx[i].min(cone.idx[j]), cone.idx[i].max(cone.idx[j]));
-        let mid = match mids.get(&key) {
-            Some(&id) => id,
-            None => {
-                let (a, b) = (key.0 as usize * p, key.1 as usize * p);
-                for k in 0..p {
-                    mbuf[k] = verts[a + k] + verts[b + k];
-                }
-                let n = crate::linalg::norm(&mbuf);
-                mbuf.iter_mut().for_each(|x| *x /= n);
-                let x = g(&mbuf);
-                evals += 1;
-                lower = lower.max(x);
-                let id = gval.len() as u32;
-                verts.extend_from_slice(&mbuf);
-                gval.push(x);
-                mids.insert(key, id);
-                id
-            }
-        };
+        let mid = found.midpoint((cone.idx[i].min(cone.idx[j]), cone.idx[i].max(cone.idx[j])));
         let depth = cone.depth.saturating_add(1);
         max_depth = max_depth.max(depth);
         for replace in [i, j] {
             let mut idx = cone.idx;
             idx[replace] = mid;
-            let (ub, edge) = cone_bound_p::<P>(&verts, &gval, &idx[..p]);
-            push(Cone { ub, idx, edge, depth }, &mut arena, &mut free, &mut heap);
+            let (ub, edge) = cone_bound_p::<P>(&found.verts, &found.gval, &idx[..p]);
+            open.push(Cone { ub, idx, edge, depth });
         }
         splits += 1;
     }
-    let U = heap.peek().map(|c| c.ub).unwrap_or(lower);
+    let U = open.heap.peek().map(|c| c.ub).unwrap_or(found.lower);
+    covered(p, found.lower, U, max_depth)
+}
+
+/// The enclosure from the best value `lower` and the largest open bound `U` after splits as
+/// deep as `max_depth`: a NaN value of g voids the bound (and `f64::max` would hide it); the
+/// covering slivers of the floating midpoints (module docs) widen it, `max g <= U / (1 - D delta)`.
+fn covered(p: usize, lower: f64, U: f64, max_depth: u16) -> Enclosure {
     if U.is_nan() {
-        // a NaN value of g voids the bound (and `f64::max` would hide it)
         return Enclosure::new(lower, f64::NAN);
     }
-    // covering slivers of the floating midpoints (module docs): max g <= U / (1 - D delta)
     let delta = 4.0 * (p as f64).sqrt() * (p as f64 + 4.0) * EPS;
     let cover = f64::from(max_depth) * delta;
     let upper = if U > 0.0 { U / (1.0 - cover) * (1.0 + 2.0 * EPS) } else { U };
     Enclosure::new(lower, upper.max(lower))
+}
+
+/// The unit vectors met so far (rows of `verts`), g at each (`gval`), the number of
+/// evaluations and the best value; the midpoints of edges already split, by vertex ids.
+struct Vertices<G> {
+    p: usize,
+    g: G,
+    verts: Vec<f64>,
+    gval: Vec<f64>,
+    evals: usize,
+    lower: f64,
+    mids: HashMap<(u32, u32), u32>,
+}
+
+impl<G: FnMut(&[f64]) -> f64> Vertices<G> {
+    /// The `2p` signed coordinate axes: vertex `2i` is `+e_i`, `2i + 1` is `-e_i`.
+    fn axes(p: usize, g: G) -> Self {
+        let mut found = Vertices {
+            p,
+            g,
+            verts: Vec::with_capacity(p * 4096),
+            gval: Vec::with_capacity(4096),
+            evals: 0,
+            lower: f64::NEG_INFINITY,
+            mids: HashMap::new(),
+        };
+        let mut e = vec![0.0; p];
+        for i in 0..p {
+            for sgn in [1.0, -1.0] {
+                e.iter_mut().for_each(|x| *x = 0.0);
+                e[i] = sgn;
+                found.add(&e);
+            }
+        }
+        found
+    }
+
+    /// Evaluates g at the unit vector `v` and keeps both; the new vertex's id.
+    fn add(&mut self, v: &[f64]) -> u32 {
+        let x = (self.g)(v);
+        self.evals += 1;
+        self.lower = self.lower.max(x);
+        let id = self.gval.len() as u32;
+        self.verts.extend_from_slice(v);
+        self.gval.push(x);
+        id
+    }
+
+    /// The normalised midpoint of the edge between vertices `key` (ids, smaller first), made
+    /// and evaluated once: neighbouring cones share it.
+    fn midpoint(&mut self, key: (u32, u32)) -> u32 {
+        if let Some(&id) = self.mids.get(&key) {
+            return id;
+        }
+        let p = self.p;
+        let (a, b) = (key.0 as usize * p, key.1 as usize * p);
+        let mut m: Vec<f64> = (0..p).map(|k| self.verts[a + k] + self.verts[b + k]).collect();
+        let n = crate::linalg::norm(&m);
+        m.iter_mut().for_each(|x| *x /= n);
+        let id = self.add(&m);
+        self.mids.insert(key, id);
+        id
+    }
+}
+
+/// The open cones: an arena whose slots of split cones are reused, and a heap of (bound, slot).
+struct Open {
+    arena: Vec<Cone>,
+    free: Vec<u32>,
+    heap: BinaryHeap<Entry>,
+}
+
+impl Open {
+    fn with_capacity(n: usize) -> Self {
+        Open { arena: Vec::with_capacity(n), free: Vec::new(), heap: BinaryHeap::with_capacity(n) }
+    }
+
+    fn push(&mut self, cone: Cone) {
+        let slot = match self.free.pop() {
+            Some(k) => {
+                self.arena[k as usize] = cone;
+                k
+            }
+            None => {
+                self.arena.push(cone);
+                (self.arena.len() - 1) as u32
+            }
+        };
+        self.heap.push(Entry { ub: cone.ub, slot });
+    }
+
+    /// The open cone of largest bound, taken out (its slot freed).
+    fn pop(&mut self) -> Cone {
+        let slot = self.heap.pop().expect("nonempty").slot;
+        self.free.push(slot);
+        self.arena[slot as usize]
+    }
 }
