@@ -82,6 +82,29 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
 /// The figures of `a`, written: the files (what `run` prints; the Python package's `figure`).
 pub fn write(a: &Args) -> anyhow::Result<Vec<PathBuf>> {
     // options and the output folder are checked before the work
+    let (width, height) = checked_options(a)?;
+    let figs = match a.kind {
+        Kind::Sweep => sweep_figures(a)?,
+        Kind::Trajectory => trajectory_figures(a, &model_file(a)?)?,
+        Kind::Psi => psi_figures(&model_file(a)?)?,
+        Kind::Tube => tube_figures(&model_file(a)?)?,
+    };
+    let figs: Vec<(String, Figure)> = figs
+        .into_iter()
+        .map(|(stem, mut f)| {
+            f.size = (width, height);
+            if a.no_title {
+                f.title.clear();
+            }
+            (stem, f)
+        })
+        .collect();
+    Ok(figures::write_figure_with(&figs, &a.out, &a.format, a.dpi)?)
+}
+
+/// The figure's size (pixels at 96 dpi) from --size, --width, --height, with the other options
+/// checked and the output folder writable.
+fn checked_options(a: &Args) -> anyhow::Result<(u32, u32)> {
     let preset = a.size.map_or((900, 600), |s| s.size());
     let (width, height) = (a.width.unwrap_or(preset.0), a.height.unwrap_or(preset.1));
     anyhow::ensure!(
@@ -98,85 +121,82 @@ pub fn write(a: &Args) -> anyhow::Result<Vec<PathBuf>> {
             anyhow::ensure!(v > 0.0 && v.is_finite(), "{name} {v}: must be positive and finite");
         }
     }
-    let figs: Vec<(String, Figure)> = match a.kind {
-        Kind::Sweep => {
-            let path = if a.input.is_dir() { a.input.join("sweep.json") } else { a.input.clone() };
-            let r = SweepResult::read(&path)?;
-            let cols: Vec<&str> = if a.columns.is_empty() {
-                ["theta", "theta_best", "measured_rate"]
-                    .into_iter()
-                    .filter(|c| r.columns.iter().any(|k| k.name == *c))
-                    .collect()
-            } else {
-                a.columns.iter().map(String::as_str).collect()
-            };
-            let f = figures::sweep::sweep_figure(&r, a.x.as_deref(), &cols)?;
-            vec![(format!("sweep-{}", cols.join("-")), f)]
-        }
-        _ => {
-            let sys = model::load(&a.input).with_context(|| a.input.display().to_string())?;
-            if matches!(a.kind, Kind::Psi | Kind::Tube) {
-                crate::budget::theta_size("figure", sys.n(), sys.p())?;
-            }
-            match a.kind {
-                Kind::Trajectory => {
-                    let dt = a.dt.unwrap_or(sys.sim.dt);
-                    let t_end = a.t_end.unwrap_or_else(|| match sys.period() {
-                        Some(T) => T * sys.sim.periods as f64,
-                        None => sys.sim.t_end.unwrap_or(100.0),
-                    });
-                    if a.dt.is_some() {
-                        crate::budget::step(dt, &sys, Some(t_end), "--dt")?;
-                    } else if a.t_end.is_some() && dt > t_end {
-                        crate::budget::step(dt, &sys, Some(t_end), "--t-end")?;
-                    }
-                    crate::budget::steps(
-                        "figure trajectory",
-                        (t_end / dt).ceil(),
-                        &format!("t_end = {} at dt = {}", crate::budget::num(t_end), crate::budget::num(dt)),
-                    )?;
-                    let (yz, x) = figures::trajectory::trajectory_figures(
-                        &sys,
-                        &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() },
-                    )?;
-                    vec![("trajectory-yz".into(), yz), ("trajectory-x".into(), x)]
-                }
-                Kind::Psi => {
-                    let r = bounds::assemble(&sys, &bounds::ThetaSettings::bound_only())?;
-                    eprintln!(
-                        "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
-                        r.theta,
-                        match (r.theta_verified, r.theta < 0.0) {
-                            (true, true) => "verified: certifies convergence",
-                            (true, false) => "a valid bound, no convergence guaranteed",
-                            (false, _) => "not verified",
-                        },
-                        r.psi_0,
-                        r.psi_inf,
-                        -r.lambda
-                    );
-                    vec![("fig-psi1".into(), figures::psi::from_report(&r))]
-                }
-                Kind::Tube => {
-                    let settings = bounds::ThetaSettings::bound_only();
-                    let orbit = bounds::orbit::EtaOrbit::new(&sys, &settings.orbit)?;
-                    let tube = bounds::tube::OutputTube::new(&sys, &settings.tube)?;
-                    let z = figures::tube::periodic_z(&sys, 2000)?;
-                    vec![("fig-loop".into(), figures::tube::tube_figure(&sys, &orbit, &tube, &z))]
-                }
-                Kind::Sweep => unreachable!("handled above"),
-            }
-        }
+    Ok((width, height))
+}
+
+/// `figure sweep`: the chosen columns (default theta, theta_best and the measured exponent,
+/// those the sweep has) of a sweep result.
+fn sweep_figures(a: &Args) -> anyhow::Result<Vec<(String, Figure)>> {
+    let path = if a.input.is_dir() { a.input.join("sweep.json") } else { a.input.clone() };
+    let r = SweepResult::read(&path)?;
+    let cols: Vec<&str> = if a.columns.is_empty() {
+        ["theta", "theta_best", "measured_rate"]
+            .into_iter()
+            .filter(|c| r.columns.iter().any(|k| k.name == *c))
+            .collect()
+    } else {
+        a.columns.iter().map(String::as_str).collect()
     };
-    let figs: Vec<(String, Figure)> = figs
-        .into_iter()
-        .map(|(stem, mut f)| {
-            f.size = (width, height);
-            if a.no_title {
-                f.title.clear();
-            }
-            (stem, f)
-        })
-        .collect();
-    Ok(figures::write_figure_with(&figs, &a.out, &a.format, a.dpi)?)
+    let f = figures::sweep::sweep_figure(&r, a.x.as_deref(), &cols)?;
+    Ok(vec![(format!("sweep-{}", cols.join("-")), f)])
+}
+
+/// The model file of `figure trajectory|psi|tube`, within theta's size limits for psi and tube.
+fn model_file(a: &Args) -> anyhow::Result<model::System> {
+    let sys = model::load(&a.input).with_context(|| a.input.display().to_string())?;
+    if matches!(a.kind, Kind::Psi | Kind::Tube) {
+        crate::budget::theta_size("figure", sys.n(), sys.p())?;
+    }
+    Ok(sys)
+}
+
+/// `figure psi` (Fig. psi1), with theta and its verdict on stderr.
+fn psi_figures(sys: &model::System) -> anyhow::Result<Vec<(String, Figure)>> {
+    let r = bounds::assemble(sys, &bounds::ThetaSettings::bound_only())?;
+    eprintln!(
+        "theta = {:.6} ({}), psi(0) = {:.6}, psi(gamma_inf) = {:.6}, -lambda = {:.6}",
+        r.theta,
+        match (r.theta_verified, r.theta < 0.0) {
+            (true, true) => "verified: certifies convergence",
+            (true, false) => "a valid bound, no convergence guaranteed",
+            (false, _) => "not verified",
+        },
+        r.psi_0,
+        r.psi_inf,
+        -r.lambda
+    );
+    Ok(vec![("fig-psi1".into(), figures::psi::from_report(&r))])
+}
+
+/// `figure tube` (Fig. loop): the orbit, the tube and the simulated periodic z.
+fn tube_figures(sys: &model::System) -> anyhow::Result<Vec<(String, Figure)>> {
+    let settings = bounds::ThetaSettings::bound_only();
+    let orbit = bounds::orbit::EtaOrbit::new(sys, &settings.orbit)?;
+    let tube = bounds::tube::OutputTube::new(sys, &settings.tube)?;
+    let z = figures::tube::periodic_z(sys, 2000)?;
+    Ok(vec![("fig-loop".into(), figures::tube::tube_figure(sys, &orbit, &tube, &z))])
+}
+
+/// `figure trajectory`: y and z, and x, against time, within the step budget.
+fn trajectory_figures(a: &Args, sys: &model::System) -> anyhow::Result<Vec<(String, Figure)>> {
+    let dt = a.dt.unwrap_or(sys.sim.dt);
+    let t_end = a.t_end.unwrap_or_else(|| match sys.period() {
+        Some(T) => T * sys.sim.periods as f64,
+        None => sys.sim.t_end.unwrap_or(100.0),
+    });
+    if a.dt.is_some() {
+        crate::budget::step(dt, sys, Some(t_end), "--dt")?;
+    } else if a.t_end.is_some() && dt > t_end {
+        crate::budget::step(dt, sys, Some(t_end), "--t-end")?;
+    }
+    crate::budget::steps(
+        "figure trajectory",
+        (t_end / dt).ceil(),
+        &format!("t_end = {} at dt = {}", crate::budget::num(t_end), crate::budget::num(dt)),
+    )?;
+    let (yz, x) = figures::trajectory::trajectory_figures(
+        sys,
+        &TrajectorySettings { t_end: a.t_end, dt: a.dt, ..Default::default() },
+    )?;
+    Ok(vec![("trajectory-yz".into(), yz), ("trajectory-x".into(), x)])
 }
