@@ -62,6 +62,25 @@ pub struct Simulation {
 pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation> {
     let sys = src.system()?;
     let dt = o.dt.unwrap_or(sys.sim.dt);
+    let periods = checked_options(o, &sys, dt)?;
+    let (t_end, h) = horizon(src, &sys, o, dt, periods)?;
+    crate::budget::steps("simulate", (t_end / h).round(), &format!("t_end = {} at dt = {}", num(t_end), num(h)))?;
+    let steps = (t_end / h).round().max(1.0) as usize;
+    let max_rows = o.max_rows.unwrap_or(steps + 1);
+    let rows = (steps as f64).min(max_rows as f64);
+    crate::budget::samples(
+        "simulate",
+        rows * (1 + sys.n() + sys.m() + 2 * sys.p()) as f64,
+        "numbers in trajectory.csv, --max-rows",
+    )?;
+    let every = steps.div_ceil(max_rows).max(1);
+    let (trajectory, method) = integrate(src, &sys, o.integrator, h, steps, every)?;
+    Ok(Simulation { sys, trajectory, method, h, steps, every })
+}
+
+/// The options checked against each other and the model (`dt` the step asked for): the number
+/// of input periods.
+fn checked_options(o: &SimulateOptions, sys: &System, dt: f64) -> anyhow::Result<usize> {
     if !(dt > 0.0 && dt.is_finite()) {
         bail!("--dt must be positive and finite, got {dt}");
     }
@@ -75,7 +94,7 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
     }
     if o.dt.is_some() {
         let t_end = o.t_end.or(sys.sim.t_end).filter(|_| sys.period().is_none() || o.t_end.is_some());
-        crate::budget::step(dt, &sys, t_end, "--dt")?;
+        crate::budget::step(dt, sys, t_end, "--dt")?;
     }
     let periods = o.periods.unwrap_or(sys.sim.periods);
     if periods == 0 {
@@ -84,7 +103,13 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
     if let Some(r) = o.max_rows.filter(|&r| r < 2) {
         bail!("--max-rows must be at least 2, got {r}");
     }
-    let (t_end, h) = match (sys.period(), o.t_end) {
+    Ok(periods)
+}
+
+/// The final time and the step: whole periods of a periodic input at `T / ceil(T / dt)`
+/// (within the step budget), else `t_end` (the option's, the file's, or 100) at `dt`.
+fn horizon(src: &Source, sys: &System, o: &SimulateOptions, dt: f64, periods: usize) -> anyhow::Result<(f64, f64)> {
+    Ok(match (sys.period(), o.t_end) {
         (Some(T), None) => {
             crate::budget::steps(
                 "simulate",
@@ -108,27 +133,29 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
             }
             (te.or(sys.sim.t_end).unwrap_or(100.0), dt)
         }
-    };
-    crate::budget::steps("simulate", (t_end / h).round(), &format!("t_end = {} at dt = {}", num(t_end), num(h)))?;
-    let steps = (t_end / h).round().max(1.0) as usize;
-    let max_rows = o.max_rows.unwrap_or(steps + 1);
-    let rows = (steps as f64).min(max_rows as f64);
-    crate::budget::samples(
-        "simulate",
-        rows * (1 + sys.n() + sys.m() + 2 * sys.p()) as f64,
-        "numbers in trajectory.csv, --max-rows",
-    )?;
-    let every = steps.div_ceil(max_rows).max(1);
+    })
+}
+
+/// `steps` steps of `h`, every `every`-th kept, by the chosen integrator: the trajectory and
+/// how it was simulated.
+fn integrate(
+    src: &Source,
+    sys: &System,
+    integrator: Integrator,
+    h: f64,
+    steps: usize,
+    every: usize,
+) -> anyhow::Result<(Trajectory, String)> {
     let mut effects: Vec<&str> = sys.effects.list.iter().map(|e| e.kind()).collect();
     if sys.controller.is_some() {
         effects.push("a digital controller");
     }
-    let (trajectory, method) = match o.integrator {
+    Ok(match integrator {
         Integrator::CatchingUp if effects.is_empty() => {
-            (simulate_model(&sys, h, steps, every)?, format!("catching-up, h = {h:e}"))
+            (simulate_model(sys, h, steps, every)?, format!("catching-up, h = {h:e}"))
         }
         Integrator::CatchingUp => (
-            simulate_model(&sys, h, steps, every)?,
+            simulate_model(sys, h, steps, every)?,
             format!("extended model with {}, h = {h:e}", effects.join(", ")),
         ),
         Integrator::Event if !effects.is_empty() => bail!(
@@ -144,7 +171,7 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
                 max_events,
                 ..Default::default()
             };
-            let (tr, events) = event_driven(&sys, &settings).map_err(|e| match e {
+            let (tr, events) = event_driven(sys, &settings).map_err(|e| match e {
                 DynamicsError::TooManyEvents { t, .. } => anyhow::anyhow!(
                     "event-driven reference: more than {max_events} events before t = {} ({EVENTS_PER_STEP} per step of the run): the contact chatters or the state diverges; use --integrator catching-up",
                     num(t)
@@ -153,6 +180,5 @@ pub fn simulate(src: &Source, o: &SimulateOptions) -> anyhow::Result<Simulation>
             })?;
             (tr, format!("event-driven, {events} events"))
         }
-    };
-    Ok(Simulation { sys, trajectory, method, h, steps, every })
+    })
 }
