@@ -231,50 +231,14 @@ fn text_w(s: &str, sz: u32) -> f64 {
     w / 64.0 * LINE_PER_EM * EM_PER_SIZE
 }
 
-/// Greek letters and symbols of TeX (`\delta` -> `δ`).
+/// Greek letters and symbols of TeX (`\delta` -> `δ`, [`super::tex_symbols`]), a degree sign
+/// and the spaces.
 fn tex_symbol(name: &str) -> Option<&'static str> {
-    Some(match name {
-        "alpha" => "α",
-        "beta" => "β",
-        "gamma" => "γ",
-        "delta" => "δ",
-        "epsilon" | "varepsilon" => "ε",
-        "zeta" => "ζ",
-        "eta" => "η",
-        "theta" | "vartheta" => "θ",
-        "kappa" => "κ",
-        "lambda" => "λ",
-        "mu" => "μ",
-        "nu" => "ν",
-        "xi" => "ξ",
-        "pi" => "π",
-        "rho" => "ρ",
-        "sigma" => "σ",
-        "tau" => "τ",
-        "phi" | "varphi" => "φ",
-        "chi" => "χ",
-        "psi" => "ψ",
-        "omega" => "ω",
-        "Gamma" => "Γ",
-        "Delta" => "Δ",
-        "Theta" => "Θ",
-        "Lambda" => "Λ",
-        "Xi" => "Ξ",
-        "Pi" => "Π",
-        "Sigma" => "Σ",
-        "Phi" => "Φ",
-        "Psi" => "Ψ",
-        "Omega" => "Ω",
-        "infty" => "∞",
-        "cdot" => "·",
-        "times" => "×",
-        "le" | "leq" => "≤",
-        "ge" | "geq" => "≥",
-        "pm" => "±",
-        "circ" => "°",
-        "," | ";" | " " | "quad" => " ",
-        _ => return None,
-    })
+    match name {
+        "circ" => Some("°"),
+        "," | ";" | " " | "quad" => Some(" "),
+        _ => super::tex_symbols::symbol(name),
+    }
 }
 
 /// A label as the figures draw it: TeX math (`$...$`, as a sweep spec's `label` writes it:

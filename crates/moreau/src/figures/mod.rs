@@ -10,13 +10,15 @@
 //! - [`diagnosis`]: measured vs nominal vs fitted, residuals and zooms of `moreau diagnose`.
 //!
 //! Every figure is a [`canvas::Figure`] (data only) rendered by [`canvas::write_figure`] (or
-//! [`canvas::to_svg`], [`canvas::write_png`]); [`fonts`] embeds the DejaVu font in all of them.
+//! [`canvas::to_svg`], [`canvas::write_png`]); [`fonts`] embeds the DejaVu font in all of them;
+//! [`tex_symbols`] is the one table of TeX's Greek letters and symbols both directions use.
 pub mod canvas;
 pub mod diagnosis;
 pub mod fonts;
 pub mod pgf;
 pub mod psi;
 pub mod sweep;
+pub mod tex_symbols;
 pub mod trajectory;
 pub mod tube;
 

@@ -58,47 +58,21 @@ fn plain_tex(s: &str) -> String {
             continue;
         }
         let math = match c {
-            'α' => Some("\\alpha"),
-            'β' => Some("\\beta"),
-            'γ' => Some("\\gamma"),
-            'δ' => Some("\\delta"),
-            'ε' => Some("\\varepsilon"),
-            'η' => Some("\\eta"),
-            'θ' => Some("\\theta"),
-            'κ' => Some("\\kappa"),
-            'λ' => Some("\\lambda"),
-            'μ' => Some("\\mu"),
-            'ξ' => Some("\\xi"),
-            'π' => Some("\\pi"),
-            'ρ' => Some("\\rho"),
-            'σ' => Some("\\sigma"),
-            'τ' => Some("\\tau"),
-            'φ' => Some("\\varphi"),
-            'ψ' => Some("\\psi"),
-            'ω' => Some("\\omega"),
-            'Θ' => Some("\\Theta"),
-            'Ξ' => Some("\\Xi"),
-            'Φ' => Some("\\Phi"),
-            'Ψ' => Some("\\Psi"),
-            'Ω' => Some("\\Omega"),
-            '∞' => Some("\\infty"),
-            '\u{e000}' => Some("_\\infty"),
-            '−' => Some("-"),
-            '≤' => Some("\\le"),
-            '≥' => Some("\\ge"),
-            '·' => Some("\\cdot"),
-            '′' => Some("'"),
-            '₀' => Some("_0"),
-            '₁' => Some("_1"),
-            '₂' => Some("_2"),
-            '₃' => Some("_3"),
-            '²' => Some("^2"),
-            _ => None,
+            '\u{e000}' => Some("_\\infty".to_string()),
+            '−' => Some("-".to_string()),
+            '′' => Some("'".to_string()),
+            '₀' => Some("_0".to_string()),
+            '₁' => Some("_1".to_string()),
+            '₂' => Some("_2".to_string()),
+            '₃' => Some("_3".to_string()),
+            '²' => Some("^2".to_string()),
+            '°' => Some("^\\circ".to_string()),
+            c => super::tex_symbols::command(c),
         };
         match math {
             Some(m) => {
                 out.push('$');
-                out.push_str(m);
+                out.push_str(&m);
                 out.push('$');
             }
             None => match c {
@@ -288,5 +262,8 @@ mod tests {
         // TeX as a sweep spec writes it is kept; the text around it converted
         assert_eq!(tex_text("$\\delta$ (m)"), "$\\delta$ (m)");
         assert_eq!(tex_text("$A_{21}$ = −3, 50%"), "$A_{21}$ = $-$3, 50\\%");
+        // every letter of the shared table (tex_symbols), the preferred command where two exist
+        assert_eq!(tex_text("Δ ± ε, φ × 2"), "$\\Delta$ $\\pm$ $\\varepsilon$, $\\varphi$ $\\times$ 2");
+        assert_eq!(tex_text("angle (°)"), "angle ($^\\circ$)");
     }
 }
