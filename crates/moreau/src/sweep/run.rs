@@ -198,7 +198,34 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     crate::output::remove_stale_staging(
         opts.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")),
     );
-    let mut done = previous_points(&header, &opts.out, &stem, opts.overwrite)?;
+    let Plan { mut done, in_scope, todo } = plan(&header, opts, &stem)?;
+    let resumed = in_scope - todo.len();
+    let cp = checkpoint_path(&opts.out, &stem);
+    let cp_file = Mutex::new(open_checkpoint(&header, opts, &stem, &cp)?);
+    let new = evaluate_all(spec, evaluator, opts, &todo, header.columns.len(), &cp_file)?;
+    let computed = new.len();
+    for p in new {
+        done.insert(p.index, p);
+    }
+    header.points = done.into_values().collect();
+    let failed = header.points.iter().filter(|p| !p.ok()).count();
+    let files = write_tables(&header, &opts.out, &stem, digits)?;
+    drop(cp_file);
+    let _ = std::fs::remove_file(&cp);
+    Ok(RunSummary { in_scope, resumed, computed, failed, files, result: header })
+}
+
+/// What a run does: the points already done (kept from an earlier run unless `--fresh`, the
+/// failed ones dropped with `--retry-failed`), how many points the run's shard holds, and the
+/// indices still to evaluate.
+struct Plan {
+    done: BTreeMap<usize, PointRecord>,
+    in_scope: usize,
+    todo: Vec<usize>,
+}
+
+fn plan(header: &SweepResult, opts: &RunOptions, stem: &str) -> Result<Plan, SweepError> {
+    let mut done = previous_points(header, &opts.out, stem, opts.overwrite)?;
     if opts.fresh {
         done.clear();
     }
@@ -208,37 +235,41 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
     let in_scope: Vec<usize> = (0..header.total_points).filter(|&i| opts.shard.is_none_or(|s| s.contains(i))).collect();
     done.retain(|i, _| opts.shard.is_none_or(|s| s.contains(*i)));
     let todo: Vec<usize> = in_scope.iter().copied().filter(|i| !done.contains_key(i)).collect();
-    let resumed = in_scope.len() - todo.len();
+    Ok(Plan { done, in_scope: in_scope.len(), todo })
+}
 
-    // checkpoint: header line, then one line per finished point (flushed)
+/// The checkpoint `cp`, open for appending: a header line, then one line per finished point
+/// (an earlier run's file of the same sweep is continued). Every line goes out in one write, so
+/// a line is whole or (cut by an interruption) unparsable, never mixed with another.
+fn open_checkpoint(
+    header: &SweepResult,
+    opts: &RunOptions,
+    stem: &str,
+    cp: &Path,
+) -> Result<std::fs::File, SweepError> {
     std::fs::create_dir_all(&opts.out)
         .map_err(|e| SweepError::Write { path: opts.out.clone(), reason: e.to_string() })?;
-    let cp = checkpoint_path(&opts.out, &stem);
-    // every line goes out in one write to a file opened for appending, so a line is whole or
-    // (cut by an interruption) unparsable, never mixed with another
-    let mut cp_file = {
-        let cperr = |e: std::io::Error| SweepError::Write { path: cp.clone(), reason: e.to_string() };
-        let exists_same = !opts.fresh && cp.exists() && previous_points(&header, &opts.out, &stem, false).is_ok();
-        if !exists_same {
-            std::fs::write(&cp, format!("{}\n", header.header_json())).map_err(cperr)?;
-        }
-        std::fs::OpenOptions::new().append(true).open(&cp).map_err(cperr)?
-    };
-    let _ = cp_file.flush();
-    let cp_file = Mutex::new(cp_file);
+    let cperr = |e: std::io::Error| SweepError::Write { path: cp.to_path_buf(), reason: e.to_string() };
+    let exists_same = !opts.fresh && cp.exists() && previous_points(header, &opts.out, stem, false).is_ok();
+    if !exists_same {
+        std::fs::write(cp, format!("{}\n", header.header_json())).map_err(cperr)?;
+    }
+    let mut f = std::fs::OpenOptions::new().append(true).open(cp).map_err(cperr)?;
+    let _ = f.flush();
+    Ok(f)
+}
 
-    let pb = if opts.progress {
-        let pb = indicatif::ProgressBar::new(todo.len() as u64);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} points, ETA {eta}")
-                .expect("template")
-                .progress_chars("=> "),
-        );
-        pb
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    let ncols = header.columns.len();
+/// The points `todo`, in parallel (on `--threads` threads where given), each written to the
+/// checkpoint as it finishes, with a progress bar where asked.
+fn evaluate_all(
+    spec: &SweepSpec,
+    evaluator: &dyn Evaluator,
+    opts: &RunOptions,
+    todo: &[usize],
+    ncols: usize,
+    cp_file: &Mutex<std::fs::File>,
+) -> Result<Vec<PointRecord>, SweepError> {
+    let pb = progress_bar(opts.progress, todo.len());
     let work = || -> Vec<PointRecord> {
         todo.par_iter()
             .map(|&i| {
@@ -262,16 +293,19 @@ pub fn run(spec: &SweepSpec, evaluator: &dyn Evaluator, opts: &RunOptions) -> Re
         None => work(),
     };
     pb.finish_and_clear();
-    let computed = new.len();
-    let failed_new = new.iter().filter(|p| !p.ok()).count();
-    for p in new {
-        done.insert(p.index, p);
+    Ok(new)
+}
+
+/// A bar of `n` points with the elapsed time and the ETA, or a hidden one.
+fn progress_bar(shown: bool, n: usize) -> indicatif::ProgressBar {
+    if !shown {
+        return indicatif::ProgressBar::hidden();
     }
-    header.points = done.into_values().collect();
-    let failed = header.points.iter().filter(|p| !p.ok()).count();
-    let _ = failed_new;
-    let files = write_tables(&header, &opts.out, &stem, digits)?;
-    drop(cp_file);
-    let _ = std::fs::remove_file(&cp);
-    Ok(RunSummary { in_scope: in_scope.len(), resumed, computed, failed, files, result: header })
+    let pb = indicatif::ProgressBar::new(n as u64);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} points, ETA {eta}")
+            .expect("template")
+            .progress_chars("=> "),
+    );
+    pb
 }
