@@ -12,6 +12,7 @@ use super::flow::{Face, PhaseKind};
 use super::FloquetError;
 use dynamics::integrators::event_driven::{event_driven, EventDrivenSettings};
 use dynamics::periodic::poincare::{periodic_regime, FixedPointStatus, PoincareSettings};
+use dynamics::trajectory::Trajectory;
 use model::System;
 use nalgebra::DVector;
 
@@ -54,10 +55,43 @@ pub fn simulate_structure(
     max_periods: usize,
 ) -> Result<PhaseStructure, FloquetError> {
     let T = 2.0 * std::f64::consts::PI / omega;
+    let s2 = near_regime(sys, T, max_periods)?;
+    let periods = 3usize;
+    let dt = T / SAMPLES as f64;
+    let st = EventDrivenSettings { dt_out: dt, max_step: dt, t_end: periods as f64 * T, ..Default::default() };
+    let (tr, _) = event_driven(&s2, &st).map_err(|e| FloquetError::Simulation { what: e.to_string() })?;
+    let first = (periods - 1) * SAMPLES;
+    let classes = classify(sys, &tr, first, lo, hi);
+    let sw = switch_samples(&classes);
+    if sw.is_empty() {
+        return Err(FloquetError::NoContact);
+    }
+    let k = sw.len();
+    let kind_after = |j: usize| classes[sw[j]];
+    let t_sw: Vec<f64> = sw.iter().map(|&i| (i as f64 - 0.5) * dt).collect();
+    let (quarter, t0) = section(&t_sw, T, omega, phase);
+    // first switch after t0
+    let j0 = (0..k).min_by(|&a, &b| (t_sw[a] - t0).rem_euclid(T).total_cmp(&(t_sw[b] - t0).rem_euclid(T))).unwrap_or(0);
+    let mut kinds = vec![kind_after((j0 + k - 1) % k)];
+    let mut durations = Vec::new();
+    let mut t_prev = t0;
+    for i in 0..k {
+        let j = (j0 + i) % k;
+        let d = (t_sw[j] - t_prev).rem_euclid(T);
+        durations.push(d);
+        t_prev = t_sw[j];
+        kinds.push(kind_after(j));
+    }
+    let i0 = first + ((t0 / dt).round() as usize % SAMPLES);
+    Ok(PhaseStructure { quarter, kinds, durations, x0: tr.x_at(i0)[..sys.n()].to_vec(), z0: tr.z_at(i0)[0] })
+}
+
+/// `sys` started at the fixed point of the catching-up Poincare map (period `T`). The fixed
+/// point only seeds the structure: an iteration stalled by the catching-up's own jitter near
+/// the regime is good enough (Newton and Krawczyk decide); far from it is not.
+fn near_regime(sys: &System, T: f64, max_periods: usize) -> Result<System, FloquetError> {
     let ps = PoincareSettings { dt: T / 2000.0, tol_residual: 1e-9, max_periods, ..Default::default() };
     let reg = periodic_regime(sys, &ps).map_err(|e| FloquetError::Simulation { what: e.to_string() })?;
-    // the fixed point only seeds the structure: an iteration stalled by the catching-up's own
-    // jitter near the regime is good enough (Newton and Krawczyk decide); far from it is not
     let scale = 1.0 + reg.x0.iter().chain(&reg.z0).fold(0.0f64, |a, v| a.max(v.abs()));
     if reg.status != FixedPointStatus::Converged && !(reg.residual <= 1e-4 * scale) {
         return Err(FloquetError::NoRegime { periods: reg.iterations });
@@ -65,14 +99,14 @@ pub fn simulate_structure(
     let mut s2 = sys.clone();
     s2.x0 = DVector::from_column_slice(&reg.x0);
     s2.z0 = DVector::from_column_slice(&reg.z0);
-    let periods = 3usize;
-    let dt = T / SAMPLES as f64;
-    let st = EventDrivenSettings { dt_out: dt, max_step: dt, t_end: periods as f64 * T, ..Default::default() };
-    let (tr, _) = event_driven(&s2, &st).map_err(|e| FloquetError::Simulation { what: e.to_string() })?;
-    let first = (periods - 1) * SAMPLES;
-    let n = sys.n();
+    Ok(s2)
+}
+
+/// The class of each of the [`SAMPLES`] samples from `first` on: engaged on a face (`q` on the
+/// face within `1e-9`, `y'` pushing) or resting.
+fn classify(sys: &System, tr: &Trajectory, first: usize, lo: f64, hi: f64) -> Vec<PhaseKind> {
     let tol = 1e-9 * (1.0 + hi.abs().max(lo.abs()));
-    let classes: Vec<PhaseKind> = (first..first + SAMPLES)
+    (first..first + SAMPLES)
         .map(|i| {
             let x = DVector::from_column_slice(tr.x_at(i));
             let z = tr.z_at(i)[0];
@@ -88,10 +122,14 @@ pub fn simulate_structure(
                 PhaseKind::Resting
             }
         })
-        .collect();
-    // cyclic runs: switch j at sample index sw[j] (class changes between sw - 1 and sw)
+        .collect()
+}
+
+/// The cyclic runs of `classes`: switch `j` at sample `sw[j]` (the class changes between
+/// `sw - 1` and `sw`), one-sample runs dropped (classification noise at a release, where
+/// `y' = 0`).
+fn switch_samples(classes: &[PhaseKind]) -> Vec<usize> {
     let mut sw: Vec<usize> = (0..SAMPLES).filter(|&i| classes[i] != classes[(i + SAMPLES - 1) % SAMPLES]).collect();
-    // drop one-sample runs (classification noise at a release, where y' = 0)
     loop {
         let k = sw.len();
         if k < 2 {
@@ -108,13 +146,12 @@ pub fn simulate_structure(
             None => break,
         }
     }
-    if sw.is_empty() {
-        return Err(FloquetError::NoContact);
-    }
-    let k = sw.len();
-    let kind_after = |j: usize| classes[sw[j]];
-    let t_sw: Vec<f64> = sw.iter().map(|&i| (i as f64 - 0.5) * dt).collect();
-    // the section: the quarter of the input phase farthest from a switch
+    sw
+}
+
+/// The section: the quarter of the input phase farthest from a switch (at times `t_sw`), and
+/// its time in `[0, T)`.
+fn section(t_sw: &[f64], T: f64, omega: f64, phase: f64) -> (usize, f64) {
     let dist = |t0: f64| {
         t_sw.iter()
             .map(|&ts| {
@@ -125,19 +162,5 @@ pub fn simulate_structure(
     };
     let t_of = |q: usize| ((q as f64 * std::f64::consts::FRAC_PI_2 - phase) / omega).rem_euclid(T);
     let quarter = (0..4).max_by(|&a, &b| dist(t_of(a)).total_cmp(&dist(t_of(b)))).unwrap_or(0);
-    let t0 = t_of(quarter);
-    // first switch after t0
-    let j0 = (0..k).min_by(|&a, &b| (t_sw[a] - t0).rem_euclid(T).total_cmp(&(t_sw[b] - t0).rem_euclid(T))).unwrap_or(0);
-    let mut kinds = vec![kind_after((j0 + k - 1) % k)];
-    let mut durations = Vec::new();
-    let mut t_prev = t0;
-    for i in 0..k {
-        let j = (j0 + i) % k;
-        let d = (t_sw[j] - t_prev).rem_euclid(T);
-        durations.push(d);
-        t_prev = t_sw[j];
-        kinds.push(kind_after(j));
-    }
-    let i0 = first + ((t0 / dt).round() as usize % SAMPLES);
-    Ok(PhaseStructure { quarter, kinds, durations, x0: tr.x_at(i0)[..n].to_vec(), z0: tr.z_at(i0)[0] })
+    (quarter, t_of(quarter))
 }
