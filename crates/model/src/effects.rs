@@ -2,7 +2,9 @@
 //! the `discovery` crate to express what a recording shows and the nominal model lacks.
 //! Each effect equals the nominal model when its parameters are zero (or it is absent), so a
 //! fitted model is an ordinary model file.
-use crate::toml_access::{check_keys, describe, f64_at, key, opt_f64, str_at, vec_at, vec_value};
+use crate::toml_access::{
+    check_keys, describe, f64_at, key, nonneg, opt_f64, opt_nonneg, positive, str_at, vec_at, vec_value,
+};
 use crate::ModelError;
 use toml::{Table, Value};
 
@@ -100,14 +102,6 @@ pub struct Effects {
     pub list: Vec<Effect>,
 }
 
-fn nonneg(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
-    let v = f64_at(t, prefix, k)?;
-    if v < 0.0 {
-        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be non-negative" });
-    }
-    Ok(v)
-}
-
 fn state_index(t: &Table, prefix: &str, n: usize) -> Result<usize, ModelError> {
     index_at(t, prefix, "state", n)
 }
@@ -118,14 +112,6 @@ fn index_at(t: &Table, prefix: &str, k: &str, n: usize) -> Result<usize, ModelEr
         return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be a state index 0..n-1" });
     }
     Ok(v as usize)
-}
-
-fn positive(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
-    let v = f64_at(t, prefix, k)?;
-    if v <= 0.0 {
-        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be positive" });
-    }
-    Ok(v)
 }
 
 /// A backlash's `location`: `"loop"` (the default) or `"input"`.
@@ -158,7 +144,7 @@ fn stribeck(t: &Table, prefix: &str, n: usize) -> Result<Effect, ModelError> {
         });
     }
     let stribeck_velocity = positive(t, prefix, "stribeck_velocity")?;
-    let viscous = if opt_f64(t, prefix, "viscous")?.is_some() { nonneg(t, prefix, "viscous")? } else { 0.0 };
+    let viscous = opt_nonneg(t, prefix, "viscous")?.unwrap_or(0.0);
     Ok(Effect::StribeckFriction { state, level, static_level, stribeck_velocity, viscous })
 }
 

@@ -81,6 +81,7 @@ fn geo(key: &str) -> impl FnOnce(GeometryError) -> ModelError + '_ {
     move |source| ModelError::Geometry { key: key.into(), source }
 }
 
+/// The `[theta]` table (the origin of `R^p` where there is none): one of the shapes, checked.
 fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
     let Some(t) = t else { return Ok(Shape::origin(p)) };
     let pre = "theta";
@@ -93,33 +94,10 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
         }
     };
     Ok(match shape {
-        "interval" => {
-            check_keys(t, pre, "shape, half_width, lo, hi")?;
-            if let Some(d) = opt_f64(t, pre, "half_width")? {
-                if d < 0.0 {
-                    return Err(ModelError::OutOfRange {
-                        key: "theta.half_width".into(),
-                        value: d,
-                        reason: "must be non-negative",
-                    });
-                }
-                Shape::Interval(Interval::symmetric(d).map_err(geo("theta.half_width"))?)
-            } else {
-                Shape::Interval(
-                    Interval::new(f64_at(t, pre, "lo")?, f64_at(t, pre, "hi")?).map_err(geo("theta.lo/hi"))?,
-                )
-            }
-        }
+        "interval" => theta_interval(t)?,
         "ball" => {
             check_keys(t, pre, "shape, centre, radius")?;
-            let r = f64_at(t, pre, "radius")?;
-            if r < 0.0 {
-                return Err(ModelError::OutOfRange {
-                    key: "theta.radius".into(),
-                    value: r,
-                    reason: "must be non-negative",
-                });
-            }
+            let r = nonneg(t, pre, "radius")?;
             Shape::Ball(Ball::new(centre(t)?, r).map_err(geo("theta.radius"))?)
         }
         "point" => {
@@ -131,28 +109,7 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
             if t.contains_key("semi_axes") && t.contains_key("matrix") {
                 return Err(ModelError::ExclusiveKeys { a: "theta.semi_axes".into(), b: "theta.matrix".into() });
             }
-            let c = centre(t)?;
-            if t.contains_key("semi_axes") {
-                let a = vec_at(t, pre, "semi_axes")?;
-                if let Some(&bad) = a.iter().find(|&&x| x <= 0.0) {
-                    return Err(ModelError::OutOfRange {
-                        key: "theta.semi_axes".into(),
-                        value: bad,
-                        reason: "semi-axes must be positive",
-                    });
-                }
-                if a.len() != c.len() {
-                    return Err(ModelError::Dimension {
-                        key: "theta.semi_axes".into(),
-                        expected: format!("length {}", c.len()),
-                        got: format!("length {}", a.len()),
-                    });
-                }
-                Shape::Ellipsoid(Ellipsoid::axis_aligned(c, &a).map_err(geo("theta.semi_axes"))?)
-            } else {
-                let m = matrix_at(t, pre, "matrix", false)?;
-                Shape::Ellipsoid(Ellipsoid::new(c, &m).map_err(geo("theta.matrix"))?)
-            }
+            theta_ellipsoid(t, centre(t)?)?
         }
         "ball_intersection" => {
             check_keys(t, pre, "shape, centres, radii")?;
@@ -175,6 +132,42 @@ fn parse_theta(t: Option<&Table>, p: usize) -> Result<Shape, ModelError> {
         }
         other => return Err(ModelError::UnknownShape { value: other.to_string() }),
     })
+}
+
+/// `shape = "interval"`: `half_width` (symmetric) or `lo` and `hi`.
+fn theta_interval(t: &Table) -> Result<Shape, ModelError> {
+    let pre = "theta";
+    check_keys(t, pre, "shape, half_width, lo, hi")?;
+    Ok(Shape::Interval(match opt_nonneg(t, pre, "half_width")? {
+        Some(d) => Interval::symmetric(d).map_err(geo("theta.half_width"))?,
+        None => Interval::new(f64_at(t, pre, "lo")?, f64_at(t, pre, "hi")?).map_err(geo("theta.lo/hi"))?,
+    }))
+}
+
+/// `shape = "ellipsoid"` about centre `c`: positive `semi_axes` along the coordinates, or a
+/// `matrix`.
+fn theta_ellipsoid(t: &Table, c: Vec<f64>) -> Result<Shape, ModelError> {
+    let pre = "theta";
+    if !t.contains_key("semi_axes") {
+        let m = matrix_at(t, pre, "matrix", false)?;
+        return Ok(Shape::Ellipsoid(Ellipsoid::new(c, &m).map_err(geo("theta.matrix"))?));
+    }
+    let a = vec_at(t, pre, "semi_axes")?;
+    if let Some(&bad) = a.iter().find(|&&x| x <= 0.0) {
+        return Err(ModelError::OutOfRange {
+            key: "theta.semi_axes".into(),
+            value: bad,
+            reason: "semi-axes must be positive",
+        });
+    }
+    if a.len() != c.len() {
+        return Err(ModelError::Dimension {
+            key: "theta.semi_axes".into(),
+            expected: format!("length {}", c.len()),
+            got: format!("length {}", a.len()),
+        });
+    }
+    Ok(Shape::Ellipsoid(Ellipsoid::axis_aligned(c, &a).map_err(geo("theta.semi_axes"))?))
 }
 
 /// Inscribed radius, relative to the largest radius, below which an intersection of balls
@@ -283,16 +276,7 @@ fn parse_input(t: Option<&Table>, m: usize, dir: &Path) -> Result<Input, ModelEr
                 None => InputHold::Foh,
                 Some(_) => InputHold::parse(str_at(t, pre, "hold")?, "input.hold")?,
             };
-            let period = opt_f64(t, pre, "period")?;
-            if let Some(per) = period {
-                if per <= 0.0 {
-                    return Err(ModelError::OutOfRange {
-                        key: "input.period".into(),
-                        value: per,
-                        reason: "must be positive",
-                    });
-                }
-            }
+            let period = opt_positive(t, pre, "period")?;
             let input = Input::from_csv(&dir.join(file), period, hold)?;
             if let (Some(per), Input::Samples { t, .. }) = (period, &input) {
                 crate::input::check_period(per, t, file)?;
@@ -409,16 +393,7 @@ pub fn parse_str_with(text: &str, origin: &str, dir: &Path) -> Result<System, Mo
             }
             sim.periods = per as usize;
         }
-        sim.t_end = opt_f64(t, "simulation", "t_end")?;
-        if let Some(te) = sim.t_end {
-            if te <= 0.0 {
-                return Err(ModelError::OutOfRange {
-                    key: "simulation.t_end".into(),
-                    value: te,
-                    reason: "must be positive",
-                });
-            }
-        }
+        sim.t_end = opt_positive(t, "simulation", "t_end")?;
     }
     let effects = Effects::parse(root.get("effects"), n, p)?;
     let mut sys = System::validated(name, A, B, C, E, theta, input, x0, z0, sim, effects)?;

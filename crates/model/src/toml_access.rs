@@ -57,6 +57,34 @@ pub(crate) fn opt_f64(t: &Table, prefix: &str, k: &str) -> Result<Option<f64>, M
     t.get(k).map(|v| number(v, &key(prefix, k))).transpose()
 }
 
+/// A number at `k` that must be non-negative.
+pub(crate) fn nonneg(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
+    let v = f64_at(t, prefix, k)?;
+    if v < 0.0 {
+        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be non-negative" });
+    }
+    Ok(v)
+}
+
+/// A number at `k` that must be positive.
+pub(crate) fn positive(t: &Table, prefix: &str, k: &str) -> Result<f64, ModelError> {
+    let v = f64_at(t, prefix, k)?;
+    if v <= 0.0 {
+        return Err(ModelError::OutOfRange { key: key(prefix, k), value: v, reason: "must be positive" });
+    }
+    Ok(v)
+}
+
+/// [`nonneg`] where `k` may be absent.
+pub(crate) fn opt_nonneg(t: &Table, prefix: &str, k: &str) -> Result<Option<f64>, ModelError> {
+    t.get(k).map(|_| nonneg(t, prefix, k)).transpose()
+}
+
+/// [`positive`] where `k` may be absent.
+pub(crate) fn opt_positive(t: &Table, prefix: &str, k: &str) -> Result<Option<f64>, ModelError> {
+    t.get(k).map(|_| positive(t, prefix, k)).transpose()
+}
+
 pub(crate) fn str_at<'a>(t: &'a Table, prefix: &str, k: &str) -> Result<&'a str, ModelError> {
     match get(t, prefix, k)? {
         Value::String(s) => Ok(s),
