@@ -142,6 +142,38 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let want: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(50);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3030);
+    let start = std::time::Instant::now();
+    let (rows, drawn) = draw_rows(want, seed);
+    let total = start.elapsed().as_secs_f64();
+    if std::env::var("FLOQUET_BENCHMARK_ROWS").is_ok() {
+        print_rows(&rows);
+    }
+    print_summary(&rows, seed, drawn, total);
+    let mut reasons: Vec<String> = rows.iter().filter_map(|r| r.reason.clone()).collect();
+    reasons.sort();
+    reasons.dedup();
+    for r in reasons {
+        let c = rows.iter().filter(|x| x.reason.as_deref() == Some(r.as_str())).count();
+        println!("  not verified ({c}): {r}");
+    }
+    let ratios: Vec<f64> =
+        rows.iter().filter(|r| r.verified).filter_map(|r| r.theta_best.map(|t| t / r.enc[1])).collect::<Vec<_>>();
+    if !ratios.is_empty() {
+        let mut s = ratios.clone();
+        s.sort_by(f64::total_cmp);
+        println!(
+            "theta_best / floquet_hi: {} systems, median {:.3}, min {:.3}, max {:.3}",
+            s.len(),
+            s[s.len() / 2],
+            s[0],
+            s[s.len() - 1]
+        );
+    }
+}
+
+/// Draws until `want` convergent systems (capped at 40 `want` candidates): their rows and the
+/// number of systems drawn.
+fn draw_rows(want: usize, seed: u64) -> (Vec<Row>, usize) {
     let params = theorems::strategies::draw(&system_params(&config()), seed, 40 * want);
     let measure = RateSettings {
         periods: 30,
@@ -153,7 +185,6 @@ fn main() {
         dt: std::env::var("FLOQUET_DT").ok().and_then(|v| v.parse().ok()).unwrap_or(2e-3),
         ..Default::default()
     };
-    let start = std::time::Instant::now();
     let mut rows: Vec<Row> = Vec::new();
     let mut drawn = 0;
     for chunk in params.chunks(16) {
@@ -166,35 +197,44 @@ fn main() {
         rows.extend(got);
     }
     rows.truncate(want);
-    let total = start.elapsed().as_secs_f64();
-    if std::env::var("FLOQUET_BENCHMARK_ROWS").is_ok() {
-        println!("| # | n | measured ln V (95 % CI + step) | measured multiplier (95 % CI + step) | event-driven FD | floquet_exponent | rel. width | time | theta_best | theta_best / floquet |");
-        println!("|---|---|---|---|---|---|---|---|---|---|");
-        for (i, r) in rows.iter().enumerate() {
-            let enc = if r.verified {
-                format!("[{:.6}, {:.6}]", r.enc[0], r.enc[1])
-            } else {
-                format!("not verified: {}", r.reason.as_deref().unwrap_or("?"))
-            };
-            let tb = r.theta_best.map(|v| format!("{v:.4}")).unwrap_or("-".into());
-            let ratio = match (r.verified, r.theta_best) {
-                (true, Some(v)) => format!("{:.3}", v / r.enc[1]),
-                _ => "-".into(),
-            };
-            println!(
-                "| {i} | {} | {:.5} ({:.5}, {:.5}) | {} | {} | {enc} | {:.1e} | {:.0} ms | {tb} | {ratio} |",
-                r.n,
-                r.rate,
-                r.ci.0,
-                r.ci.1,
-                r.mult.map(|u| format!("{:.6} ({:.6}, {:.6})", u.0, u.1, u.2)).unwrap_or("-".into()),
-                r.fd.map(|v| format!("{v:.6}")).unwrap_or("-".into()),
-                r.rel_width,
-                1e3 * r.secs
-            );
-        }
-        println!();
+    (rows, drawn)
+}
+
+/// One row per system (`FLOQUET_BENCHMARK_ROWS=1`): the measurements, the enclosure, its time
+/// and `theta_best / floquet`.
+fn print_rows(rows: &[Row]) {
+    println!("| # | n | measured ln V (95 % CI + step) | measured multiplier (95 % CI + step) | event-driven FD | floquet_exponent | rel. width | time | theta_best | theta_best / floquet |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for (i, r) in rows.iter().enumerate() {
+        let enc = if r.verified {
+            format!("[{:.6}, {:.6}]", r.enc[0], r.enc[1])
+        } else {
+            format!("not verified: {}", r.reason.as_deref().unwrap_or("?"))
+        };
+        let tb = r.theta_best.map(|v| format!("{v:.4}")).unwrap_or("-".into());
+        let ratio = match (r.verified, r.theta_best) {
+            (true, Some(v)) => format!("{:.3}", v / r.enc[1]),
+            _ => "-".into(),
+        };
+        println!(
+            "| {i} | {} | {:.5} ({:.5}, {:.5}) | {} | {} | {enc} | {:.1e} | {:.0} ms | {tb} | {ratio} |",
+            r.n,
+            r.rate,
+            r.ci.0,
+            r.ci.1,
+            r.mult.map(|u| format!("{:.6} ({:.6}, {:.6})", u.0, u.1, u.2)).unwrap_or("-".into()),
+            r.fd.map(|v| format!("{v:.6}")).unwrap_or("-".into()),
+            r.rel_width,
+            1e3 * r.secs
+        );
     }
+    println!();
+}
+
+/// The enclosures against the measurements: verified, narrow, overlapping the measured interval
+/// or excluded beyond 4 sigma of it, the same against the dominant multiplier, bracketed by the
+/// pairs, and against the event-driven finite differences.
+fn print_summary(rows: &[Row], seed: u64, drawn: usize, total: f64) {
     let ver: Vec<&Row> = rows.iter().filter(|r| r.verified).collect();
     let narrow = ver.iter().filter(|r| r.rel_width <= 1e-3).count();
     let overlap = ver.iter().filter(|r| r.enc[0] <= r.ci.1 && r.ci.0 <= r.enc[1]).count();
@@ -237,23 +277,4 @@ fn main() {
         ver.len(),
         fd_dev.len()
     );
-    let mut reasons: Vec<String> = rows.iter().filter_map(|r| r.reason.clone()).collect();
-    reasons.sort();
-    reasons.dedup();
-    for r in reasons {
-        let c = rows.iter().filter(|x| x.reason.as_deref() == Some(r.as_str())).count();
-        println!("  not verified ({c}): {r}");
-    }
-    let ratios: Vec<f64> = ver.iter().filter_map(|r| r.theta_best.map(|t| t / r.enc[1])).collect::<Vec<_>>();
-    if !ratios.is_empty() {
-        let mut s = ratios.clone();
-        s.sort_by(f64::total_cmp);
-        println!(
-            "theta_best / floquet_hi: {} systems, median {:.3}, min {:.3}, max {:.3}",
-            s.len(),
-            s[s.len() / 2],
-            s[0],
-            s[s.len() - 1]
-        );
-    }
 }

@@ -233,13 +233,53 @@ fn main() {
     if std::env::var("THETA_BENCHMARK_NEAR").is_ok_and(|v| v == "1") {
         return near_main(want, seed, min_p);
     }
+    let start = std::time::Instant::now();
+    let (rows, drawn) = draw_rows(want, seed, min_p, &input_kind);
+    let secs = start.elapsed().as_secs_f64();
+    let table_a: Vec<&Row> = rows.iter().collect();
+    let table_b: Vec<&Row> = rows.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).collect();
+    if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
+        print_rows(&table_a);
+    }
+    println!(
+        "Seed {seed}: {drawn} systems drawn, {} convergent (measured 95 % interval below 0), {} of them certified by the paper's theta; {secs:.0} s on this machine.",
+        rows.len(),
+        table_b.len()
+    );
+    println!();
+    print_summary(&format!("A. All {} convergent systems:", table_a.len()), &table_a);
+    print_summary(&format!("B. The {} convergent systems certified by the paper's theta:", table_b.len()), &table_b);
+    print_ceilings(&table_a, &table_b);
+    print_where_star_loses(&table_b);
+    // by output dimension (issue 29 item 3): theta_engaged and theta_best per p
+    for (title, set) in [("A", &table_a), ("B", &table_b)] {
+        print_by_p(title, set, &BOUNDS[2..]);
+    }
+    let fc: Vec<f64> =
+        table_b.iter().filter_map(|r| r.floor_ceiling.filter(|c| *c < 0.0).map(|c| c / r.rate)).collect();
+    let fc_n = table_b.iter().filter(|r| r.p >= 2).count();
+    println!(
+        "Table B, p >= 2: theta_engaged with the simulated smallest |z'| per cell as floors (not a bound): < 0 on {} of {fc_n}, median / measured {:.3}.",
+        fc.len(),
+        median(fc.clone())
+    );
+    println!();
+    let all_viol = rows
+        .iter()
+        .filter(|r| BOUNDS.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
+        .count();
+    println!("Violations over all {} convergent systems and all bounds: {all_viol}.", rows.len());
+    paired_with_sine(&rows, &input_kind);
+}
+
+/// Draws until `want` convergent systems and `want` certified by the paper's theta (capped at
+/// 60 `want` candidates; `p >= min_p`): the rows and the number of systems drawn. Table A: all
+/// convergent systems drawn; table B: those certified by the paper's theta (the bounds' ratios
+/// compared on the same systems).
+fn draw_rows(want: usize, seed: u64, min_p: usize, input_kind: &str) -> (Vec<Row>, usize) {
     let params = theorems::strategies::draw(&system_params(&config()), seed, 60 * want);
     let measure = RateSettings { periods: 30, transient_periods: 10, pairs: 2, ..Default::default() };
     let settings = ThetaSettings { stationary: None, measure: Some(measure), ..Default::default() };
-    let start = std::time::Instant::now();
-    // Draw until `want` convergent systems and `want` certified by the paper's theta (capped at
-    // 60 `want` candidates). Table A: all convergent systems drawn; table B: those certified by
-    // the paper's theta (the bounds' ratios compared on the same systems).
     let mut rows: Vec<Row> = Vec::new();
     let mut paper_certified = 0;
     let mut drawn = 0;
@@ -251,67 +291,60 @@ fn main() {
         let got: Vec<Row> = chunk
             .par_iter()
             .filter(|c| c.n >= 2 && c.p >= min_p)
-            .filter_map(|c| measure_system(c, &settings, &input_kind))
+            .filter_map(|c| measure_system(c, &settings, input_kind))
             .collect();
         paper_certified += got.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).count();
         rows.extend(got);
     }
-    let secs = start.elapsed().as_secs_f64();
+    (rows, drawn)
+}
 
-    let table_a: Vec<&Row> = rows.iter().collect();
-    let table_b: Vec<&Row> = rows.iter().filter(|r| r.rep.theta_verified && r.rep.theta < 0.0).collect();
-    if std::env::var("THETA_BENCHMARK_ROWS").is_ok() {
-        print_rows(&table_a);
-    }
-    let bounds = BOUNDS;
-    let summary = |title: &str, set: &[&Row]| {
-        println!("{title}");
-        println!();
-        println!("| bound | certified (verified < 0) | median bound / measured | min | max | violations |");
-        println!("|---|---|---|---|---|---|");
-        for (name, get) in bounds {
-            let cert: Vec<&&Row> = set.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
-            let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
-            let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
-            let (lo, hi) = ratios.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
-            println!(
-                "| {name} | {} of {} | {:.3} | {:.3} | {:.3} | {violations} |",
-                cert.len(),
-                set.len(),
-                median(ratios.clone()),
-                lo,
-                hi
-            );
-        }
-        println!();
-    };
-    println!(
-        "Seed {seed}: {drawn} systems drawn, {} convergent (measured 95 % interval below 0), {} of them certified by the paper's theta; {secs:.0} s on this machine.",
-        rows.len(),
-        table_b.len()
-    );
+/// Table `title`: for each bound, how many systems of `set` it certifies, the median, smallest
+/// and largest bound / measured, and the violations.
+fn print_summary(title: &str, set: &[&Row]) {
+    println!("{title}");
     println!();
-    summary(&format!("A. All {} convergent systems:", table_a.len()), &table_a);
-    summary(&format!("B. The {} convergent systems certified by the paper's theta:", table_b.len()), &table_b);
-    // Ceiling of eq. (theta) itself (NOT a bound): the chord with the measured path length per
-    // period and the measured limsup |z'| in place of their certified bounds, minimised over
-    // lambda (table B: a lambda search of its own with this objective, plus the report's curve;
-    // table A: the report's curve only). Any theta built on eq. (theta) with tighter path or
-    // speed bounds stays above it, so its median ratio caps theta_star's.
-    let ceiling = |r: &Row| -> Option<f64> {
-        if r.ceiling.is_some() {
-            return r.ceiling;
-        }
-        let m = r.rep.measured.as_ref()?;
-        let (g1, ginf) = (m.path_length_per_period / (r.rep.period * r.rep.R), m.limsup_zdot / r.rep.R);
-        r.rep
-            .curve
-            .iter()
-            .map(|&(lambda, beta, _)| bounds::Psi { alpha: r.rep.alpha.lower, lambda, beta }.theta(g1, ginf))
-            .filter(|t| t.is_finite())
-            .min_by(f64::total_cmp)
-    };
-    for (title, set) in [("A", &table_a), ("B", &table_b)] {
+    println!("| bound | certified (verified < 0) | median bound / measured | min | max | violations |");
+    println!("|---|---|---|---|---|---|");
+    for (name, get) in BOUNDS {
+        let cert: Vec<&&Row> = set.iter().filter(|r| get(&r.rep).1 && get(&r.rep).0 < 0.0).collect();
+        let ratios: Vec<f64> = cert.iter().map(|r| get(&r.rep).0 / r.rate).collect();
+        let violations = cert.iter().filter(|r| get(&r.rep).0 < r.hi).count();
+        let (lo, hi) = ratios.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        println!(
+            "| {name} | {} of {} | {:.3} | {:.3} | {:.3} | {violations} |",
+            cert.len(),
+            set.len(),
+            median(ratios.clone()),
+            lo,
+            hi
+        );
+    }
+    println!();
+}
+
+/// Ceiling of eq. (theta) itself (NOT a bound): the chord with the measured path length per
+/// period and the measured limsup |z'| in place of their certified bounds, minimised over
+/// lambda (table B: a lambda search of its own with this objective, plus the report's curve;
+/// table A: the report's curve only). Any theta built on eq. (theta) with tighter path or
+/// speed bounds stays above it, so its median ratio caps theta_star's.
+fn ceiling(r: &Row) -> Option<f64> {
+    if r.ceiling.is_some() {
+        return r.ceiling;
+    }
+    let m = r.rep.measured.as_ref()?;
+    let (g1, ginf) = (m.path_length_per_period / (r.rep.period * r.rep.R), m.limsup_zdot / r.rep.R);
+    r.rep
+        .curve
+        .iter()
+        .map(|&(lambda, beta, _)| bounds::Psi { alpha: r.rep.alpha.lower, lambda, beta }.theta(g1, ginf))
+        .filter(|t| t.is_finite())
+        .min_by(f64::total_cmp)
+}
+
+/// The [`ceiling`] against the measured exponent, on tables A and B.
+fn print_ceilings(table_a: &[&Row], table_b: &[&Row]) {
+    for (title, set) in [("A", table_a), ("B", table_b)] {
         let c: Vec<(f64, f64)> = set.iter().filter_map(|r| ceiling(r).map(|t| (t, r.rate))).collect();
         let neg: Vec<f64> = c.iter().filter(|(t, _)| *t < 0.0).map(|(t, m)| t / m).collect();
         println!(
@@ -321,8 +354,11 @@ fn main() {
             median(neg.clone())
         );
     }
-    // where theta_star loses against the ceiling: certified path / measured path (<= 1) and
-    // certified limsup |z'| / measured (>= 1), medians over table B
+}
+
+/// Where theta_star loses against the [`ceiling`]: certified path / measured path (<= 1) and
+/// certified limsup |z'| / measured (>= 1), medians over table B.
+fn print_where_star_loses(table_b: &[&Row]) {
     let path_ratio: Vec<f64> = table_b
         .iter()
         .filter_map(|r| {
@@ -341,25 +377,6 @@ fn main() {
         speed_ratio(|r| r.zdot_bound),
         median(star_vs_ceiling)
     );
-    // by output dimension (issue 29 item 3): theta_engaged and theta_best per p
-    for (title, set) in [("A", &table_a), ("B", &table_b)] {
-        print_by_p(title, set, &bounds[2..]);
-    }
-    let fc: Vec<f64> =
-        table_b.iter().filter_map(|r| r.floor_ceiling.filter(|c| *c < 0.0).map(|c| c / r.rate)).collect();
-    let fc_n = table_b.iter().filter(|r| r.p >= 2).count();
-    println!(
-        "Table B, p >= 2: theta_engaged with the simulated smallest |z'| per cell as floors (not a bound): < 0 on {} of {fc_n}, median / measured {:.3}.",
-        fc.len(),
-        median(fc.clone())
-    );
-    println!();
-    let all_viol = rows
-        .iter()
-        .filter(|r| bounds.iter().any(|(_, g)| g(&r.rep).1 && g(&r.rep).0 < 0.0 && g(&r.rep).0 < r.hi))
-        .count();
-    println!("Violations over all {} convergent systems and all bounds: {all_viol}.", rows.len());
-    paired_with_sine(&rows, &input_kind);
 }
 
 /// The paired comparison with the sine (`THETA_BENCHMARK_INPUT` other than `sine`): over the
