@@ -246,6 +246,7 @@ struct Fine<'a> {
     h: f64,
     /// A delayed held input: its switching instant splits a fine step.
     split: bool,
+    /// The samples reach the plant through a zero-order hold.
     zoh: bool,
 }
 
