@@ -10,7 +10,7 @@ import sys
 from collections import defaultdict
 
 LINE = re.compile(r"^\s*(\w+) -> (\S+)\s.*?perr (Some\(([-\d.e+]+)\)|None).*?true (Some\(([-\d.e+]+)\)|None) "
-                  r"est (Some\(([-\d.e+]+)\)|None) sd (Some\(([-\d.e+]+)\)|None) ([\d.]+)s ")
+                  r"est (Some\(([-\d.e+]+)\)|None) sd (Some\(([-\d.e+]+)\)|None) (?:sdstat (?:Some\([-\d.e+]+\)|None) )?([\d.]+)s ")
 
 
 def main(paths):
@@ -32,6 +32,9 @@ def main(paths):
                 t, e, sd = float(m.group(6)), float(m.group(8)), float(m.group(10))
                 r["nz"] += 1
                 r["z2"] += abs(e - t) <= 2.0 * sd
+    if not rows:
+        # a changed line format must not read as an empty benchmark
+        sys.exit(f"discovery-bench-table: no case line of bench_one in {', '.join(paths)} (has its format changed?)")
     tot = defaultdict(int)
     print("| class | cases | named | within 15 % | within 2 sigma | slowest (s) |")
     print("|---|---|---|---|---|---|")
