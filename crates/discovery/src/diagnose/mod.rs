@@ -31,6 +31,10 @@
 //! whole record with the hypotheses it kept (again with every one where the whole record shows
 //! more than the leading part did).
 //!
+//! An effect that acts only beyond the estimation segment (`extend`): where the model is left
+//! incomplete by a candidate whose estimation fit was stuck but which halves the held-out error,
+//! the record is diagnosed again with a longer estimation segment.
+//!
 //! Several recordings of one machine: [`joint`] ([`diagnose_recordings`]) runs the above on
 //! each, then selects among the models they selected by leave-one-recording-out validation
 //! and fits the selected one jointly.
@@ -38,6 +42,7 @@ pub mod joint;
 pub mod report;
 pub mod settings;
 
+mod extend;
 mod hold;
 mod markdown;
 mod notes;
@@ -88,6 +93,16 @@ pub(crate) fn diagnose_selected(
     s: &DiagnoseSettings,
 ) -> Result<(Report, Selected), DiscoveryError> {
     s.validate(sys, rec)?;
+    let first = screened_or_whole(sys, rec, s)?;
+    extend::extended(sys, rec, s, first, screened_or_whole)
+}
+
+/// A long record screened ([`screen`]), any other diagnosed whole.
+fn screened_or_whole(
+    sys: &System,
+    rec: &Recording,
+    s: &DiagnoseSettings,
+) -> Result<(Report, Selected), DiscoveryError> {
     match screen::head(rec, s) {
         Some(head) => screen::diagnose_screened(sys, rec, &head, s, diagnose_whole),
         None => diagnose_whole(sys, rec, s),
