@@ -35,8 +35,8 @@ enum Late {
 }
 
 impl Late {
-    /// The sign in `rep` (diagnosed with estimation share `fraction` of `rec`), if any.
-    fn of(rep: &Report, rec: &Recording, fraction: f64) -> Option<Late> {
+    /// The sign in `rep` (diagnosed under `s` on `rec`), if any.
+    fn of(rep: &Report, rec: &Recording, s: &DiagnoseSettings) -> Option<Late> {
         let remaining = rep.remaining.as_ref()?;
         if let Some((label, share)) = &remaining.held_out_extension {
             let stuck =
@@ -45,7 +45,7 @@ impl Late {
                 return Some(Late::Stuck(label.clone(), *share));
             }
         }
-        let k_est = ((rec.len() as f64) * fraction).round() as usize;
+        let k_est = s.estimation_samples(rec.len());
         let w = remaining.windows.first()?;
         (k_est < rec.len() && w.t_start >= rec.time(k_est)).then_some(Late::Window(w.t_start, w.t_end))
     }
@@ -54,7 +54,7 @@ impl Late {
     fn found(&self, rep: &Report, sel: &Selected) -> bool {
         match self {
             Late::Stuck(label, _) => {
-                sel.chosen.as_ref().is_some_and(|c| c.label.split('+').any(|part| part.trim() == label))
+                sel.chosen.as_ref().is_some_and(|c| c.parts.iter().any(|h| &h.kind.label() == label))
             }
             Late::Window(..) => sel.chosen.is_some() && !rep.model_incomplete,
         }
@@ -87,7 +87,7 @@ pub(super) fn extended(
     if !first.0.model_incomplete || s.estimation_fraction >= EXTENDED_FRACTION {
         return Ok(first);
     }
-    let Some(late) = Late::of(&first.0, rec, s.estimation_fraction) else { return Ok(first) };
+    let Some(late) = Late::of(&first.0, rec, s) else { return Ok(first) };
     let wider = DiagnoseSettings { estimation_fraction: EXTENDED_FRACTION, ..s.clone() };
     let (mut rep, sel) = diagnose(sys, rec, &wider)?;
     if !late.found(&rep, &sel) {

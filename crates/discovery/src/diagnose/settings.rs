@@ -133,6 +133,12 @@ impl Default for DiagnoseSettings {
 }
 
 impl DiagnoseSettings {
+    /// Samples of the estimation segment of a record of `n` samples: the first
+    /// `estimation_fraction` of them.
+    pub fn estimation_samples(&self, n: usize) -> usize {
+        ((n as f64) * self.estimation_fraction).round() as usize
+    }
+
     /// Checks the settings and their agreement with the model `sys` and the recording `rec`:
     /// the estimation fraction in `[0.2, 0.95]`, at least 2 folds, the recording's inputs and
     /// outputs those of the model, a stated initial state of the model's dimensions.

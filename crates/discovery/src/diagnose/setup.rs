@@ -91,7 +91,7 @@ impl<'a> Setup<'a> {
         let dt = rec.dt;
         let w = flat(&rec.w);
         let y = flat(&rec.y);
-        let k_est = ((n_samp as f64) * s.estimation_fraction).round() as usize;
+        let k_est = s.estimation_samples(n_samp);
         let max_sub = s.max_substeps.max(1);
         let fast = sys.eig_F().iter().map(|c| c.norm()).fold(0.0, f64::max);
         let k0 = if fast > 0.0 { ((dt * fast * s.substep_ratio).ceil() as usize).clamp(1, max_sub) } else { 1 };
