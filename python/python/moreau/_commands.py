@@ -334,7 +334,9 @@ def diagnose(
         DataFrame with those columns, or a 2-D array with columns ``t, w1..wm, y1..yp[, z1..zp]``;
         or a list of CSV files of one machine (the joint diagnosis).
     estimation_fraction : float, default 0.7
-        Fraction of the record used for estimation (the rest validates).
+        Fraction of the record used for estimation (the rest validates). Below 0.9, a
+        record whose missing effect acts only after it is diagnosed again with 0.9 (the
+        report's first note says so).
     max_effects : int, default 2
         Greatest number of effects added by forward selection.
     input_hold : {"auto", "zoh", "foh"}, default "auto"

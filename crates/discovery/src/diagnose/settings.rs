@@ -12,7 +12,9 @@ use serde::Serialize;
 /// Settings of the diagnosis.
 #[derive(Debug, Clone)]
 pub struct DiagnoseSettings {
-    /// Fraction of the record used for estimation. Default 0.7.
+    /// Fraction of the record used for estimation. Default 0.7. Below
+    /// `extend::EXTENDED_FRACTION` (0.9), a record whose missing effect acts only after it is
+    /// diagnosed again with 0.9 (`diagnose/extend.rs`).
     pub estimation_fraction: f64,
     /// Largest number of linear sub-steps per sample. Default 64.
     pub max_substeps: usize,
