@@ -321,12 +321,13 @@ impl<'a> Fine<'a> {
     fn step(&self, s: &mut FineState, t: f64, h: f64) {
         let (n, vel) = (s.x.len(), self.pl.vel);
         // Held and delayed: the input is constant on each piece (its midpoint's value).
-        let u1 = if self.split && self.zoh { self.input(t + 0.5 * h) } else { self.input(t) };
+        let u_mid = self.input(t + 0.5 * h);
+        let u1 = if self.split && self.zoh { u_mid } else { self.input(t) };
         self.deriv(&s.x, u1, s.z, &mut s.k1);
         for i in 0..n {
             s.xm[i] = s.x[i] + 0.5 * h * s.k1[i];
         }
-        self.deriv(&s.xm, self.input(t + 0.5 * h), s.z, &mut s.k2);
+        self.deriv(&s.xm, u_mid, s.z, &mut s.k2);
         let v_old = s.x[vel];
         for i in 0..n {
             s.x[i] += h * s.k2[i];

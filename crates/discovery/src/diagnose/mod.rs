@@ -32,8 +32,9 @@
 //! more than the leading part did).
 //!
 //! An effect that acts only beyond the estimation segment (`extend`): where the model is left
-//! incomplete by a candidate whose estimation fit was stuck but which halves the held-out error,
-//! the record is diagnosed again with a longer estimation segment.
+//! incomplete and what is missing acts after the estimation segment (a candidate stuck there
+//! halves the held-out error, or the residual's largest window starts after it), the record is
+//! diagnosed again with a longer estimation segment.
 //!
 //! Several recordings of one machine: [`joint`] ([`diagnose_recordings`]) runs the above on
 //! each, then selects among the models they selected by leave-one-recording-out validation

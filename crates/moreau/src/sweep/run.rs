@@ -250,7 +250,10 @@ fn open_checkpoint(
     std::fs::create_dir_all(&opts.out)
         .map_err(|e| SweepError::Write { path: opts.out.clone(), reason: e.to_string() })?;
     let cperr = |e: std::io::Error| SweepError::Write { path: cp.to_path_buf(), reason: e.to_string() };
-    let exists_same = !opts.fresh && cp.exists() && previous_points(header, &opts.out, stem, false).is_ok();
+    // `plan` read the files already; without --overwrite it refused any of another sweep, so
+    // they are this sweep's and need no second reading
+    let exists_same =
+        !opts.fresh && cp.exists() && (!opts.overwrite || previous_points(header, &opts.out, stem, false).is_ok());
     if !exists_same {
         std::fs::write(cp, format!("{}\n", header.header_json())).map_err(cperr)?;
     }
