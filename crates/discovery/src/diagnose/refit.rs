@@ -1,5 +1,5 @@
 //! The selected model refitted and written out: its reported uncertainty ([`uncertainty`]:
-//! statistical sigma combined with the jackknife's model-error spread) and the fitted model
+//! statistical sigma or the jackknife's spread, the larger, with the stepping bias) and the fitted model
 //! ([`fitted`]: its simulation and residual, the grey-box values, `fitted.toml`'s system with
 //! the input file that replays the fit, and the effects as reported).
 use super::pass::FinerFit;
@@ -33,10 +33,11 @@ pub(super) struct Uncertainty {
 }
 
 /// Reported uncertainty: the statistical sigma of the fit (the larger of Gauss-Newton and
-/// the batch-means sandwich) combined with the model-error spread of a delete-a-group
-/// jackknife over contiguous folds of the estimation segment (fit::jackknife) and with the
-/// bias of the fitter's own stepping ([`stepping_part`], from `finer`: the selected model
-/// refitted at a finer stepping); `chosen`'s sigmas become the combined ones.
+/// the batch-means sandwich) or, where larger, the spread of a delete-a-group jackknife over
+/// contiguous folds of the estimation segment (noise and model error: [`jackknife::combine`]),
+/// with the bias of the fitter's own stepping added in quadrature ([`with_stepping`], from
+/// `finer`: the selected model refitted at a finer stepping); `chosen`'s sigmas become the
+/// combined ones.
 pub(super) fn uncertainty(
     data: &Setup,
     ctx: &FitContext,
@@ -80,10 +81,10 @@ pub(super) fn uncertainty(
             let st = stepping_part(&c.params, &f.theta, f.substeps, f.substeps_fine);
             let sn = stepping_part(&c.nominal, &f.nominal, f.substeps, f.substeps_fine);
             for (sd, p) in c.std.iter_mut().zip(&st) {
-                *sd = jackknife::combine(*sd, *p);
+                *sd = with_stepping(*sd, *p);
             }
             for (sd, p) in c.nominal_std.iter_mut().zip(&sn) {
-                *sd = jackknife::combine(*sd, *p);
+                *sd = with_stepping(*sd, *p);
             }
             stepping = Some((st, sn));
         }
@@ -91,11 +92,11 @@ pub(super) fn uncertainty(
     }
     let jack_resolved = jack.as_ref().is_some_and(|j| j.estimates.len() >= 2);
     let stepping_text = match (&stepping, finer) {
-        (Some(_), Some(f)) => format!(" The fitter's own stepping is included as a third part, s_step = |theta({k}) - theta({kf})| {kf}/({kf} - {k}): the selected model refitted at {kf} sub-steps per sample instead of {k} (the first-order stepping bias of the reading at {k}, extrapolated); 1 sigma = sqrt(s_stat^2 + (c s_jack)^2 + s_step^2).", k = f.substeps, kf = f.substeps_fine),
+        (Some(_), Some(f)) => format!(" The fitter's own stepping is included as a third part, s_step = |theta({k}) - theta({kf})| {kf}/({kf} - {k}): the selected model refitted at {kf} sub-steps per sample instead of {k} (the first-order stepping bias of the reading at {k}, extrapolated); 1 sigma = sqrt(max(s_stat, c s_jack)^2 + s_step^2).", k = f.substeps, kf = f.substeps_fine),
         _ => String::new(),
     };
     let method = format!(
-        "1 sigma = sqrt(s_stat^2 + (c s_jack)^2): s_stat the larger of Gauss-Newton and a batch-means sandwich (noise, white or coloured), s_jack a delete-a-group jackknife over {} contiguous folds of the estimation segment (each left out in turn, the selected model refitted on the rest: the spread that model error causes across the record, noise included), c = t_{}(0.975) / 1.96 = {:.2} so that +-2 sigma keeps 95 % coverage with the jackknife's {} degrees of freedom. {}A model error that shifts every fold alike (a bias constant over the record) is not seen by any resampling and is not included.{stepping_text}",
+        "1 sigma = max(s_stat, c s_jack): s_stat the larger of Gauss-Newton and a batch-means sandwich (noise, white or coloured), s_jack a delete-a-group jackknife over {} contiguous folds of the estimation segment (each left out in turn, the selected model refitted on the rest: the spread that model error causes across the record, noise included), c = t_{}(0.975) / 1.96 = {:.2} so that +-2 sigma keeps 95 % coverage with the jackknife's {} degrees of freedom; both parts count the noise, the jackknife also the model error, so the larger is taken. {}A model error that shifts every fold alike (a bias constant over the record) is not seen by any resampling and is not included.{stepping_text}",
         s.cv_folds,
         s.cv_folds - 1,
         jackknife::t_factor(s.cv_folds - 1),
@@ -137,7 +138,7 @@ fn derived_main(c: &Ranked, jack: Option<&Jackknife>, finer: Option<&FinerFit>) 
                     at(&f.theta[off..off + k])
                         .map_or(f64::NAN, |vf| stepping_part(&[value], &[vf], f.substeps, f.substeps_fine)[0])
                 });
-                let uncertainty = jackknife::combine(jackknife::combine(statistical, jackknife), stepping);
+                let uncertainty = with_stepping(jackknife::combine(statistical, jackknife), stepping);
                 DerivedParameter {
                     name: name.to_string(),
                     value,
@@ -161,6 +162,16 @@ fn derived_main(c: &Ranked, jack: Option<&Jackknife>, finer: Option<&FinerFit>) 
 pub fn stepping_part(theta: &[f64], theta_f: &[f64], k: usize, k_f: usize) -> Vec<f64> {
     let r = if k_f > k { k_f as f64 / (k_f - k) as f64 } else { f64::NAN };
     theta.iter().zip(theta_f).map(|(a, b)| (a - b).abs() * r).collect()
+}
+
+/// A sigma `sd` with the stepping part `step` ([`stepping_part`]) added in quadrature: a bias
+/// of the fitter's own discretisation, independent of the noise and model-error scatter. A
+/// `NaN` stepping part (no finer stepping) leaves `sd`.
+pub fn with_stepping(sd: f64, step: f64) -> f64 {
+    if !step.is_finite() {
+        return sd;
+    }
+    (sd * sd + step * step).sqrt()
 }
 
 /// The fitted model.

@@ -109,14 +109,14 @@ pub struct FittedEffect {
     pub label: String,
     pub description: String,
     pub params: Vec<(String, f64)>,
-    /// Reported 1-sigma: `sqrt(statistical^2 + jackknife^2)` ([`crate::fit::jackknife::combine`];
-    /// the statistical part alone where the jackknife is not defined).
+    /// Reported 1-sigma: `sqrt(max(statistical, jackknife)^2 + stepping^2)`
+    /// ([`crate::fit::jackknife::combine`]; a part that is not defined is left out).
     pub uncertainty: Vec<(String, f64)>,
     /// Its statistical part: the larger of Gauss-Newton and the batch-means sandwich (noise,
     /// white or coloured, for an exact model).
     pub uncertainty_statistical: Vec<(String, f64)>,
     /// Its model-error part: the delete-a-group jackknife over contiguous folds of the
-    /// estimation segment, widened by [`crate::fit::jackknife::t_factor`] for its degrees of
+    /// estimation segment (noise scatter and model-error spread), widened by [`crate::fit::jackknife::t_factor`] for its degrees of
     /// freedom (`NaN`, JSON `null`, where not computed).
     pub uncertainty_jackknife: Vec<(String, f64)>,
     /// Its stepping part: the bias of the fitter's own stepping, from the selected model

@@ -16,14 +16,18 @@
 //! the delete-a-group jackknife variance of the full-segment estimate (it contains the noise
 //! scatter as well as the model-error spread, with `g - 1` degrees of freedom).
 //!
-//! The reported 1-sigma is [`combine`]d: `sqrt(s_stat^2 + (c s_jack)^2)` with `s_stat` the larger
-//! of Gauss-Newton and the sandwich and `c = t_(g-1)(0.975) / 1.96` ([`t_factor`], 1.42 for
-//! 5 folds): a jackknife variance from `g` groups has `g - 1` degrees of freedom, so its 95 %
+//! The reported 1-sigma is [`combine`]d: `max(s_stat, c s_jack)` with `s_stat` the larger of
+//! Gauss-Newton and the sandwich and `c = t_(g-1)(0.975) / 1.96` ([`t_factor`], 1.42 for 5
+//! folds): a jackknife variance from `g` groups has `g - 1` degrees of freedom, so its 95 %
 //! interval is `+- t_(g-1)(0.975) s_jack`, and the factor keeps `+- 2 sigma` at that coverage.
-//! The sum counts the noise scatter twice (it is in both terms): on an exact model the sigma
-//! is conservative by at most `sqrt(1 + c^2)`; on a wrong model the jackknife term dominates.
-//! A model error that shifts every fold alike (a bias constant over the record) is seen by no
-//! resampling and is not covered; the report says so.
+//! Both parts estimate the same scatter where the model is exact (the jackknife's folds carry
+//! the noise too), and the jackknife alone sees the model-error spread: the larger of the two
+//! counts the noise once. (Their sum in quadrature counted it twice: on 167 fresh benchmark
+//! cases, 87 % of the truths lay within 1 sigma and 99.4 % within 2, against 68 % and 95 %
+//! claimed; the larger gives 79 % and 97 %, BENCHMARKS "Sigma: the noise counted once".)
+//! `+- 1 sigma` holds more than 68 % by design: the widening is for `+- 2 sigma`. A model error
+//! that shifts every fold alike (a bias constant over the record) is seen by no resampling and
+//! is not covered; the report says so.
 use crate::fit::{fit_estimate, FitSettings, FitStatus, Problem};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -92,13 +96,14 @@ pub fn jackknife_part(jack: f64, groups: usize) -> f64 {
 }
 
 /// The reported 1-sigma from the statistical one (`max(Gauss-Newton, sandwich)`) and the
-/// jackknife's part ([`jackknife_part`]): `sqrt(stat^2 + jack^2)`. A `NaN` jackknife (too few
-/// refits) leaves `stat`; a `NaN` `stat` (not identifiable) stays `NaN`.
+/// jackknife's part ([`jackknife_part`]): the larger, since both estimate the noise scatter and
+/// the jackknife adds the model-error spread. A `NaN` jackknife (too few refits) leaves `stat`;
+/// a `NaN` `stat` (not identifiable) stays `NaN`.
 pub fn combine(stat: f64, jack: f64) -> f64 {
-    if !jack.is_finite() {
+    if !jack.is_finite() || stat.is_nan() {
         return stat;
     }
-    (stat * stat + jack * jack).sqrt()
+    stat.max(jack)
 }
 
 /// The full-segment estimate the folds are refitted from (physical units).
@@ -190,11 +195,12 @@ mod tests {
     }
 
     #[test]
-    fn the_combined_sigma_never_claims_less_than_either_part() {
+    fn the_combined_sigma_is_the_larger_part() {
         for (s, j) in [(1.0, 0.0), (1.0, 3.0), (0.2, 0.1), (0.0, 0.5)] {
-            let c = combine(s, j);
-            assert!(c >= s && c >= j && c <= s + j + 1e-15, "combine({s}, {j}) = {c}");
+            assert_eq!(combine(s, j), f64::max(s, j), "combine({s}, {j})");
         }
+        // Negative control: the noise is not counted twice (the quadrature sum was 1.414 here).
+        assert_eq!(combine(1.0, 1.0), 1.0);
         // A zero-spread jackknife (or a failed one) cannot shrink the statistical sigma.
         assert_eq!(combine(0.3, 0.0), 0.3);
         assert_eq!(combine(0.3, f64::NAN), 0.3);
