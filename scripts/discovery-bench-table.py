@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Per-class table of `bench_one` outputs (issue 27's acceptance): named (top-1), main
-parameter within 15 %, within the reported 2 sigma, and the slowest case.
+parameter within 15 %, within the reported 2 sigma, and the slowest case; with `BENCH_NEXT=1`
+outputs, a second table: how the returned models predict each machine's next experiment.
 
 Usage: python3 scripts/discovery-bench-table.py OUT1.txt [OUT2.txt ...]
 (each OUT the stdout of `cargo run --release -p discovery --example bench_one CASES SEED PROFILE CLASSES`).
@@ -12,11 +13,20 @@ from collections import defaultdict
 LINE = re.compile(r"^\s*(\w+) -> (\S+)\s.*?perr (Some\(([-\d.e+]+)\)|None).*?true (Some\(([-\d.e+]+)\)|None) "
                   r"est (Some\(([-\d.e+]+)\)|None) sd (Some\(([-\d.e+]+)\)|None) (?:sdstat (?:Some\([-\d.e+]+\)|None) )?([\d.]+)s ")
 
+NEXT = re.compile(r"^\s*next experiment \((.*?)\): RMSE nominal ([-\d.e+naNinf]+), returned ([-\d.e+naNinf]+), "
+                  r"noise floor ([-\d.e+naNinf]+);")
+AT_FLOOR = 1.1  # bench::NEXT_AT_FLOOR: within a tenth of the noise floor
 
 def main(paths):
     rows = defaultdict(lambda: {"n": 0, "named": 0, "p15": 0, "np": 0, "z2": 0, "nz": 0, "max_s": 0.0})
+    nexts = defaultdict(list)
     for path in paths:
+        cls = None
         for line in open(path):
+            n = NEXT.match(line)
+            if n and cls is not None:
+                nexts[cls].append(tuple(float(n.group(i)) for i in (2, 3, 4)))
+                continue
             m = LINE.match(line)
             if not m:
                 continue
@@ -47,6 +57,27 @@ def main(paths):
           f"| {tot['p15']}/{tot['np']} ({100 * tot['p15'] / max(tot['np'], 1):.1f} %) "
           f"| {tot['z2']}/{tot['nz']} ({100 * tot['z2'] / max(tot['nz'], 1):.1f} %) | |")
     print(f"(effect classes alone: named {eff['named']}/{eff['n']})")
+    if nexts:
+        next_table(nexts)
+
+
+def next_table(nexts):
+    """Per class: the returned model's prediction of the next experiment within AT_FLOOR of
+    the noise floor, worse than the nominal's, and the median RMSE over the floor of each."""
+    def median(v):
+        v = sorted(v)
+        return v[len(v) // 2]
+    print()
+    print("| class | cases | returned model at the noise floor | worse than the nominal "
+          "| RMSE / floor, nominal (median) | RMSE / floor, returned (median) |")
+    print("|---|---|---|---|---|---|")
+    allv = []
+    for cls, v in nexts.items():
+        allv += v
+        print(f"| {cls} | {len(v)} | {sum(f <= AT_FLOOR * t for _, f, t in v)} | {sum(f > nm for nm, f, _ in v)} "
+              f"| {median([nm / t for nm, _, t in v]):.2f} | {median([f / t for _, f, t in v]):.2f} |")
+    print(f"| all | {len(allv)} | {sum(f <= AT_FLOOR * t for _, f, t in allv)} | {sum(f > nm for nm, f, _ in allv)} "
+          f"| {median([nm / t for nm, _, t in allv]):.2f} | {median([f / t for _, f, t in allv]):.2f} |")
 
 
 if __name__ == "__main__":

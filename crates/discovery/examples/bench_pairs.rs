@@ -10,6 +10,8 @@
 //! model and of the true pair (where fitted), the time and the case.
 //!
 //! `ESTIMATE_X0=1` has the initial state estimated (as for a model file that states none).
+//! `BENCH_NEXT=1` also records each machine's next experiment and predicts it with the
+//! returned model (a line per case, `bench::next_experiment`).
 //!
 //! `BENCH_PAIRS_TRUTH` set: each unflagged miss is diagnosed again with only its two true
 //! effects offered (`DiagnoseSettings::library`), and the line `truth only` gives what that
@@ -71,6 +73,9 @@ fn main() {
                 r.equivalents,
                 r.error
             );
+            if let Some(n) = &r.next {
+                println!("{:>36}    {n}", "");
+            }
             let again = match truth.as_deref() {
                 Some("all") => true,
                 Some(_) => !r.model_incomplete,

@@ -1,6 +1,8 @@
 //! The concealed-effect benchmark: generates cases with [`crate::bench_gen`], diagnoses each
 //! with [`crate::diagnose`] (which knows nothing of the generator) and scores the names and
 //! parameters.
+pub mod next_experiment;
+
 use crate::bench_gen::{self, Conditions, Profile, CLASSES, FRICTION_CLASSES};
 use crate::diagnose::{diagnose, DiagnoseSettings};
 use crate::physics;
@@ -46,7 +48,7 @@ pub struct CaseResult {
     pub est_std: Option<f64>,
     /// Its statistical part alone.
     pub est_std_statistical: Option<f64>,
-    /// Its jackknife part alone (widened for its degrees of freedom, as it enters the sum).
+    /// Its jackknife part alone (widened for its degrees of freedom, as it enters the sigma).
     pub est_std_jackknife: Option<f64>,
     pub fit_before: f64,
     pub fit_after: f64,
@@ -59,7 +61,14 @@ pub struct CaseResult {
     pub seconds: f64,
     /// A diagnosis error (should not happen).
     pub error: Option<String>,
+    /// How the returned model predicts the machine's next experiment (`BENCH_NEXT=1`; a
+    /// prediction's error goes to `error`).
+    pub next: Option<next_experiment::NextScore>,
 }
+
+/// A prediction of the next experiment whose RMSE is at most this factor over the noise floor
+/// is at the floor (the benchmark's summary): a tenth above what the noise alone leaves.
+pub const NEXT_AT_FLOOR: f64 = 1.1;
 
 /// The benchmark's result.
 #[derive(Debug, Clone, Serialize)]
@@ -144,6 +153,7 @@ pub fn run_case_with(
             if out.correct {
                 score_estimate(&case, &rep, &mut out);
             }
+            out.next = next_score(&case, &rep, &s, &mut out.error);
         }
     }
     out
@@ -179,6 +189,7 @@ impl CaseResult {
             delta_bic_truth: None,
             seconds,
             error: None,
+            next: None,
         }
     }
 }
@@ -256,6 +267,23 @@ fn score_estimate(case: &bench_gen::Case, rep: &crate::Report, out: &mut CaseRes
     out.est_std = sd(|f| &f.uncertainty, |d| d.uncertainty);
     out.est_std_statistical = sd(|f| &f.uncertainty_statistical, |d| d.uncertainty_statistical);
     out.est_std_jackknife = sd(|f| &f.uncertainty_jackknife, |d| d.uncertainty_jackknife);
+}
+
+/// How `rep`'s model predicts `case`'s next experiment (`None` without one); a prediction
+/// that fails is the case's `error`.
+fn next_score(
+    case: &bench_gen::Case,
+    rep: &crate::Report,
+    s: &DiagnoseSettings,
+    error: &mut Option<String>,
+) -> Option<next_experiment::NextScore> {
+    match next_experiment::score(case, rep, s)? {
+        Ok(n) => Some(n),
+        Err(e) => {
+            *error = Some(format!("next experiment: {e}"));
+            None
+        }
+    }
 }
 
 /// The selected model's BIC gain over the nominal, from the ranking (0 when nothing was added).
@@ -339,7 +367,7 @@ pub fn run_classes(
 impl BenchResult {
     /// Confusion matrix and summary as text.
     pub fn to_text(&self) -> String {
-        [self.confusion_text(), self.naming_text(), self.parameter_text(), self.time_text()].concat()
+        [self.confusion_text(), self.naming_text(), self.parameter_text(), self.next_text(), self.time_text()].concat()
     }
 
     /// The confusion matrix: true class per row, predicted per column (then `other`).
@@ -477,10 +505,45 @@ impl BenchResult {
     }
 
     /// The diagnoses' total time and time per case.
+    /// Per class, how the returned models predict the machines' next experiments (empty
+    /// without `BENCH_NEXT=1`): how many predict it within [`NEXT_AT_FLOOR`] of the noise
+    /// floor, how many worse than the nominal model, and the median RMSE over the floor of
+    /// the nominal and of the returned model.
+    fn next_text(&self) -> String {
+        let mut out = String::new();
+        for class in &self.classes {
+            let scores: Vec<&next_experiment::NextScore> =
+                self.cases.iter().filter(|c| &c.class == class).filter_map(|c| c.next.as_ref()).collect();
+            if scores.is_empty() {
+                continue;
+            }
+            let at_floor = scores.iter().filter(|n| n.over_floor() <= NEXT_AT_FLOOR).count();
+            let worse = scores.iter().filter(|n| n.rmse_fitted > n.rmse_nominal).count();
+            let nominal = median(scores.iter().map(|n| n.rmse_nominal / n.rmse_truth).collect());
+            let fitted = median(scores.iter().map(|n| n.over_floor()).collect());
+            out += &format!(
+                "{class:>20}: at the floor {at_floor}/{n}, worse than the nominal {worse}/{n}; RMSE / noise floor: nominal {nominal:.2}, returned {fitted:.2} (medians)\n",
+                n = scores.len()
+            );
+        }
+        if out.is_empty() {
+            return out;
+        }
+        format!(
+            "\nthe machine's next experiment (new input and noise), predicted by the returned model as it is:\n{out}"
+        )
+    }
+
     fn time_text(&self) -> String {
         let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
         format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / self.cases.len().max(1) as f64)
     }
+}
+
+/// The upper median of `v` (`NaN` where empty), as the tables' medians are read.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 #[cfg(test)]
@@ -528,6 +591,8 @@ pub struct PairResult {
     pub q_threshold: f64,
     pub seconds: f64,
     pub error: Option<String>,
+    /// How the returned model predicts the machine's next experiment (`BENCH_NEXT=1`).
+    pub next: Option<next_experiment::NextScore>,
 }
 
 /// Runs case `index` of the pair `pair` (`None` where the pair cannot co-occur), the true
@@ -558,6 +623,7 @@ pub fn run_pair_case(
         q_threshold: f64::NAN,
         seconds: start.elapsed().as_secs_f64(),
         error: None,
+        next: None,
     };
     match r {
         Err(e) => out.error = Some(e.to_string()),
@@ -590,6 +656,7 @@ pub fn run_pair_case(
             out.model_incomplete = rep.model_incomplete;
             out.q_final = rep.residual_fitted.q_auto;
             out.q_threshold = rep.residual_fitted.q_auto_threshold;
+            out.next = next_score(&case, &rep, &s, &mut out.error);
         }
     }
     Some(out)

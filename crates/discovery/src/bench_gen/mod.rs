@@ -147,6 +147,17 @@ fn noise_var() -> Result<Option<f64>, String> {
     bench_var("BENCH_NOISE_DB", finite, "a finite level in dB (default -30)")
 }
 
+/// `BENCH_NEXT` (`1`).
+fn next_var() -> Result<Option<()>, String> {
+    bench_var("BENCH_NEXT", |v| (v == "1").then_some(()), "1 (or unset: one recording per case)")
+}
+
+/// Whether each case also records its machine's next experiment ([`NextExperiment`]):
+/// `BENCH_NEXT=1`. The first recording's draws are the same either way.
+pub fn next_requested() -> bool {
+    matches!(next_var(), Ok(Some(())))
+}
+
 /// `BENCH_SIGNAL` ([`ForcedInput::parse`]).
 fn signal_var() -> Result<Option<ForcedInput>, String> {
     bench_var("BENCH_SIGNAL", ForcedInput::parse, "chirp or steps (or unset: the drawn inputs)")
@@ -179,12 +190,15 @@ pub fn noise_db() -> f64 {
 }
 
 /// What is wrong with the benchmark's environment variables (`BENCH_SIGNAL`,
-/// `BENCH_NOISE_DB`, `BENCH_LENGTH`, `BENCH_TRUTH`), naming the first refused variable and its
-/// value; `None` where each is unset or valid. The generator reads them leniently; the runners
+/// `BENCH_NOISE_DB`, `BENCH_LENGTH`, `BENCH_TRUTH`, `BENCH_NEXT`), naming the first refused
+/// variable and its value; `None` where each is unset or valid. The generator reads them leniently; the runners
 /// refuse to start on one, so a typo does not pass for a measurement under the condition it
 /// names.
 pub fn env_error() -> Option<String> {
-    [signal_var().err(), noise_var().err(), length_var().err(), truth_var().err()].into_iter().flatten().next()
+    [signal_var().err(), noise_var().err(), length_var().err(), truth_var().err(), next_var().err()]
+        .into_iter()
+        .flatten()
+        .next()
 }
 
 /// The sampling and noise conditions of one case (reported per case by the benchmark).
@@ -332,6 +346,20 @@ pub struct Case {
     pub nominal_fit: f64,
     pub description: String,
     pub conditions: Conditions,
+    /// The machine's next experiment, where `BENCH_NEXT=1` asks for it ([`next_requested`]).
+    pub next: Option<NextExperiment>,
+}
+
+/// A second recording of a case's machine: the same plant, concealed effects, initial state,
+/// hold, sampling, duration and noise level and colour; a new input and new noise. A model
+/// fitted on the first recording must predict it (issue 27: in-sample is not validation).
+#[derive(Debug, Clone)]
+pub struct NextExperiment {
+    pub recording: Recording,
+    /// Its output without measurement noise.
+    pub clean: Vec<f64>,
+    /// The input's family (`multisine`, `filtered noise`, `sine segments`).
+    pub input: &'static str,
 }
 
 /// The true plant in physical form.
@@ -573,13 +601,19 @@ pub fn generate(class: &'static str, seed: u64, index: usize) -> Case {
 
 /// Generates case number `index` of `class` from `seed` in `profile`.
 pub fn generate_profile(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
-    generate_classes(&[class], seed, index, profile, forced_signal())
+    generate_classes(&[class], seed, index, profile, forced_signal(), next_requested())
+}
+
+/// [`generate_profile`] with the machine's next experiment ([`Case::next`]) whatever
+/// `BENCH_NEXT` says.
+pub fn generate_with_next(class: &'static str, seed: u64, index: usize, profile: Profile) -> Case {
+    generate_classes(&[class], seed, index, profile, forced_signal(), true)
 }
 
 /// [`generate_profile`] with the input `input` in place of the drawn one (and of
 /// `BENCH_SIGNAL`'s).
 pub fn generate_with_input(class: &'static str, seed: u64, index: usize, profile: Profile, input: ForcedInput) -> Case {
-    generate_classes(&[class], seed, index, profile, Some(input))
+    generate_classes(&[class], seed, index, profile, Some(input), next_requested())
 }
 
 /// Whether two classes can be concealed in one recording by [`generate_pair`]: distinct, not
@@ -615,18 +649,21 @@ pub fn pairs() -> Vec<[&'static str; 2]> {
 /// plant, input and noise are drawn as for the first class alone. `None` where the pair is not
 /// [`pair_compatible`].
 pub fn generate_pair(pair: [&'static str; 2], seed: u64, index: usize, profile: Profile) -> Option<Case> {
-    pair_compatible(pair[0], pair[1]).then(|| generate_classes(&pair, seed, index, profile, forced_signal()))
+    pair_compatible(pair[0], pair[1])
+        .then(|| generate_classes(&pair, seed, index, profile, forced_signal(), next_requested()))
 }
 
 /// Generates case number `index` concealing every class of `classes` (one, or a pair) from
 /// `seed` in `profile`. One class draws exactly what it always did; the second of a pair takes
-/// its target and sign from a stream of its own. `input` replaces the drawn input kind.
+/// its target and sign from a stream of its own. `input` replaces the drawn input kind; `next`
+/// also records the machine's next experiment.
 fn generate_classes(
     classes: &[&'static str],
     seed: u64,
     index: usize,
     profile: Profile,
     input: Option<ForcedInput>,
+    next: bool,
 ) -> Case {
     let class = classes[0];
     let mix = case_mix(classes, seed, index);
@@ -682,26 +719,15 @@ fn generate_classes(
     let truths =
         true_effects(classes, mix, (target, sign), wmax, plant.vel, &fshape, &measure_all, &clean_nom, period, ystd);
     let truth = truths.first().cloned();
-    let effs: Vec<&Effect> = truths.iter().collect();
-    let clean = if converged_truth() {
-        // The magnitudes above were set on the 20-per-sample grid; the recording's truth is
-        // converged to a tenth of a sigma of any fitted parameter (white-noise count of samples).
-        let tol = 0.1 * noise_std * noise_scale / (ns as f64).sqrt();
-        plant_sim::simulate_converged(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive, tol).0
-    } else {
-        plant_sim::simulate_effects(&plant, hw_nom, &effs, &signal, &x0, dt, ns, drive)
-    };
+    let machine = Machine { plant: &plant, hw_nom, effs: truths.iter().collect(), x0: &x0, dt, ns, drive };
+    let clean = machine.clean(&signal, noise_std * noise_scale);
     let y: Vec<f64> = clean.iter().zip(&noise).map(|(a, b)| a + b * noise_scale).collect();
     let nominal_fit = fit_percent(&y, &clean_nom);
     let name = format!("bench {} #{index} (n = {n})", classes.join("+"));
     let nominal = nominal_system(name, &plant, nominal_has_play, &x0, dt, duration);
-    let recording = Recording::from_samples(
-        &format!("bench-{}-{index}", classes.join("+")),
-        &t,
-        w.iter().map(|v| vec![*v]).collect(),
-        y.iter().map(|v| vec![*v]).collect(),
-        None,
-    );
+    let label = format!("bench-{}-{index}", classes.join("+"));
+    let recording = machine.recording(&label, &t, &w, &y);
+    let next = next.then(|| machine.next_experiment(&label, mix, duration, noise_std * noise_scale, noise_rho));
     let conditions = Conditions { profile, hold: drive.name(), dt, noise_rho, omega0: plant.omega0, zeta: plant.zeta };
     let description = format!(
         "n = {n}, omega0 = {:.2}, zeta = {:.2}, input {sig_name}, {ns} samples, {}, nominal fit {nominal_fit:.1} %",
@@ -709,7 +735,73 @@ fn generate_classes(
         plant.zeta,
         conditions.short()
     );
-    Case { class, nominal, truth, truths, classes: classes.to_vec(), recording, nominal_fit, description, conditions }
+    Case {
+        class,
+        nominal,
+        truth,
+        truths,
+        classes: classes.to_vec(),
+        recording,
+        nominal_fit,
+        description,
+        conditions,
+        next,
+    }
+}
+
+/// The true machine of a case: the plant, the nominal's play, the concealed effects, the
+/// initial state, what the plant sees of the command, and the recording's sampling.
+struct Machine<'a> {
+    plant: &'a Plant,
+    hw_nom: f64,
+    effs: Vec<&'a Effect>,
+    x0: &'a [f64],
+    dt: f64,
+    ns: usize,
+    drive: Drive,
+}
+
+impl Machine<'_> {
+    /// The clean output under `signal`. The effects' magnitudes are set on the 20-per-sample
+    /// grid; a recording's truth is converged to a tenth of a sigma of any fitted parameter
+    /// (white-noise count of samples) for measurement noise of standard deviation `noise_std`
+    /// (unless [`converged_truth`] is off).
+    fn clean(&self, signal: &Signal, noise_std: f64) -> Vec<f64> {
+        let (pl, hw, effs, x0, dt, ns, drive) =
+            (self.plant, self.hw_nom, &self.effs, self.x0, self.dt, self.ns, self.drive);
+        if converged_truth() {
+            let tol = 0.1 * noise_std / (ns as f64).sqrt();
+            plant_sim::simulate_converged(pl, hw, effs, signal, x0, dt, ns, drive, tol).0
+        } else {
+            plant_sim::simulate_effects(pl, hw, effs, signal, x0, dt, ns, drive)
+        }
+    }
+
+    /// The recording `label` of command samples `w` and measured outputs `y` at times `t`.
+    fn recording(&self, label: &str, t: &[f64], w: &[f64], y: &[f64]) -> Recording {
+        Recording::from_samples(
+            label,
+            t,
+            w.iter().map(|v| vec![*v]).collect(),
+            y.iter().map(|v| vec![*v]).collect(),
+            None,
+        )
+    }
+
+    /// The machine's next experiment ([`NextExperiment`]): an input of the same families drawn
+    /// afresh, and new measurement noise of the same standard deviation `noise_std` and AR(1)
+    /// colour `rho`, both from a stream of their own (the first recording's draws stay as
+    /// they were), over the same `duration`.
+    fn next_experiment(&self, label: &str, mix: u64, duration: f64, noise_std: f64, rho: f64) -> NextExperiment {
+        let mut rng = ChaCha8Rng::seed_from_u64(mix ^ 0x4E58_7E59_0000_0002);
+        let (signal, input) = random_signal(&mut rng, self.plant.omega0, duration);
+        let noise = measurement_noise(&mut rng, self.ns, noise_std, rho);
+        let t: Vec<f64> = (0..self.ns).map(|k| k as f64 * self.dt).collect();
+        let w: Vec<f64> = t.iter().map(|&tk| signal.eval(tk)).collect();
+        let clean = self.clean(&signal, noise_std);
+        let y: Vec<f64> = clean.iter().zip(&noise).map(|(a, b)| a + b).collect();
+        NextExperiment { recording: self.recording(&format!("{label}-next"), &t, &w, &y), clean, input }
+    }
 }
 
 /// The seed of case `index` of `classes` from `seed`: one class draws what it always did; the
