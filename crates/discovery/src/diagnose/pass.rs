@@ -232,6 +232,16 @@ impl<'a> Pass<'a> {
                     self.hold,
                     &mut self.hold_report,
                 )
+                .or_else(|| {
+                    hold::rival_prefers_other(
+                        data,
+                        &self.ctx,
+                        &selection.ranking,
+                        selection.chosen.as_ref(),
+                        self.hold,
+                        &mut self.hold_report,
+                    )
+                })
                 .map(|(other, note, r)| (other, note, Some(r)))
             });
             if let Some((other, note, carried)) = undone {
