@@ -11,7 +11,9 @@
 //! delay too), the hold is switched and the diagnosis is redone. Once the selection has
 //! settled ([`selected_model_prefers_other`], once), its model is refitted under the other
 //! hold; where it fits better there, the hold is switched (a switch by the effects undone) and
-//! the diagnosis redone.
+//! the diagnosis redone. Where it does not, the ranking's readings that can still ask for the
+//! other hold are refitted under it ([`ranking_prefers_other`]): a delay stopped at its bound
+//! under the zero-order hold, and the best rivals of a model of two effects.
 //!
 //! Delay under an unknown hold ([`delay_under_both_holds`], `auto` only): a selected input
 //! delay is refitted under the other hold; where the two fits differ by less than the tie
@@ -295,22 +297,14 @@ pub const DELAY_AT_BOUND_SHARE: f64 = 1e-3;
 /// ([`colour_deflation`]), the hold is switched and the diagnosis redone; that model is
 /// returned to be carried (it stands only where it beats the redone selection by the margin
 /// and passes its cross-validation, `select::forward::adopt_carried`).
-pub(super) fn delay_at_bound_prefers_other(
-    data: &Setup,
-    ctx: &FitContext,
-    ranking: &[Ranked],
-    chosen: Option<&Ranked>,
-    hold: InputHold,
-    report: &mut HoldReport,
-) -> Option<(InputHold, String, Ranked)> {
-    let c = chosen?;
+fn delay_at_bound_prefers_other(q: &Question, report: &mut HoldReport) -> Option<(InputHold, String, Ranked)> {
+    let Question { data, ranking, c, hold, .. } = *q;
     let s = data.s;
     // After a switch by the effects ([`overturned_by_effects`], which asked the delay too) the
     // zero-order hold was chosen over the first-order one with the effects in: fresh singles
     // seed 10923 (mixed) `asymmetric_coulomb` #3, zero-order held, went back to the first-order
     // hold with a delay of 0.92 h/2 (the zero-order hold's equivalent) without that guard.
-    let asked = s.input_hold == HoldChoice::Auto && s.screened_hold.is_none() && hold == InputHold::Zoh;
-    if !asked || report.switched || has_delay(c) {
+    if hold != InputHold::Zoh || report.switched {
         return None;
     }
     let at_bound = |r: &Ranked| {
@@ -318,7 +312,7 @@ pub(super) fn delay_at_bound_prefers_other(
         !at.is_empty() && at.iter().all(|&i| r.params.get(i).is_some_and(|&d| d <= DELAY_AT_BOUND_SHARE * data.dt))
     };
     let r = ranking.iter().filter(|r| at_bound(r)).min_by(|a, b| a.bic.total_cmp(&b.bic))?;
-    let d = gain_under_other_hold(data, ctx, r, c, hold)?;
+    let d = q.gain_under_other_hold(r)?;
     if !(d > s.select.tie_bic) {
         return None;
     }
@@ -360,18 +354,9 @@ pub const HOLD_RIVALS: usize = 8;
 /// more than the tie margin, its residual's colour counted ([`colour_deflation`]), the hold is
 /// switched and the diagnosis redone, and the rival is returned to be carried (as for
 /// [`delay_at_bound_prefers_other`]).
-pub(super) fn rival_prefers_other(
-    data: &Setup,
-    ctx: &FitContext,
-    ranking: &[Ranked],
-    chosen: Option<&Ranked>,
-    hold: InputHold,
-    report: &mut HoldReport,
-) -> Option<(InputHold, String, Ranked)> {
-    let c = chosen?;
-    let s = data.s;
-    let asked = s.input_hold == HoldChoice::Auto && s.screened_hold.is_none();
-    if !asked || c.parts.len() < 2 || has_delay(c) {
+fn rival_prefers_other(q: &Question, report: &mut HoldReport) -> Option<(InputHold, String, Ranked)> {
+    let Question { ranking, c, hold, .. } = *q;
+    if c.parts.len() < 2 {
         return None;
     }
     let mut rivals: Vec<&Ranked> = ranking
@@ -389,9 +374,9 @@ pub(super) fn rival_prefers_other(
     let (r, d) = rivals
         .into_iter()
         .take(HOLD_RIVALS)
-        .filter_map(|r| gain_under_other_hold(data, ctx, r, c, hold).map(|d| (r, d)))
+        .filter_map(|r| q.gain_under_other_hold(r).map(|d| (r, d)))
         .max_by(|a, b| a.1.total_cmp(&b.1))?;
-    if !(d > s.select.tie_bic) {
+    if !(d > q.data.s.select.tie_bic) {
         return None;
     }
     let other = other_hold(hold);
@@ -462,15 +447,51 @@ fn colour_deflation(pb: &fit::Problem, r: &FitResult) -> f64 {
     crate::residual::independent_share(pb.estimation_residual_rho(&r.theta, &r.nominal, &r.x0).unwrap_or(0.0))
 }
 
-/// `r` (of the ranking, fitted under `hold`) refitted under the other hold: how much lower
-/// its BIC is there than the selected model's `c` under `hold`, counted for its residual's
-/// colour ([`colour_deflation`]); `None` where the refit fails.
-fn gain_under_other_hold(data: &Setup, ctx: &FitContext, r: &Ranked, c: &Ranked, hold: InputHold) -> Option<f64> {
-    let (ctx_o, r_o) = refit_under_other_hold(data, r, hold, ctx.substeps, data.x_scale.clone(), &data.s.fit);
-    if r_o.status == fit::FitStatus::Failed || !r_o.sse.is_finite() {
+/// What the ranking's other readings are asked against ([`ranking_prefers_other`]): the
+/// selected model `c` of `ranking`, fitted under `hold` in `ctx`.
+#[derive(Clone, Copy)]
+struct Question<'q, 'd> {
+    data: &'q Setup<'d>,
+    ctx: &'q FitContext<'d>,
+    ranking: &'q [Ranked],
+    c: &'q Ranked,
+    hold: InputHold,
+}
+
+impl Question<'_, '_> {
+    /// `r` (of the ranking) refitted under the other hold: how much lower its BIC is there than
+    /// the selected model's under `hold`, counted for its residual's colour
+    /// ([`colour_deflation`]); `None` where the refit fails.
+    fn gain_under_other_hold(&self, r: &Ranked) -> Option<f64> {
+        let (data, hold) = (self.data, self.hold);
+        let (ctx_o, r_o) = refit_under_other_hold(data, r, hold, self.ctx.substeps, data.x_scale.clone(), &data.s.fit);
+        if r_o.status == fit::FitStatus::Failed || !r_o.sse.is_finite() {
+            return None;
+        }
+        Some((self.c.bic - bic_under_other_hold(r, r_o.sse, data.n_res)) * colour_deflation(&r.problem(&ctx_o), &r_o))
+    }
+}
+
+/// Once the selection has settled without a delay, and the selected model did not ask for the
+/// other hold ([`selected_model_prefers_other`]; `auto` hold only, once per diagnosis): the
+/// ranking's other readings that can, a delay stopped at its bound
+/// ([`delay_at_bound_prefers_other`]) or a rival of a model of several effects
+/// ([`rival_prefers_other`]). The hold to switch to, the note, and the reading to carry.
+pub(super) fn ranking_prefers_other(
+    data: &Setup,
+    ctx: &FitContext,
+    ranking: &[Ranked],
+    chosen: Option<&Ranked>,
+    hold: InputHold,
+    report: &mut HoldReport,
+) -> Option<(InputHold, String, Ranked)> {
+    let c = chosen?;
+    let asked = data.s.input_hold == HoldChoice::Auto && data.s.screened_hold.is_none();
+    if !asked || has_delay(c) {
         return None;
     }
-    Some((c.bic - bic_under_other_hold(r, r_o.sse, data.n_res)) * colour_deflation(&r.problem(&ctx_o), &r_o))
+    let q = Question { data, ctx, ranking, c, hold };
+    delay_at_bound_prefers_other(&q, report).or_else(|| rival_prefers_other(&q, report))
 }
 
 /// BIC of the fitted model `c` refitted under the other hold to the estimation SSE `sse_other`

@@ -3,8 +3,9 @@
 //!
 //! A pass ends in a restart (the next pass starts from the singles of this one) where
 //! - the best effects overturn an `auto` hold ([`super::hold::overturned_by_effects`], once),
-//! - the selected model fits better under the other hold
-//!   ([`super::hold::selected_model_prefers_other`], once), or
+//! - the selected model, or a reading of the ranking that can ask for it, fits better under
+//!   the other hold ([`super::hold::selected_model_prefers_other`],
+//!   [`super::hold::ranking_prefers_other`], once), or
 //! - the selected model needs more sub-steps than the nominal (once): the whole selection is
 //!   rerun at the sub-steps it needs.
 //!
@@ -224,7 +225,7 @@ impl<'a> Pass<'a> {
             )
             .map(|(other, note)| (other, note, selection.chosen.clone()))
             .or_else(|| {
-                hold::delay_at_bound_prefers_other(
+                hold::ranking_prefers_other(
                     data,
                     &self.ctx,
                     &selection.ranking,
@@ -232,16 +233,6 @@ impl<'a> Pass<'a> {
                     self.hold,
                     &mut self.hold_report,
                 )
-                .or_else(|| {
-                    hold::rival_prefers_other(
-                        data,
-                        &self.ctx,
-                        &selection.ranking,
-                        selection.chosen.as_ref(),
-                        self.hold,
-                        &mut self.hold_report,
-                    )
-                })
                 .map(|(other, note, r)| (other, note, Some(r)))
             });
             if let Some((other, note, carried)) = undone {
