@@ -504,7 +504,6 @@ impl BenchResult {
         s
     }
 
-    /// The diagnoses' total time and time per case.
     /// Per class, how the returned models predict the machines' next experiments (empty
     /// without `BENCH_NEXT=1`): how many predict it within [`NEXT_AT_FLOOR`] of the noise
     /// floor, how many worse than the nominal model, and the median RMSE over the floor of
@@ -534,6 +533,7 @@ impl BenchResult {
         )
     }
 
+    /// The diagnoses' total time and time per case.
     fn time_text(&self) -> String {
         let secs: f64 = self.cases.iter().map(|c| c.seconds).sum();
         format!("\ndiagnosis time: {secs:.1} s total, {:.2} s per case\n", secs / self.cases.len().max(1) as f64)

@@ -6,6 +6,7 @@
 //! state the model states. Scored against the nominal model's prediction and the noise floor.
 use crate::bench_gen::{self, NextExperiment};
 use crate::diagnose::{diagnose, DiagnoseSettings, HoldChoice, InitialState};
+use crate::metrics::rmse;
 use crate::{DiscoveryError, Recording, Report};
 use model::System;
 use serde::Serialize;
@@ -106,11 +107,6 @@ pub fn prediction_rmse(
     };
     let y: Vec<f64> = rec.y.iter().flatten().copied().collect();
     Ok(rmse(&diagnose(sys, rec, &s)?.series.yhat_nominal, &y))
-}
-
-/// Root mean square of `a - b`.
-fn rmse(a: &[f64], b: &[f64]) -> f64 {
-    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len().max(1) as f64).sqrt()
 }
 
 #[cfg(test)]

@@ -726,7 +726,7 @@ fn generate_classes(
     let name = format!("bench {} #{index} (n = {n})", classes.join("+"));
     let nominal = nominal_system(name, &plant, nominal_has_play, &x0, dt, duration);
     let label = format!("bench-{}-{index}", classes.join("+"));
-    let recording = machine.recording(&label, &t, &w, &y);
+    let recording = recording_of(&label, &t, &w, &y);
     let next = next.then(|| machine.next_experiment(&label, mix, duration, noise_std * noise_scale, noise_rho));
     let conditions = Conditions { profile, hold: drive.name(), dt, noise_rho, omega0: plant.omega0, zeta: plant.zeta };
     let description = format!(
@@ -747,6 +747,11 @@ fn generate_classes(
         conditions,
         next,
     }
+}
+
+/// The recording `label` of command samples `w` and measured outputs `y` at times `t`.
+fn recording_of(label: &str, t: &[f64], w: &[f64], y: &[f64]) -> Recording {
+    Recording::from_samples(label, t, w.iter().map(|v| vec![*v]).collect(), y.iter().map(|v| vec![*v]).collect(), None)
 }
 
 /// The true machine of a case: the plant, the nominal's play, the concealed effects, the
@@ -777,17 +782,6 @@ impl Machine<'_> {
         }
     }
 
-    /// The recording `label` of command samples `w` and measured outputs `y` at times `t`.
-    fn recording(&self, label: &str, t: &[f64], w: &[f64], y: &[f64]) -> Recording {
-        Recording::from_samples(
-            label,
-            t,
-            w.iter().map(|v| vec![*v]).collect(),
-            y.iter().map(|v| vec![*v]).collect(),
-            None,
-        )
-    }
-
     /// The machine's next experiment ([`NextExperiment`]): an input of the same families drawn
     /// afresh, and new measurement noise of the same standard deviation `noise_std` and AR(1)
     /// colour `rho`, both from a stream of their own (the first recording's draws stay as
@@ -800,7 +794,7 @@ impl Machine<'_> {
         let w: Vec<f64> = t.iter().map(|&tk| signal.eval(tk)).collect();
         let clean = self.clean(&signal, noise_std);
         let y: Vec<f64> = clean.iter().zip(&noise).map(|(a, b)| a + b).collect();
-        NextExperiment { recording: self.recording(&format!("{label}-next"), &t, &w, &y), clean, input }
+        NextExperiment { recording: recording_of(&format!("{label}-next"), &t, &w, &y), clean, input }
     }
 }
 
